@@ -1,0 +1,28 @@
+#pragma once
+/// Thread control. Stages are written so that their output never depends on the thread count;
+/// this only bounds how many cores they use.
+#include <memory>
+
+namespace viewcells {
+
+/// While alive, limits every parallel stage (TBB and Embree's TBB tasks) to `threads` threads.
+/// threads == 0 means all hardware threads.
+class ThreadLimit {
+ public:
+  explicit ThreadLimit(int threads);
+  ~ThreadLimit();
+  ThreadLimit(const ThreadLimit&) = delete;
+  ThreadLimit& operator=(const ThreadLimit&) = delete;
+  /// The number of threads in effect.
+  int threads() const { return threads_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int threads_;
+};
+
+/// Number of hardware threads.
+int hardware_threads();
+
+}  // namespace viewcells

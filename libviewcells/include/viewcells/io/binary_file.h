@@ -1,0 +1,100 @@
+#pragma once
+/// Versioned, checksummed binary containers for the toolkit's own files (.vseg, later .vcells
+/// and .pvs). Layout: magic (4 bytes), format version (u32), payload size (u64), FNV-1a 64
+/// checksum of the payload (u64), compressed size (u64), then the zstd-compressed payload.
+/// Little-endian. Reading rejects wrong magic, newer versions, truncation and bit flips.
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "viewcells/core/error.h"
+
+namespace viewcells {
+
+/// Appends plain values and arrays to a byte buffer.
+class ByteWriter {
+ public:
+  template <class T>
+  void put(const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    const auto* p = reinterpret_cast<const char*>(&v);
+    data_.append(p, sizeof(T));
+  }
+  template <class T>
+  void put_array(const std::vector<T>& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    put<uint64_t>(v.size());
+    data_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
+  }
+  void put_string(const std::string& s) {
+    put<uint64_t>(s.size());
+    data_.append(s);
+  }
+  const std::string& data() const { return data_; }
+
+ private:
+  std::string data_;
+};
+
+/// Reads what ByteWriter wrote; every read is bounds-checked and throws Error naming the file.
+class ByteReader {
+ public:
+  ByteReader(const std::string& data, std::string file) : data_(data), file_(std::move(file)) {}
+  template <class T>
+  T get() {
+    static_assert(std::is_trivially_copyable_v<T>);
+    need(sizeof(T));
+    T v;
+    std::memcpy(&v, data_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return v;
+  }
+  /// max_count guards against absurd sizes in a corrupt file before allocating.
+  template <class T>
+  std::vector<T> get_array(uint64_t max_count) {
+    const uint64_t n = get<uint64_t>();
+    if (n > max_count) fail("array of " + std::to_string(n) + " elements exceeds " + std::to_string(max_count));
+    need(n * sizeof(T));
+    std::vector<T> v(n);
+    if (n) std::memcpy(v.data(), data_.data() + pos_, n * sizeof(T));
+    pos_ += n * sizeof(T);
+    return v;
+  }
+  std::string get_string() {
+    const uint64_t n = get<uint64_t>();
+    need(n);
+    std::string s = data_.substr(pos_, n);
+    pos_ += n;
+    return s;
+  }
+  bool at_end() const { return pos_ == data_.size(); }
+  [[noreturn]] void fail(const std::string& what) const {
+    throw Error(file_, 0, "corrupt file: " + what);
+  }
+
+ private:
+  void need(uint64_t n) const {
+    if (n > data_.size() - pos_) fail("payload ends early");
+  }
+  const std::string& data_;
+  std::string file_;
+  size_t pos_ = 0;
+};
+
+/// Writes payload into `path` atomically (temporary file + rename).
+void write_container(const std::string& path, const char (&magic)[5], uint32_t version,
+                     const std::string& payload);
+/// Reads and verifies a container; returns the payload and sets `version`.
+/// Throws Error for a missing file, wrong magic, a version above max_version, or corruption.
+std::string read_container(const std::string& path, const char (&magic)[5], uint32_t max_version,
+                           uint32_t& version);
+
+/// FNV-1a 64-bit hash of a byte string.
+uint64_t fnv1a64(const std::string& bytes);
+
+/// Writes `text` to `path` atomically; throws Error on failure.
+void write_text_file(const std::string& path, const std::string& text);
+
+}  // namespace viewcells

@@ -1,0 +1,66 @@
+#pragma once
+/// Visibility segment sampling (view-cell-construction paper, section 4.1): points uniform in
+/// the view space box, directions uniform on the sphere, a forward and a backward ray, the
+/// segment between their termination points. Parallel and reproducible: samples are drawn in
+/// fixed-size batches, each with its own random stream, so the output is bit-identical for
+/// any number of threads.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "viewcells/raycast/ray_caster.h"
+#include "viewcells/sampling/segments.h"
+
+namespace viewcells {
+
+enum class EmptySpaceMode { kAuto, kOn, kOff };
+/// Parses "auto", "on", "off"; throws Error otherwise.
+EmptySpaceMode parse_empty_space_mode(const std::string& s);
+
+struct SamplerConfig {
+  uint64_t samples = 1'000'000;  ///< samples drawn; the valid ones become segments
+  uint64_t seed = 1;
+  Box3 view_box;  ///< empty: the scene bounds
+  /// Empty view space detection (back-face hit: move the origin there and re-cast). kAuto
+  /// enables it only when every object is a closed, consistently outward-oriented solid.
+  EmptySpaceMode empty_space = EmptySpaceMode::kAuto;
+  int max_recasts = 8;        ///< re-casts per sample before it is dropped as stuck in solids
+  uint32_t batch_size = 1024; ///< samples per random stream: fixes the output, not the threads
+  bool show_progress = true;  ///< progress bar on stderr (only when it is a terminal)
+};
+
+struct EmptySpaceDecision {
+  bool enabled = false;
+  std::string reason;
+};
+/// Whether empty space detection applies to this scene under `mode`, and why.
+EmptySpaceDecision decide_empty_space(const Scene& scene, EmptySpaceMode mode);
+
+struct SamplingStats {
+  uint64_t samples = 0;
+  uint64_t rays = 0;          ///< every ray cast, re-casts included
+  uint64_t recast_rays = 0;   ///< rays re-cast by empty space detection
+  uint64_t valid_segments = 0;
+  uint64_t missed_both = 0;       ///< neither ray hit anything: not a visibility segment
+  uint64_t stuck_in_solid = 0;    ///< still inside solids after max_recasts
+  uint64_t outside_view_box = 0;  ///< no length inside the view box (re-cast past its boundary)
+  EmptySpaceDecision empty_space;
+  Box3 view_box;
+  bool view_box_from_scene = true;
+  double seconds = 0;
+  std::vector<uint64_t> segments_per_object;  ///< segments seeing each object at either end
+};
+
+struct SamplingResult {
+  SegmentSet segments;
+  SamplingStats stats;
+};
+
+/// Draws config.samples samples. Throws Error for an empty scene or a view box of zero volume.
+SamplingResult sample_segments(const Scene& scene, const RayCaster& caster, const SamplerConfig& config);
+
+/// The forward and backward rays of every sample, exactly as sample_segments casts them first
+/// (interleaved: forward of sample i at 2i, backward at 2i + 1). For raw ray-rate measurement.
+std::vector<Ray> primary_rays(const Scene& scene, const SamplerConfig& config);
+
+}  // namespace viewcells

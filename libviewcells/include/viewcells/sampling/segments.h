@@ -1,0 +1,50 @@
+#pragma once
+/// Visibility segments (view-cell-construction paper, section 4.1), stored as a structure of
+/// arrays: endpoints a and b in double precision, inside the view space box, and the object
+/// seen at each end (kNoObject where the segment left the scene unhit and was clipped).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "viewcells/core/vec3.h"
+#include "viewcells/scene/scene.h"
+
+namespace viewcells {
+
+struct SegmentSet {
+  Box3 view_box;
+  std::vector<double> ax, ay, az, bx, by, bz;
+  std::vector<uint32_t> object_a, object_b;
+
+  size_t size() const { return ax.size(); }
+  Vec3 a(size_t i) const { return {ax[i], ay[i], az[i]}; }
+  Vec3 b(size_t i) const { return {bx[i], by[i], bz[i]}; }
+  void reserve(size_t n);
+  void resize(size_t n);
+  void push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob);
+  void set(size_t i, const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob) {
+    ax[i] = a.x, ay[i] = a.y, az[i] = a.z, bx[i] = b.x, by[i] = b.y, bz[i] = b.z;
+    object_a[i] = oa, object_b[i] = ob;
+  }
+  /// Moves segments [from, from + n) to [to, to + n); to <= from (compaction).
+  void move_range(size_t from, size_t n, size_t to);
+  bool operator==(const SegmentSet& o) const;
+  /// Bytes used by the arrays.
+  size_t memory_bytes() const { return size() * (6 * sizeof(double) + 2 * sizeof(uint32_t)); }
+};
+
+/// What a segment file records besides the segments.
+struct SegmentFileHeader {
+  uint64_t seed = 0;
+  uint64_t samples = 0;            ///< samples drawn (valid or not)
+  uint64_t scene_fingerprint = 0;  ///< Scene::fingerprint() of the scene sampled
+  uint32_t object_count = 0;
+  bool empty_space_detection = false;
+};
+
+/// Writes a versioned, checksummed, zstd-compressed `.vseg` file (atomically).
+void write_segments(const std::string& path, const SegmentSet& segments, const SegmentFileHeader& header);
+/// Reads a `.vseg` file; rejects corrupt, truncated or inconsistent files with an Error.
+SegmentSet read_segments(const std::string& path, SegmentFileHeader* header = nullptr);
+
+}  // namespace viewcells

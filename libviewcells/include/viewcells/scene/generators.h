@@ -1,0 +1,35 @@
+#pragma once
+/// Deterministic scene generators (same kind, seed and size give the same scene, bit for bit),
+/// so that tests and demos need no downloads. Z is up; units are metres. Every object is a set
+/// of closed, outward-oriented boxes that never touch (1 mm gaps), so generated scenes are
+/// solid and empty view space detection applies.
+#include <cstdint>
+#include <string>
+
+#include "viewcells/scene/scene.h"
+
+namespace viewcells {
+
+enum class GeneratorKind {
+  kOffice,         ///< multi-storey interior: rooms along corridors, doors, stairwell, furniture
+  kCity,           ///< street grid, buildings of strongly varying heights, street furniture
+  kRotatedOffice,  ///< the office rotated 30 degrees about the vertical axis
+};
+
+/// Parses "office", "city", "rotated-office"; throws Error otherwise.
+GeneratorKind parse_generator_kind(const std::string& name);
+const char* to_string(GeneratorKind kind);
+
+struct GeneratorConfig {
+  GeneratorKind kind = GeneratorKind::kOffice;
+  uint64_t seed = 1;
+  /// Scale, >= 1. Office: 1 + size rooms per corridor side, 1 + (size-1)/3 floors (size 1 is
+  /// about a thousand triangles). City: size x size blocks (size 20 is about a million
+  /// triangles and ten thousand objects).
+  int size = 1;
+};
+
+/// Generates the scene; objects are named (e.g. "f0_room_a2_desk", "block_3_4_building_1").
+Scene generate_scene(const GeneratorConfig& config);
+
+}  // namespace viewcells

@@ -1,0 +1,22 @@
+#include "viewcells/core/parallel.h"
+
+#include <tbb/global_control.h>
+#include <tbb/info.h>
+
+namespace viewcells {
+
+struct ThreadLimit::Impl {
+  explicit Impl(int n) : control(tbb::global_control::max_allowed_parallelism, n) {}
+  tbb::global_control control;
+};
+
+ThreadLimit::ThreadLimit(int threads)
+    : threads_(threads > 0 ? threads : hardware_threads()) {
+  impl_ = std::make_unique<Impl>(threads_);
+}
+
+ThreadLimit::~ThreadLimit() = default;
+
+int hardware_threads() { return tbb::info::default_concurrency(); }
+
+}  // namespace viewcells

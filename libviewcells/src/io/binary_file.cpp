@@ -1,0 +1,90 @@
+#include "viewcells/io/binary_file.h"
+
+#include <unistd.h>
+#include <zstd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+namespace viewcells {
+
+uint64_t fnv1a64(const std::string& bytes) {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+void write_text_file(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp." + std::to_string(getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw Error(path, 0, "cannot open for writing");
+    out.write(text.data(), static_cast<std::streamsize>(text.size()));
+    out.flush();
+    if (!out) {
+      std::remove(tmp.c_str());
+      throw Error(path, 0, "write failed (disk full?)");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw Error(path, 0, "cannot replace file: " + ec.message());
+  }
+}
+
+void write_container(const std::string& path, const char (&magic)[5], uint32_t version,
+                     const std::string& payload) {
+  std::string compressed(ZSTD_compressBound(payload.size()), '\0');
+  const size_t csize = ZSTD_compress(compressed.data(), compressed.size(), payload.data(),
+                                     payload.size(), /*level=*/1);
+  if (ZSTD_isError(csize)) throw Error(path, 0, std::string("zstd: ") + ZSTD_getErrorName(csize));
+  compressed.resize(csize);
+  ByteWriter header;
+  header.put<uint32_t>(0);  // placeholder replaced by the magic below
+  header.put<uint32_t>(version);
+  header.put<uint64_t>(payload.size());
+  header.put<uint64_t>(fnv1a64(payload));
+  header.put<uint64_t>(csize);
+  std::string file = header.data();
+  std::memcpy(file.data(), magic, 4);
+  file += compressed;
+  write_text_file(path, file);
+}
+
+std::string read_container(const std::string& path, const char (&magic)[5], uint32_t max_version,
+                           uint32_t& version) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, 0, "cannot open file");
+  std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ByteReader r(file, path);
+  if (file.size() < 32) throw Error(path, 0, "not a " + std::string(magic) + " file (too short)");
+  if (std::memcmp(file.data(), magic, 4) != 0)
+    throw Error(path, 0, "not a " + std::string(magic) + " file (wrong magic)");
+  r.get<uint32_t>();
+  version = r.get<uint32_t>();
+  if (version == 0 || version > max_version)
+    throw Error(path, 0, "format version " + std::to_string(version) + " is not supported (this build reads up to " +
+                             std::to_string(max_version) + ")");
+  const uint64_t raw_size = r.get<uint64_t>();
+  const uint64_t checksum = r.get<uint64_t>();
+  const uint64_t csize = r.get<uint64_t>();
+  if (csize != file.size() - 32)
+    throw Error(path, 0, "corrupt file: expected " + std::to_string(csize) + " compressed bytes, found " +
+                             std::to_string(file.size() - 32) + " (truncated?)");
+  const unsigned long long frame_size = ZSTD_getFrameContentSize(file.data() + 32, csize);
+  if (frame_size != raw_size) throw Error(path, 0, "corrupt file: compressed frame does not match header");
+  std::string payload(raw_size, '\0');
+  const size_t got = ZSTD_decompress(payload.data(), raw_size, file.data() + 32, csize);
+  if (ZSTD_isError(got) || got != raw_size)
+    throw Error(path, 0, "corrupt file: decompression failed");
+  if (fnv1a64(payload) != checksum) throw Error(path, 0, "corrupt file: checksum mismatch");
+  return payload;
+}
+
+}  // namespace viewcells

@@ -1,0 +1,279 @@
+// Visibility segment sampling, view-cell-construction paper section 4.1, with empty view space
+// detection (figure 5). Directions: phi = 2 pi u1, cos(theta) = 1 - 2 u2 (uniform on the sphere).
+#include "viewcells/sampling/sampler.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <cmath>
+
+#include "viewcells/core/error.h"
+#include "viewcells/core/progress.h"
+#include "viewcells/core/rng.h"
+
+namespace viewcells {
+
+EmptySpaceMode parse_empty_space_mode(const std::string& s) {
+  if (s == "auto") return EmptySpaceMode::kAuto;
+  if (s == "on") return EmptySpaceMode::kOn;
+  if (s == "off") return EmptySpaceMode::kOff;
+  throw Error("unknown empty-space mode '" + s + "' (expected auto, on or off)");
+}
+
+EmptySpaceDecision decide_empty_space(const Scene& scene, EmptySpaceMode mode) {
+  size_t open = 0, inconsistent = 0, inward = 0;
+  std::string example;
+  for (const ObjectInfo& o : scene.objects) {
+    if (o.solid()) continue;
+    const char* why = !o.closed ? "open" : (!o.oriented ? "inconsistently oriented" : "normals point inwards");
+    (!o.closed ? open : (!o.oriented ? inconsistent : inward))++;
+    if (example.empty()) example = "'" + o.name + "' is " + why;
+  }
+  const size_t bad = open + inconsistent + inward;
+  const std::string n = std::to_string(scene.objects.size());
+  EmptySpaceDecision d;
+  switch (mode) {
+    case EmptySpaceMode::kOff:
+      d = {false, "disabled by the user"};
+      break;
+    case EmptySpaceMode::kOn:
+      d = {true, bad ? "enabled by the user although " + std::to_string(bad) + " of " + n +
+                           " objects are not closed outward-oriented solids (" + example + ")"
+                     : "enabled by the user; all " + n + " objects are closed outward-oriented solids"};
+      break;
+    case EmptySpaceMode::kAuto:
+      d = bad ? EmptySpaceDecision{false, "disabled: " + std::to_string(bad) + " of " + n +
+                                              " objects are not closed outward-oriented solids (" +
+                                              std::to_string(open) + " open, " + std::to_string(inconsistent) +
+                                              " inconsistently oriented, " + std::to_string(inward) +
+                                              " inward; e.g. " + example + ")"}
+              : EmptySpaceDecision{true, "enabled: all " + n +
+                                             " objects are closed, consistently oriented and outward facing"};
+      break;
+  }
+  return d;
+}
+
+namespace {
+
+Vec3 sample_direction(Rng& rng) {
+  const double phi = 2.0 * M_PI * rng.uniform();
+  const double cos_theta = 1.0 - 2.0 * rng.uniform();
+  const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
+  return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta};
+}
+
+Vec3 clamp_to_box(const Vec3& p, const Box3& b) { return max(b.lo, min(b.hi, p)); }
+
+/// Draws the points and directions of batch `batch` (samples [first, first + count)).
+void draw_batch(uint64_t seed, uint64_t batch, size_t count, const Box3& box, std::vector<Vec3>& points,
+                std::vector<Vec3>& dirs) {
+  Rng rng(seed, batch);
+  points.resize(count);
+  dirs.resize(count);
+  const Vec3 e = box.extent();
+  for (size_t i = 0; i < count; ++i) {
+    points[i] = {box.lo.x + e.x * rng.uniform(), box.lo.y + e.y * rng.uniform(), box.lo.z + e.z * rng.uniform()};
+    dirs[i] = sample_direction(rng);
+  }
+}
+
+/// What one batch produced: its segments sit in the shared output at [first, first + valid).
+struct BatchOutput {
+  size_t first = 0, valid = 0;
+  uint64_t rays = 0, recast_rays = 0, missed_both = 0, stuck = 0, outside = 0;
+};
+
+class BatchSampler {
+ public:
+  BatchSampler(const RayCaster& caster, const Box3& box, bool esd, int max_recasts, double recast_eps)
+      : caster_(caster), box_(box), esd_(esd), max_recasts_(max_recasts), eps_(recast_eps) {}
+
+  /// Samples batch `batch` and writes its valid segments to `segs` from index out.first on
+  /// (the batch's own slots: at most `count` of them).
+  void run(uint64_t seed, uint64_t batch, size_t count, SegmentSet& segs, BatchOutput& out) {
+    segs_ = &segs;
+    draw_batch(seed, batch, count, box_, points_, dirs_);
+    rays_.resize(2 * count);
+    hits_.resize(2 * count);
+    for (size_t i = 0; i < count; ++i) {
+      rays_[2 * i] = Ray{points_[i], dirs_[i]};
+      rays_[2 * i + 1] = Ray{points_[i], -dirs_[i]};
+    }
+    caster_.intersect(rays_, hits_);
+    out.rays += 2 * count;
+    pending_.clear();
+
+    for (size_t i = 0; i < count; ++i) {
+      const Hit& fwd = hits_[2 * i];
+      const Hit& bwd = hits_[2 * i + 1];
+      const bool fwd_inside = fwd.hit() && !fwd.front, bwd_inside = bwd.hit() && !bwd.front;
+      if (esd_ && (fwd_inside || bwd_inside)) {
+        // The origin lies inside a solid: continue from where the ray leaves it (figure 5).
+        const Vec3 dir = fwd_inside ? dirs_[i] : -dirs_[i];
+        const Hit& exit = fwd_inside ? fwd : bwd;
+        pending_.push_back({points_[i] + dir * exit.t, dir, exit.object, 1});
+        continue;
+      }
+      emit(points_[i], dirs_[i], bwd.hit() ? -bwd.t : -INFINITY, bwd.object, fwd.hit() ? fwd.t : INFINITY,
+           fwd.object, out);
+    }
+
+    // Re-cast from the exit points, in batches, until every sample has left the solids.
+    while (!pending_.empty()) {
+      rays_.resize(pending_.size());
+      hits_.resize(pending_.size());
+      for (size_t k = 0; k < pending_.size(); ++k)
+        rays_[k] = Ray{pending_[k].origin, pending_[k].dir, eps_};
+      caster_.intersect(std::span<const Ray>(rays_.data(), pending_.size()),
+                        std::span<Hit>(hits_.data(), pending_.size()));
+      out.rays += pending_.size();
+      out.recast_rays += pending_.size();
+      next_.clear();
+      for (size_t k = 0; k < pending_.size(); ++k) {
+        const Pending& p = pending_[k];
+        const Hit& h = hits_[k];
+        if (h.hit() && !h.front) {  // left one solid straight into another
+          if (p.depth >= max_recasts_) {
+            ++out.stuck;
+          } else {
+            next_.push_back({p.origin + p.dir * h.t, p.dir, h.object, p.depth + 1});
+          }
+          continue;
+        }
+        // The near end is the exit surface, seen (front side) from the segment.
+        emit(p.origin, p.dir, 0.0, p.exit_object, h.hit() ? h.t : INFINITY, h.object, out);
+      }
+      pending_.swap(next_);
+    }
+  }
+
+ private:
+  struct Pending {
+    Vec3 origin, dir;
+    uint32_t exit_object;
+    int depth;
+  };
+
+  /// The segment o + t*d, t in [t0, t1], seeing object o0 at t0 and o1 at t1, clipped to the box.
+  void emit(const Vec3& o, const Vec3& d, double t0, uint32_t o0, double t1, uint32_t o1, BatchOutput& out) {
+    if (o0 == kNoObject && o1 == kNoObject) {
+      ++out.missed_both;
+      return;
+    }
+    // A segment needs length inside the box. Re-cast segments can fail this: the exit surface
+    // of a solid may lie on (or beyond) the box boundary, e.g. a facade on the scene bounds.
+    double c0, c1;
+    if (!clip_line_to_box(box_, o, d, c0, c1) || std::min(t1, c1) - std::max(t0, c0) <= eps_) {
+      ++out.outside;
+      return;
+    }
+    // Hits beyond the box keep their object: it is visible from the part inside the box.
+    const Vec3 a = clamp_to_box(o + d * std::max(t0, c0), box_);
+    const Vec3 b = clamp_to_box(o + d * std::min(t1, c1), box_);
+    segs_->set(out.first + out.valid++, a, b, o0, o1);
+  }
+
+  const RayCaster& caster_;
+  Box3 box_;
+  bool esd_;
+  int max_recasts_;
+  double eps_;
+  SegmentSet* segs_ = nullptr;
+  std::vector<Vec3> points_, dirs_;
+  std::vector<Ray> rays_;
+  std::vector<Hit> hits_;
+  std::vector<Pending> pending_, next_;
+};
+
+Box3 resolve_view_box(const Scene& scene, const SamplerConfig& config, bool& from_scene) {
+  if (scene.triangles.empty()) throw Error("cannot sample an empty scene");
+  from_scene = config.view_box.empty();
+  const Box3 box = from_scene ? scene.bounds : config.view_box;
+  if (!is_finite(box.lo) || !is_finite(box.hi)) throw Error("view space box has non-finite coordinates");
+  if (!(box.volume() > 0))
+    throw Error(std::string("the view space box has zero volume") +
+                (from_scene ? " (the scene is flat: give a view box with --view-box)" : ""));
+  return box;
+}
+
+}  // namespace
+
+std::vector<Ray> primary_rays(const Scene& scene, const SamplerConfig& config) {
+  bool from_scene;
+  const Box3 box = resolve_view_box(scene, config, from_scene);
+  std::vector<Ray> rays(2 * config.samples);
+  const uint64_t batches = (config.samples + config.batch_size - 1) / config.batch_size;
+  tbb::parallel_for(uint64_t{0}, batches, [&](uint64_t b) {
+    std::vector<Vec3> points, dirs;
+    const uint64_t first = b * config.batch_size;
+    const size_t count = std::min<uint64_t>(config.batch_size, config.samples - first);
+    draw_batch(config.seed, b, count, box, points, dirs);
+    for (size_t i = 0; i < count; ++i) {
+      rays[2 * (first + i)] = Ray{points[i], dirs[i]};
+      rays[2 * (first + i) + 1] = Ray{points[i], -dirs[i]};
+    }
+  });
+  return rays;
+}
+
+SamplingResult sample_segments(const Scene& scene, const RayCaster& caster, const SamplerConfig& config) {
+  if (config.batch_size == 0) throw Error("batch size must be positive");
+  SamplingResult result;
+  SamplingStats& stats = result.stats;
+  stats.view_box = resolve_view_box(scene, config, stats.view_box_from_scene);
+  stats.empty_space = decide_empty_space(scene, config.empty_space);
+  stats.samples = config.samples;
+
+  const uint64_t batches = (config.samples + config.batch_size - 1) / config.batch_size;
+  std::vector<BatchOutput> outputs(batches);
+  // Every sample owns one slot of the output; valid segments are compacted afterwards. This
+  // touches each page once, instead of growing per-batch buffers and copying them.
+  SegmentSet& segs = result.segments;
+  segs.view_box = stats.view_box;
+  segs.resize(config.samples);
+  // Re-cast rays start a little past the exit surface: 1e-6 of the scene diagonal is well above
+  // Embree's float resolution in its local frame and well below the generators' 2 mm gaps.
+  const double eps = 1e-6 * std::max(scene.bounds.diagonal(), stats.view_box.diagonal());
+  tbb::enumerable_thread_specific<BatchSampler> samplers(
+      [&] { return BatchSampler(caster, stats.view_box, stats.empty_space.enabled, config.max_recasts, eps); });
+  Progress progress("sampling", config.samples);
+  const bool show = config.show_progress;
+  const auto start = std::chrono::steady_clock::now();
+  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, batches, 1), [&](const tbb::blocked_range<uint64_t>& r) {
+    BatchSampler& sampler = samplers.local();  // scratch buffers only: no effect on the output
+    for (uint64_t b = r.begin(); b < r.end(); ++b) {
+      const uint64_t first = b * config.batch_size;
+      const size_t count = std::min<uint64_t>(config.batch_size, config.samples - first);
+      outputs[b].first = first;
+      sampler.run(config.seed, b, count, segs, outputs[b]);
+      if (show) progress.advance(count);
+    }
+  });
+
+  // Compact in batch order: the output does not depend on which thread ran what.
+  size_t valid = 0;
+  for (const BatchOutput& out : outputs) {
+    segs.move_range(out.first, out.valid, valid);
+    valid += out.valid;
+    stats.rays += out.rays;
+    stats.recast_rays += out.recast_rays;
+    stats.missed_both += out.missed_both;
+    stats.stuck_in_solid += out.stuck;
+    stats.outside_view_box += out.outside;
+  }
+  segs.resize(valid);
+  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (show) progress.finish();
+  stats.valid_segments = segs.size();
+
+  stats.segments_per_object.assign(scene.objects.size(), 0);
+  for (size_t i = 0; i < segs.size(); ++i) {
+    if (segs.object_a[i] != kNoObject) ++stats.segments_per_object[segs.object_a[i]];
+    if (segs.object_b[i] != kNoObject && segs.object_b[i] != segs.object_a[i])
+      ++stats.segments_per_object[segs.object_b[i]];
+  }
+  return result;
+}
+
+}  // namespace viewcells

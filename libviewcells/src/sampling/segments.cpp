@@ -1,0 +1,108 @@
+#include "viewcells/sampling/segments.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "viewcells/io/binary_file.h"
+
+namespace viewcells {
+
+void SegmentSet::reserve(size_t n) {
+  for (auto* v : {&ax, &ay, &az, &bx, &by, &bz}) v->reserve(n);
+  object_a.reserve(n);
+  object_b.reserve(n);
+}
+
+void SegmentSet::resize(size_t n) {
+  for (auto* v : {&ax, &ay, &az, &bx, &by, &bz}) v->resize(n);
+  object_a.resize(n);
+  object_b.resize(n);
+}
+
+void SegmentSet::push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob) {
+  ax.push_back(a.x);
+  ay.push_back(a.y);
+  az.push_back(a.z);
+  bx.push_back(b.x);
+  by.push_back(b.y);
+  bz.push_back(b.z);
+  object_a.push_back(oa);
+  object_b.push_back(ob);
+}
+
+void SegmentSet::move_range(size_t from, size_t n, size_t to) {
+  if (from == to || n == 0) return;
+  auto move = [&](auto& v) { std::copy(v.begin() + from, v.begin() + from + n, v.begin() + to); };
+  move(ax);
+  move(ay);
+  move(az);
+  move(bx);
+  move(by);
+  move(bz);
+  move(object_a);
+  move(object_b);
+}
+
+bool SegmentSet::operator==(const SegmentSet& o) const {
+  return view_box == o.view_box && ax == o.ax && ay == o.ay && az == o.az && bx == o.bx && by == o.by &&
+         bz == o.bz && object_a == o.object_a && object_b == o.object_b;
+}
+
+namespace {
+constexpr char kMagic[5] = "VSEG";
+constexpr uint32_t kVersion = 1;
+}  // namespace
+
+void write_segments(const std::string& path, const SegmentSet& s, const SegmentFileHeader& h) {
+  ByteWriter w;
+  w.put(s.view_box.lo);
+  w.put(s.view_box.hi);
+  w.put<uint64_t>(h.seed);
+  w.put<uint64_t>(h.samples);
+  w.put<uint64_t>(h.scene_fingerprint);
+  w.put<uint32_t>(h.object_count);
+  w.put<uint8_t>(h.empty_space_detection ? 1 : 0);
+  for (const auto* v : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) w.put_array(*v);
+  w.put_array(s.object_a);
+  w.put_array(s.object_b);
+  write_container(path, kMagic, kVersion, w.data());
+}
+
+SegmentSet read_segments(const std::string& path, SegmentFileHeader* header) {
+  uint32_t version = 0;
+  const std::string payload = read_container(path, kMagic, kVersion, version);
+  ByteReader r(payload, path);
+  SegmentSet s;
+  SegmentFileHeader h;
+  s.view_box.lo = r.get<Vec3>();
+  s.view_box.hi = r.get<Vec3>();
+  h.seed = r.get<uint64_t>();
+  h.samples = r.get<uint64_t>();
+  h.scene_fingerprint = r.get<uint64_t>();
+  h.object_count = r.get<uint32_t>();
+  h.empty_space_detection = r.get<uint8_t>() != 0;
+  const uint64_t max_count = payload.size() / sizeof(uint32_t);
+  for (auto* v : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) *v = r.get_array<double>(max_count);
+  s.object_a = r.get_array<uint32_t>(max_count);
+  s.object_b = r.get_array<uint32_t>(max_count);
+  if (!r.at_end()) r.fail("trailing bytes after the segment arrays");
+  const size_t n = s.ax.size();
+  for (const auto* v : {&s.ay, &s.az, &s.bx, &s.by, &s.bz})
+    if (v->size() != n) r.fail("segment arrays differ in length");
+  if (s.object_a.size() != n || s.object_b.size() != n) r.fail("object arrays differ in length");
+  if (s.view_box.empty() || !is_finite(s.view_box.lo) || !is_finite(s.view_box.hi)) r.fail("invalid view box");
+  for (size_t i = 0; i < n; ++i) {
+    if (!s.view_box.contains(s.a(i)) || !s.view_box.contains(s.b(i)))
+      r.fail("segment " + std::to_string(i) + " lies outside the view box or is not finite");
+    for (uint32_t o : {s.object_a[i], s.object_b[i]})
+      if (o != kNoObject && o >= h.object_count)
+        r.fail("segment " + std::to_string(i) + " names object " + std::to_string(o) + " of " +
+               std::to_string(h.object_count));
+    if (s.object_a[i] == kNoObject && s.object_b[i] == kNoObject)
+      r.fail("segment " + std::to_string(i) + " sees no object");
+  }
+  if (header) *header = h;
+  return s;
+}
+
+}  // namespace viewcells

@@ -1,0 +1,91 @@
+#!/usr/bin/env bash
+# The viewcells command line as a user meets it: subcommands, reports, exit codes, messages,
+# and that a failing command leaves files already written alone.
+# Usage: cli_test.sh PATH/TO/viewcells WORKDIR
+set -u
+VC="$1"
+WORK="$2"
+rm -rf "$WORK" && mkdir -p "$WORK" && cd "$WORK" || exit 1
+passed=0
+failed=0
+ok() { passed=$((passed + 1)); }
+bad() { echo "FAIL: $*"; failed=$((failed + 1)); }
+expect_ok() { if "$@" >out.txt 2>err.txt; then ok; else bad "expected success: $* ($(cat err.txt))"; fi; }
+# expect_error FRAGMENT CMD...: non-zero exit and the fragment in stderr, never a crash.
+expect_error() {
+  local fragment="$1"
+  shift
+  "$@" >out.txt 2>err.txt
+  local rc=$?
+  if [ $rc -eq 0 ]; then bad "expected failure: $*"; return; fi
+  if [ $rc -ge 128 ]; then bad "crashed (signal $((rc - 128))): $*"; return; fi
+  if ! grep -q "viewcells: error:" err.txt && ! grep -qi "error" err.txt; then bad "no error message: $*"; return; fi
+  if ! grep -qF -- "$fragment" err.txt; then bad "message lacks '$fragment': $(cat err.txt)"; return; fi
+  ok
+}
+json_get() { python3 -c "import json,sys; d=json.load(open('$1')); print(eval('d'+sys.argv[1]))" "$2"; }
+
+# --help explains every subcommand.
+expect_ok "$VC" --help
+for sub in generate info sample; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
+expect_ok "$VC" sample --help
+grep -q -- "--measure-raw" out.txt && ok || bad "sample --help lacks --measure-raw"
+
+# generate -> info -> sample
+expect_ok "$VC" generate office --size 2 --seed 3 -o office.obj
+expect_ok "$VC" generate office --size 2 --seed 3 -o office2.obj
+cmp -s office.obj office2.obj && ok || bad "generate is not deterministic"
+expect_ok "$VC" generate rotated-office --size 1 -o rotated.obj
+expect_ok "$VC" generate city --size 2 -o city.obj
+expect_ok "$VC" info office.obj --json info.json --list
+grep -q "empty space detect: *enabled" out.txt && ok || bad "info does not report empty space detection"
+grep -q "f0_room_a0_doorwall" out.txt && ok || bad "info --list lacks object names"
+[ "$(json_get info.json "['all_solid']")" = "True" ] && ok || bad "info.json all_solid"
+expect_ok "$VC" info rotated.obj
+grep -Eq "non-axis-aligned: +[1-9][0-9]\.[0-9]+%" out.txt && ok || bad "rotated office should be mostly non-axis-aligned: $(grep non-axis out.txt)"
+
+expect_ok "$VC" sample office.obj --samples 20000 --seed 5 --threads 1 -o a.vseg --report a.json --measure-raw
+expect_ok "$VC" sample office.obj --samples 20000 --seed 5 --threads 2 -o b.vseg --report b.json
+cmp -s a.vseg b.vseg && ok || bad "segments differ between 1 and 2 threads"
+for key in "['settings']['samples']" "['settings']['seed']" "['effects']['empty_space_detection']['enabled']" \
+  "['effects']['empty_space_detection']['reason']" "['counts']['valid_segments']" "['counts']['rays']" \
+  "['timings']['segments_per_second']" "['timings']['raw_rays_per_second']" "['counts']['segments_per_object']"; do
+  json_get a.json "$key" >/dev/null 2>&1 && ok || bad "report lacks $key"
+done
+[ "$(json_get a.json "['effects']['empty_space_detection']['enabled']")" = "True" ] && ok || bad "ESD should be on for a solid scene"
+expect_ok "$VC" sample office.obj --samples 2000 --empty-space off --report off.json -q
+[ "$(json_get off.json "['effects']['empty_space_detection']['reason']")" = "disabled by the user" ] && ok || bad "ESD off reason"
+expect_ok "$VC" sample city.obj --samples 5000 --view-box 0,0,0,100,100,20 --report box.json -q
+[ "$(json_get box.json "['settings']['view_box_source']")" = "user (--view-box)" ] && ok || bad "view box source"
+
+# An open scene: empty space detection stays off, and the report says why.
+printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\ng plane\nf 1 2 3\ng other\nf 1 2 4\n' > open.obj
+expect_ok "$VC" sample open.obj --samples 1000 --report open.json -q
+[ "$(json_get open.json "['effects']['empty_space_detection']['enabled']")" = "False" ] && ok || bad "ESD should be off for an open scene"
+json_get open.json "['effects']['empty_space_detection']['reason']" | grep -q "open" && ok || bad "open-scene reason"
+
+# Bad input: clear message with file and line, non-zero exit, no crash.
+expect_error "no such file" "$VC" info missing.obj
+printf 'v 0 0 0\nv 1 nan 0\nv 0 1 0\nf 1 2 3\n' > nan.obj
+expect_error "nan.obj:2:" "$VC" info nan.obj
+printf 'v 0 0 0\nv 1 0 0\nf 1 2 9\n' > badface.obj
+expect_error "badface.obj:3:" "$VC" sample badface.obj --samples 10
+: > empty.obj
+expect_error "no triangles" "$VC" info empty.obj
+printf 'OFF\n8 6 0\n0 0 0\n1 0' > truncated.off
+expect_error "truncated.off" "$VC" info truncated.off
+expect_error "unknown scene kind" "$VC" generate castle -o x.obj
+expect_error "view-box" "$VC" sample office.obj --view-box 1,2,3
+expect_error "min < max" "$VC" sample office.obj --view-box 0,0,0,1,1,0
+expect_error "empty-space" "$VC" sample office.obj --empty-space maybe
+expect_error "samples" "$VC" sample office.obj --samples 0
+
+# A failing run leaves what was already written untouched.
+cp a.vseg keep.vseg
+cp a.json keep.json
+expect_error "nan.obj" "$VC" sample nan.obj -o a.vseg --report a.json
+cmp -s a.vseg keep.vseg && cmp -s a.json keep.json && ok || bad "a failed run changed existing outputs"
+expect_error "cannot" "$VC" generate office -o no/such/dir/x.obj
+
+echo "cli: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]

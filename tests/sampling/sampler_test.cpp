@@ -1,0 +1,241 @@
+// Invariants of visibility segments (paper section 4.1), checked against the brute-force
+// oracle: endpoints in the view box, the object recorded at each end is what a ray from the
+// segment sees there, nothing blocks the segment, and with empty space detection no segment
+// runs inside a solid.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "support/test_scenes.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/parallel.h"
+#include "viewcells/sampling/sampler.h"
+#include "viewcells/scene/generators.h"
+
+namespace viewcells {
+namespace {
+
+/// Parity test: is p inside the closed object `obj`? Casts along a fixed generic direction.
+bool inside_object(const Scene& scene, uint32_t obj, const Vec3& p) {
+  const Vec3 d = normalize(Vec3{0.5377, 0.1234, 0.8339});
+  int crossings = 0;
+  for (uint32_t t = 0; t < scene.triangles.size(); ++t) {
+    if (scene.triangle_object[t] != obj) continue;
+    const auto& tri = scene.triangles[t];
+    const Vec3 a = scene.vertices[tri[0]], e1 = scene.vertices[tri[1]] - a, e2 = scene.vertices[tri[2]] - a;
+    const Vec3 h = cross(d, e2);
+    const double det = dot(e1, h);
+    if (std::abs(det) < 1e-15) continue;
+    const Vec3 s = p - a;
+    const double u = dot(s, h) / det;
+    if (u < 0 || u > 1) continue;
+    const Vec3 q = cross(s, e1);
+    const double v = dot(d, q) / det;
+    if (v < 0 || u + v > 1) continue;
+    if (dot(e2, q) / det > 0) ++crossings;
+  }
+  return crossings % 2 == 1;
+}
+
+bool inside_any_solid(const Scene& scene, const Vec3& p) {
+  for (uint32_t o = 0; o < scene.objects.size(); ++o)
+    if (scene.objects[o].solid() && scene.objects[o].bounds.contains(p) && inside_object(scene, o, p)) return true;
+  return false;
+}
+
+struct Violations {
+  int outside_box = 0, wrong_object = 0, blocked = 0, inside_solid = 0, checked = 0;
+  std::string examples;  ///< the first few violations, for the failure message
+};
+
+/// Checks up to `limit` segments; `tol` is an absolute distance tolerance.
+Violations check_segments(const Scene& scene, const SegmentSet& segs, size_t limit, double tol,
+                          bool check_solids) {
+  const auto oracle = make_brute_force_caster(scene);
+  Violations v;
+  const size_t step = std::max<size_t>(1, segs.size() / limit);
+  for (size_t i = 0; i < segs.size(); i += step) {
+    ++v.checked;
+    const Vec3 a = segs.a(i), b = segs.b(i);
+    if (!segs.view_box.contains(a) || !segs.view_box.contains(b)) ++v.outside_box;
+    const Vec3 m = (a + b) * 0.5;
+    const double half = length(b - a) * 0.5;
+    for (int end = 0; end < 2; ++end) {
+      const Vec3 target = end ? b : a;
+      const uint32_t obj = end ? segs.object_b[i] : segs.object_a[i];
+      if (half < tol) continue;
+      const Hit h = oracle->intersect(Ray{m, (target - m) / half});
+      if (h.hit() && h.t < half - tol) {
+        ++v.blocked;  // something lies between the midpoint and this end
+      } else if (obj != kNoObject && !(h.hit() && std::abs(h.t - half) <= tol && h.object == obj)) {
+        ++v.wrong_object;
+        if (v.wrong_object < 4)
+          v.examples += "segment " + std::to_string(i) + " end " + std::to_string(end) + " names object " +
+                        std::to_string(obj) + ", the oracle sees " + std::to_string(h.object) + " at t " +
+                        std::to_string(h.t) + " of " + std::to_string(half) + "\n";
+      }
+    }
+    if (check_solids && inside_any_solid(scene, m)) {
+      if (v.inside_solid < 4)
+        v.examples += "segment " + std::to_string(i) + " runs inside a solid, midpoint " + std::to_string(m.x) + " " +
+                      std::to_string(m.y) + " " + std::to_string(m.z) + "\n";
+      ++v.inside_solid;
+    }
+  }
+  return v;
+}
+
+SamplingResult sample(const Scene& scene, uint64_t samples, uint64_t seed,
+                      EmptySpaceMode esd = EmptySpaceMode::kAuto, Box3 box = {}) {
+  const auto caster = make_embree_caster(scene);
+  SamplerConfig config;
+  config.samples = samples;
+  config.seed = seed;
+  config.empty_space = esd;
+  config.view_box = box;
+  config.show_progress = false;
+  return sample_segments(scene, *caster, config);
+}
+
+TEST(Sampler, SegmentsSatisfyInvariantsInTheOffice) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 2});
+  const SamplingResult r = sample(scene, 20000, 1);
+  const SamplingStats& st = r.stats;
+  EXPECT_TRUE(st.empty_space.enabled) << "generated scenes are solid";
+  EXPECT_EQ(st.valid_segments + st.missed_both + st.stuck_in_solid + st.outside_view_box, st.samples);
+  EXPECT_EQ(st.rays, 2 * st.samples + st.recast_rays);
+  EXPECT_GT(st.recast_rays, 0u) << "some samples start inside walls";
+  EXPECT_LT(st.missed_both, 20u) << "a closed building: almost every sample sees something";
+  // Samples inside the facades and outer slabs exit on the scene bounds: no segment there.
+  EXPECT_GT(st.outside_view_box, 0u);
+  EXPECT_GT(st.valid_segments, 15000u);
+  const Violations v = check_segments(scene, r.segments, 1500, 1e-5 * scene.bounds.diagonal(), true);
+  EXPECT_GT(v.checked, 1000);
+  EXPECT_EQ(v.outside_box, 0);
+  EXPECT_EQ(v.wrong_object, 0) << v.examples;
+  EXPECT_EQ(v.blocked, 0);
+  EXPECT_EQ(v.inside_solid, 0) << v.examples;
+  uint64_t per_object = 0;
+  for (uint64_t n : st.segments_per_object) per_object += n;
+  EXPECT_GE(per_object, st.valid_segments);
+}
+
+TEST(Sampler, WithoutEmptySpaceDetectionSegmentsRunInsideSolids) {
+  // The same check must be able to fail: switched off, segments start inside walls.
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 2});
+  const SamplingResult r = sample(scene, 5000, 1, EmptySpaceMode::kOff);
+  EXPECT_FALSE(r.stats.empty_space.enabled);
+  EXPECT_EQ(r.stats.recast_rays, 0u);
+  const Violations v = check_segments(scene, r.segments, 1000, 1e-5 * scene.bounds.diagonal(), true);
+  EXPECT_GT(v.inside_solid, 10);
+}
+
+TEST(Sampler, EmptySpaceDetectionOnlyForSolidScenes) {
+  RawMesh mesh;
+  test::add_cube(mesh, {0, 0, 0}, {1, 1, 1}, "closed");
+  test::add_cube(mesh, {2, 0, 0}, {3, 1, 1}, "open");
+  mesh.triangles.pop_back();
+  mesh.triangle_group.pop_back();
+  const Scene open = make_scene(mesh, ObjectGrouping::kGroups, "t");
+  const EmptySpaceDecision d = decide_empty_space(open, EmptySpaceMode::kAuto);
+  EXPECT_FALSE(d.enabled);
+  EXPECT_NE(d.reason.find("'open' is open"), std::string::npos) << d.reason;
+  EXPECT_TRUE(decide_empty_space(open, EmptySpaceMode::kOn).enabled);
+  EXPECT_FALSE(decide_empty_space(test::cube_grid(2), EmptySpaceMode::kOff).enabled);
+  EXPECT_TRUE(decide_empty_space(test::cube_grid(2), EmptySpaceMode::kAuto).enabled);
+  EXPECT_THROW(parse_empty_space_mode("maybe"), Error);
+}
+
+TEST(Sampler, IdenticalForOneAndTwoThreads) {
+  const Scene scene = generate_scene({GeneratorKind::kCity, 2, 3});
+  SamplingResult one, two;
+  {
+    ThreadLimit limit(1);
+    one = sample(scene, 30000, 9);
+  }
+  {
+    ThreadLimit limit(2);
+    two = sample(scene, 30000, 9);
+  }
+  EXPECT_GT(one.segments.size(), 10000u);
+  EXPECT_TRUE(one.segments == two.segments) << "output must not depend on the thread count";
+  EXPECT_EQ(one.stats.rays, two.stats.rays);
+  EXPECT_FALSE(sample(scene, 30000, 10).segments == one.segments) << "the seed matters";
+}
+
+TEST(Sampler, UserViewBoxClipsButKeepsObjectsBeyond) {
+  const Scene scene = generate_scene({GeneratorKind::kCity, 4, 2});
+  // A street-level band over part of the city.
+  const Box3 box{{20, 20, 0.5}, {120, 120, 10}};
+  const SamplingResult r = sample(scene, 20000, 2, EmptySpaceMode::kAuto, box);
+  EXPECT_FALSE(r.stats.view_box_from_scene);
+  size_t clipped_with_object = 0;
+  for (size_t i = 0; i < r.segments.size(); ++i) {
+    ASSERT_TRUE(box.contains(r.segments.a(i)) && box.contains(r.segments.b(i)));
+    // An end on the box boundary that still names an object: that object lies beyond the box.
+    for (int end = 0; end < 2; ++end) {
+      const Vec3 p = end ? r.segments.b(i) : r.segments.a(i);
+      const uint32_t o = end ? r.segments.object_b[i] : r.segments.object_a[i];
+      const bool on_boundary = p.x == box.lo.x || p.x == box.hi.x || p.y == box.lo.y || p.y == box.hi.y ||
+                               p.z == box.hi.z;
+      clipped_with_object += on_boundary && o != kNoObject;
+    }
+  }
+  EXPECT_GT(clipped_with_object, 100u);
+  const Violations v = check_segments(scene, r.segments, 800, 1e-5 * scene.bounds.diagonal(), false);
+  EXPECT_EQ(v.blocked, 0);
+}
+
+TEST(Sampler, HardCasesKeepInvariants) {
+  // Rotated walls (every ray meets them obliquely) and coordinates around 1e5.
+  Scene rotated = generate_scene({GeneratorKind::kRotatedOffice, 4, 2});
+  Scene far = generate_scene({GeneratorKind::kOffice, 4, 2});
+  translate(far, {1e5, -1e5, 1e5});
+  for (const Scene* scene : {&rotated, &far}) {
+    const SamplingResult r = sample(*scene, 10000, 5);
+    EXPECT_TRUE(r.stats.empty_space.enabled);
+    EXPECT_EQ(r.stats.stuck_in_solid, 0u);
+    const Violations v = check_segments(*scene, r.segments, 800, 1e-5 * scene->bounds.diagonal(), true);
+    EXPECT_EQ(v.outside_box, 0) << scene->source;
+    EXPECT_EQ(v.wrong_object, 0) << scene->source;
+    EXPECT_EQ(v.blocked, 0) << scene->source;
+    EXPECT_EQ(v.inside_solid, 0) << scene->source << "\n" << v.examples;
+  }
+}
+
+TEST(Sampler, PrimaryRaysAreTheSamplersRays) {
+  const Scene scene = test::cube_grid(3);
+  SamplerConfig config;
+  config.samples = 2500;
+  config.batch_size = 1000;
+  const std::vector<Ray> rays = primary_rays(scene, config);
+  ASSERT_EQ(rays.size(), 5000u);
+  for (size_t i = 0; i < rays.size(); i += 2) {
+    EXPECT_EQ(rays[i].origin, rays[i + 1].origin);
+    EXPECT_EQ(rays[i].dir, -rays[i + 1].dir);
+    EXPECT_NEAR(length(rays[i].dir), 1.0, 1e-12);
+    EXPECT_TRUE(scene.bounds.contains(rays[i].origin));
+  }
+  // The sampler's rays are the same: casting them by hand reproduces the ray count.
+  const auto caster = make_embree_caster(scene);
+  config.empty_space = EmptySpaceMode::kOff;
+  config.show_progress = false;
+  const SamplingResult r = sample_segments(scene, *caster, config);
+  std::vector<Hit> hits(rays.size());
+  caster->intersect(rays, hits);
+  uint64_t valid = 0;
+  for (size_t i = 0; i < rays.size(); i += 2) valid += hits[i].hit() || hits[i + 1].hit();
+  EXPECT_EQ(valid, r.stats.valid_segments + r.stats.outside_view_box);
+}
+
+TEST(Sampler, BadInput) {
+  const Scene scene = test::cube_grid(2);
+  EXPECT_THROW(sample(scene, 10, 1, EmptySpaceMode::kAuto, Box3{{0, 0, 0}, {1, 1, 0}}), Error);
+  Scene flat = scene;
+  for (Vec3& v : flat.vertices) v.z = 0;
+  flat.finalize();
+  EXPECT_THROW(sample(flat, 10, 1), Error) << "a flat scene has no view volume unless a box is given";
+}
+
+}  // namespace
+}  // namespace viewcells

@@ -1,0 +1,55 @@
+#include "support/test_scenes.h"
+
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+namespace viewcells::test {
+
+void add_cube(RawMesh& mesh, const Vec3& lo, const Vec3& hi, const std::string& group) {
+  const uint32_t base = static_cast<uint32_t>(mesh.vertices.size());
+  for (int i = 0; i < 8; ++i)
+    mesh.vertices.push_back({i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z});
+  // Quads with outward normals (counter-clockwise seen from outside).
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  const uint32_t g = static_cast<uint32_t>(mesh.group_names.size());
+  mesh.group_names.push_back(group);
+  for (const auto& q : quads) {
+    mesh.triangles.push_back({base + q[0], base + q[1], base + q[2]});
+    mesh.triangles.push_back({base + q[0], base + q[2], base + q[3]});
+    mesh.triangle_group.push_back(g);
+    mesh.triangle_group.push_back(g);
+  }
+}
+
+Scene cube_grid(int n, double spacing, double size) {
+  RawMesh mesh;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      add_cube(mesh, {i * spacing, j * spacing, 0}, {i * spacing + size, j * spacing + size, size},
+               "cube_" + std::to_string(i) + "_" + std::to_string(j));
+  return make_scene(std::move(mesh), ObjectGrouping::kGroups, "cube grid");
+}
+
+std::string temp_path(const std::string& name) {
+  static const std::string dir = [] {
+    auto d = std::filesystem::temp_directory_path() / ("viewcells_test_" + std::to_string(getpid()));
+    std::filesystem::create_directories(d);
+    std::atexit([] {
+      std::error_code ec;
+      std::filesystem::remove_all(std::filesystem::temp_directory_path() /
+                                      ("viewcells_test_" + std::to_string(getpid())),
+                                  ec);
+    });
+    return d.string();
+  }();
+  return dir + "/" + name;
+}
+
+void write_file(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+}  // namespace viewcells::test

@@ -1,0 +1,18 @@
+#pragma once
+// Small scenes built in code for tests, and helpers shared by several test files.
+#include <string>
+
+#include "viewcells/scene/scene.h"
+
+namespace viewcells::test {
+
+/// A closed, outward-oriented unit cube [lo, hi] as a RawMesh group (appended to `mesh`).
+void add_cube(RawMesh& mesh, const Vec3& lo, const Vec3& hi, const std::string& group);
+/// A scene of `n` x `n` cubes on a grid, each an object; closed and solid.
+Scene cube_grid(int n, double spacing = 3.0, double size = 1.0);
+/// A temporary directory unique to this test process; files are removed at exit.
+std::string temp_path(const std::string& name);
+/// Writes text to a file (for loader tests).
+void write_file(const std::string& path, const std::string& text);
+
+}  // namespace viewcells::test
