@@ -166,6 +166,7 @@ struct SampleArgs {
   std::string scene;
   std::string objects = "auto";
   uint64_t samples = 1'000'000;
+  uint64_t segments = 0;
   uint64_t seed = 1;
   std::string output;
   std::string report;
@@ -173,14 +174,17 @@ struct SampleArgs {
   std::string empty_space = "auto";
   bool fast = false;
   bool measure_raw = false;
+  bool segments_given = false;
   int max_recasts = 8;
 };
 
 int run_sample(const SampleArgs& a, const Common& c) {
   if (a.samples == 0) throw Error("--samples must be positive");
+  if (a.segments == 0 && a.segments_given) throw Error("--segments must be positive");
   ThreadLimit threads(c.threads);
   SamplerConfig config;
   config.samples = a.samples;
+  config.target_segments = a.segments;
   config.seed = a.seed;
   config.empty_space = parse_empty_space_mode(a.empty_space);
   config.max_recasts = a.max_recasts;
@@ -200,7 +204,7 @@ int run_sample(const SampleArgs& a, const Common& c) {
   const double bvh_s = sw.seconds();
 
   const EmptySpaceDecision esd = decide_empty_space(scene, config.empty_space);
-  c.log("viewcells: sampling " + std::to_string(a.samples) + " samples, seed " + std::to_string(a.seed) + ", " +
+  c.log("viewcells: sampling " + (a.segments ? "until " + std::to_string(a.segments) + " segments" : std::to_string(a.samples) + " samples") + ", seed " + std::to_string(a.seed) + ", " +
         std::to_string(threads.threads()) + " threads, " + caster->name() + "; view box " +
         (config.view_box.empty() ? "= scene bounds" : describe_box(config.view_box)) +
         "; empty space detection " + esd.reason);
@@ -212,7 +216,7 @@ int run_sample(const SampleArgs& a, const Common& c) {
   if (!a.output.empty()) {
     SegmentFileHeader header;
     header.seed = a.seed;
-    header.samples = a.samples;
+    header.samples = st.samples;
     header.scene_fingerprint = scene.fingerprint();
     header.object_count = static_cast<uint32_t>(scene.object_count());
     header.empty_space_detection = st.empty_space.enabled;
@@ -228,7 +232,8 @@ int run_sample(const SampleArgs& a, const Common& c) {
   json report;
   report["command"] = "sample";
   report["scene"] = scene_summary(scene);
-  report["settings"] = {{"samples", a.samples},
+  report["settings"] = {{"samples", a.segments ? json(nullptr) : json(a.samples)},
+                        {"target_segments", a.segments ? json(a.segments) : json(nullptr)},
                         {"seed", a.seed},
                         {"threads", threads.threads()},
                         {"object_grouping", to_string(scene.grouping)},
@@ -267,7 +272,9 @@ int run_sample(const SampleArgs& a, const Common& c) {
                  {"samples_per_second", st.samples / st.seconds},
                  {"rays_per_second", st.rays / st.seconds}};
   if (a.measure_raw) {
-    const std::vector<Ray> rays = primary_rays(scene, config);
+    SamplerConfig same = config;  // the primary rays of exactly the samples drawn
+    same.samples = st.samples;
+    const std::vector<Ray> rays = primary_rays(scene, same);
     const double raw_s = caster->time_raw(rays);
     const double raw_rate = rays.size() / raw_s;
     timing["raw_rays"] = rays.size();
@@ -320,7 +327,9 @@ int run(int argc, char** argv) {
   SampleArgs smp;
   auto* s = app.add_subcommand("sample", "Cast visibility segments through the view space (paper section 4.1)");
   s->add_option("scene", smp.scene, "Scene file (.obj, .ply, .off, .stl)")->required();
-  s->add_option("--samples", smp.samples, "Number of samples (two rays each)")->capture_default_str();
+  auto* samples_opt = s->add_option("--samples", smp.samples, "Number of samples (two rays each)")->capture_default_str();
+  s->add_option("--segments", smp.segments, "Sample until this many valid segments exist (instead of --samples)")
+      ->excludes(samples_opt);
   s->add_option("--seed", smp.seed, "Random seed")->capture_default_str();
   s->add_option("-o,--output", smp.output, "Segment file to write (.vseg)");
   s->add_option("--report", smp.report, "JSON report: settings, effects enabled and why, counts, timings");
@@ -344,7 +353,10 @@ int run(int argc, char** argv) {
   try {
     if (*g) return run_generate(gen, common);
     if (*i) return run_info(info, common);
-    if (*s) return run_sample(smp, common);
+    if (*s) {
+      smp.segments_given = s->count("--segments") > 0;
+      return run_sample(smp, common);
+    }
   } catch (const Error& e) {
     std::cerr << "viewcells: error: " << e.what() << '\n';
     return 1;

@@ -228,6 +228,35 @@ TEST(Sampler, PrimaryRaysAreTheSamplersRays) {
   EXPECT_EQ(valid, r.stats.valid_segments + r.stats.outside_view_box);
 }
 
+TEST(Sampler, SegmentTargetIsAPrefixOfTheSampleStream) {
+  const Scene scene = generate_scene({GeneratorKind::kCity, 6, 2});
+  const auto caster = make_embree_caster(scene);
+  SamplerConfig config;
+  config.show_progress = false;
+  config.samples = 60000;
+  const SamplingResult all = sample_segments(scene, *caster, config);
+  config.target_segments = 25000;
+  SamplingResult target;
+  {
+    ThreadLimit one(1);
+    target = sample_segments(scene, *caster, config);
+  }
+  ASSERT_EQ(target.segments.size(), 25000u);
+  ASSERT_GT(all.segments.size(), 25000u);
+  EXPECT_EQ(target.stats.valid_segments, 25000u);
+  EXPECT_LT(target.stats.samples, 60000u);
+  EXPECT_EQ(target.stats.samples % config.batch_size, 0u) << "whole batches";
+  for (size_t i = 0; i < 25000; i += 97) {
+    ASSERT_EQ(target.segments.a(i), all.segments.a(i)) << i;
+    ASSERT_EQ(target.segments.object_b[i], all.segments.object_b[i]) << i;
+  }
+  // An unreachable target gives up with an error rather than looping.
+  config.view_box = Box3{{-1e6, -1e6, 500}, {-1e6 + 50, -1e6 + 50, 600}};  // sky far from the city
+  config.target_segments = 10;
+  config.max_samples = 20000;
+  EXPECT_THROW(sample_segments(scene, *caster, config), Error);
+}
+
 TEST(Sampler, BadInput) {
   const Scene scene = test::cube_grid(2);
   EXPECT_THROW(sample(scene, 10, 1, EmptySpaceMode::kAuto, Box3{{0, 0, 0}, {1, 1, 0}}), Error);

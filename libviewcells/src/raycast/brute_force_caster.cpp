@@ -5,10 +5,21 @@
 
 #include <chrono>
 #include <cmath>
+#include <vector>
 
 #include "viewcells/raycast/ray_caster.h"
 
 namespace viewcells {
+
+void RayCaster::intersect_pairs(std::span<const Vec3> origins, std::span<const Vec3> dirs, std::span<Hit> hits) const {
+  std::vector<Ray> rays(2 * origins.size());
+  for (size_t i = 0; i < origins.size(); ++i) {
+    rays[2 * i] = Ray{origins[i], dirs[i]};
+    rays[2 * i + 1] = Ray{origins[i], -dirs[i]};
+  }
+  intersect(rays, hits);
+}
+
 namespace {
 
 class BruteForceCaster final : public RayCaster {

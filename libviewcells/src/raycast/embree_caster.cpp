@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <limits>
 #include <mutex>
 #include <vector>
 
@@ -63,28 +64,33 @@ class EmbreeCaster final : public RayCaster {
     RTCRayHit native[kChunk];
     for (size_t start = 0; start < rays.size(); start += kChunk) {
       const unsigned n = static_cast<unsigned>(std::min<size_t>(kChunk, rays.size() - start));
-      for (unsigned i = 0; i < n; ++i) to_native(rays[start + i], native[i]);
+      for (unsigned i = 0; i < n; ++i) to_native(rays[start + i].origin, rays[start + i].dir, rays[start + i].tnear,
+                                                 rays[start + i].tfar, native[i]);
       cast(native, n);
+      from_native(native, n, hits.data() + start);
+    }
+  }
+
+  void intersect_pairs(std::span<const Vec3> origins, std::span<const Vec3> dirs, std::span<Hit> hits) const override {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    RTCRayHit native[kChunk];
+    for (size_t start = 0; start < origins.size(); start += kChunk / 2) {
+      const unsigned n = static_cast<unsigned>(std::min<size_t>(kChunk / 2, origins.size() - start));
       for (unsigned i = 0; i < n; ++i) {
-        const RTCRayHit& rh = native[i];
-        Hit& h = hits[start + i];
-        if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
-          h = Hit{};
-          continue;
-        }
-        h.t = rh.ray.tfar;
-        h.triangle = rh.hit.primID;
-        h.object = scene_.triangle_object[rh.hit.primID];
-        // Embree's Ng is (v1-v0)x(v2-v0) like Scene::triangle_normal (checked against the oracle);
-        // using it avoids reading three vertices from random memory per hit.
-        h.front = rh.hit.Ng_x * rh.ray.dir_x + rh.hit.Ng_y * rh.ray.dir_y + rh.hit.Ng_z * rh.ray.dir_z < 0.0f;
+        to_native(origins[start + i], dirs[start + i], 0.0, kInf, native[2 * i]);
+        native[2 * i + 1] = native[2 * i];
+        native[2 * i + 1].ray.dir_x = -native[2 * i].ray.dir_x;
+        native[2 * i + 1].ray.dir_y = -native[2 * i].ray.dir_y;
+        native[2 * i + 1].ray.dir_z = -native[2 * i].ray.dir_z;
       }
+      cast(native, 2 * n);
+      from_native(native, 2 * n, hits.data() + 2 * start);
     }
   }
 
   double time_raw(std::span<const Ray> rays) const override {
     std::vector<RTCRayHit> native(rays.size());
-    for (size_t i = 0; i < rays.size(); ++i) to_native(rays[i], native[i]);
+    for (size_t i = 0; i < rays.size(); ++i) to_native(rays[i].origin, rays[i].dir, rays[i].tnear, rays[i].tfar, native[i]);
     const auto start = std::chrono::steady_clock::now();
     tbb::parallel_for(tbb::blocked_range<size_t>(0, native.size(), 2048),
                       [&](const tbb::blocked_range<size_t>& r) {
@@ -149,16 +155,16 @@ class EmbreeCaster final : public RayCaster {
     throw Error(std::string("embree: ") + where + ": " + msg);
   }
 
-  void to_native(const Ray& r, RTCRayHit& rh) const {
-    const Vec3 o = r.origin - center_;
+  void to_native(const Vec3& origin, const Vec3& dir, double tnear, double tfar, RTCRayHit& rh) const {
+    const Vec3 o = origin - center_;
     rh.ray.org_x = static_cast<float>(o.x);
     rh.ray.org_y = static_cast<float>(o.y);
     rh.ray.org_z = static_cast<float>(o.z);
-    rh.ray.dir_x = static_cast<float>(r.dir.x);
-    rh.ray.dir_y = static_cast<float>(r.dir.y);
-    rh.ray.dir_z = static_cast<float>(r.dir.z);
-    rh.ray.tnear = static_cast<float>(r.tnear);
-    rh.ray.tfar = static_cast<float>(r.tfar);
+    rh.ray.dir_x = static_cast<float>(dir.x);
+    rh.ray.dir_y = static_cast<float>(dir.y);
+    rh.ray.dir_z = static_cast<float>(dir.z);
+    rh.ray.tnear = static_cast<float>(tnear);
+    rh.ray.tfar = static_cast<float>(tfar);
     rh.ray.time = 0.0f;
     rh.ray.mask = 0xffffffffu;
     rh.ray.id = 0;
@@ -166,6 +172,23 @@ class EmbreeCaster final : public RayCaster {
     rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  }
+
+  void from_native(const RTCRayHit* native, unsigned n, Hit* hits) const {
+    for (unsigned i = 0; i < n; ++i) {
+      const RTCRayHit& rh = native[i];
+      Hit& h = hits[i];
+      if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) {
+        h = Hit{};
+        continue;
+      }
+      h.t = rh.ray.tfar;
+      h.triangle = rh.hit.primID;
+      h.object = scene_.triangle_object[rh.hit.primID];
+      // Embree's Ng is (v1-v0)x(v2-v0) like Scene::triangle_normal (checked against the oracle);
+      // using it avoids reading three vertices from random memory per hit.
+      h.front = rh.hit.Ng_x * rh.ray.dir_x + rh.hit.Ng_y * rh.ray.dir_y + rh.hit.Ng_z * rh.ray.dir_z < 0.0f;
+    }
   }
 
   void cast(RTCRayHit* rays, unsigned n) const {

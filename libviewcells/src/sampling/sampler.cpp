@@ -94,13 +94,8 @@ class BatchSampler {
   void run(uint64_t seed, uint64_t batch, size_t count, SegmentSet& segs, BatchOutput& out) {
     segs_ = &segs;
     draw_batch(seed, batch, count, box_, points_, dirs_);
-    rays_.resize(2 * count);
     hits_.resize(2 * count);
-    for (size_t i = 0; i < count; ++i) {
-      rays_[2 * i] = Ray{points_[i], dirs_[i]};
-      rays_[2 * i + 1] = Ray{points_[i], -dirs_[i]};
-    }
-    caster_.intersect(rays_, hits_);
+    caster_.intersect_pairs(points_, dirs_, hits_);
     out.rays += 2 * count;
     pending_.clear();
 
@@ -121,18 +116,17 @@ class BatchSampler {
 
     // Re-cast from the exit points, in batches, until every sample has left the solids.
     while (!pending_.empty()) {
-      rays_.resize(pending_.size());
-      hits_.resize(pending_.size());
+      recast_rays_.resize(pending_.size());
+      recast_hits_.resize(pending_.size());
       for (size_t k = 0; k < pending_.size(); ++k)
-        rays_[k] = Ray{pending_[k].origin, pending_[k].dir, eps_};
-      caster_.intersect(std::span<const Ray>(rays_.data(), pending_.size()),
-                        std::span<Hit>(hits_.data(), pending_.size()));
+        recast_rays_[k] = Ray{pending_[k].origin, pending_[k].dir, eps_};
+      caster_.intersect(recast_rays_, recast_hits_);
       out.rays += pending_.size();
       out.recast_rays += pending_.size();
       next_.clear();
       for (size_t k = 0; k < pending_.size(); ++k) {
         const Pending& p = pending_[k];
-        const Hit& h = hits_[k];
+        const Hit& h = recast_hits_[k];
         if (h.hit() && !h.front) {  // left one solid straight into another
           if (p.depth >= max_recasts_) {
             ++out.stuck;
@@ -161,6 +155,15 @@ class BatchSampler {
       ++out.missed_both;
       return;
     }
+    // Fast path: both ends are hits inside the box (always so with the default box, the scene
+    // bounds, up to rounding); no clipping needed.
+    if (std::isfinite(t0) && std::isfinite(t1) && t1 - t0 > eps_) {
+      const Vec3 a = o + d * t0, b = o + d * t1;
+      if (box_.contains(a, eps_) && box_.contains(b, eps_)) {
+        segs_->set(out.first + out.valid++, clamp_to_box(a, box_), clamp_to_box(b, box_), o0, o1);
+        return;
+      }
+    }
     // A segment needs length inside the box. Re-cast segments can fail this: the exit surface
     // of a solid may lie on (or beyond) the box boundary, e.g. a facade on the scene bounds.
     double c0, c1;
@@ -181,8 +184,9 @@ class BatchSampler {
   double eps_;
   SegmentSet* segs_ = nullptr;
   std::vector<Vec3> points_, dirs_;
-  std::vector<Ray> rays_;
   std::vector<Hit> hits_;
+  std::vector<Ray> recast_rays_;
+  std::vector<Hit> recast_hits_;
   std::vector<Pending> pending_, next_;
 };
 
@@ -219,53 +223,89 @@ std::vector<Ray> primary_rays(const Scene& scene, const SamplerConfig& config) {
 
 SamplingResult sample_segments(const Scene& scene, const RayCaster& caster, const SamplerConfig& config) {
   if (config.batch_size == 0) throw Error("batch size must be positive");
+  if (config.samples == 0 && config.target_segments == 0) throw Error("nothing to sample: samples and segments are 0");
   SamplingResult result;
   SamplingStats& stats = result.stats;
   stats.view_box = resolve_view_box(scene, config, stats.view_box_from_scene);
   stats.empty_space = decide_empty_space(scene, config.empty_space);
-  stats.samples = config.samples;
-
-  const uint64_t batches = (config.samples + config.batch_size - 1) / config.batch_size;
-  std::vector<BatchOutput> outputs(batches);
-  // Every sample owns one slot of the output; valid segments are compacted afterwards. This
-  // touches each page once, instead of growing per-batch buffers and copying them.
   SegmentSet& segs = result.segments;
   segs.view_box = stats.view_box;
-  segs.resize(config.samples);
+
   // Re-cast rays start a little past the exit surface: 1e-6 of the scene diagonal is well above
   // Embree's float resolution in its local frame and well below the generators' 2 mm gaps.
   const double eps = 1e-6 * std::max(scene.bounds.diagonal(), stats.view_box.diagonal());
   tbb::enumerable_thread_specific<BatchSampler> samplers(
       [&] { return BatchSampler(caster, stats.view_box, stats.empty_space.enabled, config.max_recasts, eps); });
-  Progress progress("sampling", config.samples);
+  const bool by_segments = config.target_segments > 0;
+  Progress progress(by_segments ? "segments" : "sampling", by_segments ? config.target_segments : config.samples);
   const bool show = config.show_progress;
   const auto start = std::chrono::steady_clock::now();
-  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, batches, 1), [&](const tbb::blocked_range<uint64_t>& r) {
-    BatchSampler& sampler = samplers.local();  // scratch buffers only: no effect on the output
-    for (uint64_t b = r.begin(); b < r.end(); ++b) {
-      const uint64_t first = b * config.batch_size;
-      const size_t count = std::min<uint64_t>(config.batch_size, config.samples - first);
-      outputs[b].first = first;
-      sampler.run(config.seed, b, count, segs, outputs[b]);
-      if (show) progress.advance(count);
-    }
-  });
 
-  // Compact in batch order: the output does not depend on which thread ran what.
-  size_t valid = 0;
-  for (const BatchOutput& out : outputs) {
-    segs.move_range(out.first, out.valid, valid);
-    valid += out.valid;
-    stats.rays += out.rays;
-    stats.recast_rays += out.recast_rays;
-    stats.missed_both += out.missed_both;
-    stats.stuck_in_solid += out.stuck;
-    stats.outside_view_box += out.outside;
+  // Rounds of batches. With a sample count there is one round; with a segment target, rounds
+  // continue until the target is reached and the output is cut at the target-th segment in
+  // batch order, so it still does not depend on the thread count.
+  uint64_t next_batch = 0;
+  std::vector<BatchOutput> outputs;
+  SegmentSet round;
+  bool done = false;
+  while (!done) {
+    uint64_t round_samples = config.samples;
+    if (by_segments) {
+      const uint64_t remaining = config.target_segments - segs.size();
+      const double rate = stats.samples ? std::max(0.02, double(stats.valid_segments) / stats.samples) : 0.9;
+      // Whole batches, so that the output is a prefix of what a large enough sample count gives.
+      round_samples = (static_cast<uint64_t>(remaining / rate * 1.05) / config.batch_size + 1) * config.batch_size;
+      if (stats.samples + round_samples > config.max_samples)
+        round_samples = config.max_samples > stats.samples ? config.max_samples - stats.samples : 0;
+      if (round_samples == 0)
+        throw Error("gave up after " + std::to_string(stats.samples) + " samples with only " +
+                    std::to_string(segs.size()) + " segments: do rays hit anything in this view box?");
+    }
+    const uint64_t batches = (round_samples + config.batch_size - 1) / config.batch_size;
+    outputs.assign(batches, BatchOutput{});
+    round.resize_for_output(round_samples);  // one slot per sample; compacted below
+    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, batches, 1), [&](const tbb::blocked_range<uint64_t>& r) {
+      BatchSampler& sampler = samplers.local();  // scratch buffers only: no effect on the output
+      for (uint64_t b = r.begin(); b < r.end(); ++b) {
+        const uint64_t first = b * config.batch_size;
+        const size_t count = std::min<uint64_t>(config.batch_size, round_samples - first);
+        outputs[b].first = first;
+        sampler.run(config.seed, next_batch + b, count, round, outputs[b]);
+        if (show) progress.advance(by_segments ? outputs[b].valid : count);
+      }
+    });
+    next_batch += batches;
+
+    // Compact in batch order: the output does not depend on which thread ran what.
+    size_t valid = 0;
+    for (uint64_t b = 0; b < batches && !done; ++b) {
+      BatchOutput& out = outputs[b];
+      if (by_segments && segs.size() + valid + out.valid >= config.target_segments) {
+        out.valid = config.target_segments - segs.size() - valid;  // the rest of this batch is dropped
+        done = true;
+      }
+      round.move_range(out.first, out.valid, valid);
+      valid += out.valid;
+      stats.samples += std::min<uint64_t>(config.batch_size, round_samples - out.first);
+      stats.rays += out.rays;
+      stats.recast_rays += out.recast_rays;
+      stats.missed_both += out.missed_both;
+      stats.stuck_in_solid += out.stuck;
+      stats.outside_view_box += out.outside;
+    }
+    if (!by_segments) done = true;
+    round.resize(valid);
+    if (segs.size() == 0) {
+      std::swap(segs.ax, round.ax), std::swap(segs.ay, round.ay), std::swap(segs.az, round.az);
+      std::swap(segs.bx, round.bx), std::swap(segs.by, round.by), std::swap(segs.bz, round.bz);
+      std::swap(segs.object_a, round.object_a), std::swap(segs.object_b, round.object_b);
+    } else {
+      segs.append(round);
+    }
+    stats.valid_segments = segs.size();
   }
-  segs.resize(valid);
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (show) progress.finish();
-  stats.valid_segments = segs.size();
 
   stats.segments_per_object.assign(scene.objects.size(), 0);
   for (size_t i = 0; i < segs.size(); ++i) {

@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
 
 #include "viewcells/io/binary_file.h"
 
@@ -19,6 +23,21 @@ void SegmentSet::resize(size_t n) {
   object_b.resize(n);
 }
 
+void SegmentSet::resize_for_output(size_t n) {
+  reserve(n);
+#ifdef __linux__
+  auto advise = [](void* p, size_t bytes) {
+    const uintptr_t page = 4096, begin = (reinterpret_cast<uintptr_t>(p) + page - 1) & ~(page - 1);
+    const uintptr_t end = (reinterpret_cast<uintptr_t>(p) + bytes) & ~(page - 1);
+    if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);  // a hint only
+  };
+  for (auto* v : {&ax, &ay, &az, &bx, &by, &bz}) advise(v->data(), n * sizeof(double));
+  advise(object_a.data(), n * sizeof(uint32_t));
+  advise(object_b.data(), n * sizeof(uint32_t));
+#endif
+  resize(n);
+}
+
 void SegmentSet::push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob) {
   ax.push_back(a.x);
   ay.push_back(a.y);
@@ -28,6 +47,18 @@ void SegmentSet::push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t o
   bz.push_back(b.z);
   object_a.push_back(oa);
   object_b.push_back(ob);
+}
+
+void SegmentSet::append(const SegmentSet& o) {
+  auto add = [](auto& to, const auto& from) { to.insert(to.end(), from.begin(), from.end()); };
+  add(ax, o.ax);
+  add(ay, o.ay);
+  add(az, o.az);
+  add(bx, o.bx);
+  add(by, o.by);
+  add(bz, o.bz);
+  add(object_a, o.object_a);
+  add(object_b, o.object_b);
 }
 
 void SegmentSet::move_range(size_t from, size_t n, size_t to) {

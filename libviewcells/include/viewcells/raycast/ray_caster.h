@@ -44,6 +44,10 @@ class RayCaster {
     intersect(std::span<const Ray>(&ray, 1), std::span<Hit>(&h, 1));
     return h;
   }
+  /// Forward and backward closest hits from each origin: hits[2i] along dirs[i], hits[2i+1]
+  /// along -dirs[i] (t in [0, inf)). The sampler's hot path; implementations may skip
+  /// building Ray structs. hits.size() == 2 * origins.size().
+  virtual void intersect_pairs(std::span<const Vec3> origins, std::span<const Vec3> dirs, std::span<Hit> hits) const;
   /// Casts the rays through the underlying engine alone, in parallel, with conversion to its
   /// native format done beforehand; returns the seconds spent casting (for --measure-raw).
   virtual double time_raw(std::span<const Ray> rays) const = 0;

@@ -19,6 +19,10 @@ EmptySpaceMode parse_empty_space_mode(const std::string& s);
 
 struct SamplerConfig {
   uint64_t samples = 1'000'000;  ///< samples drawn; the valid ones become segments
+  /// If > 0: draw samples until this many segments exist (then `samples` is ignored); the
+  /// output is the first target_segments segments in batch order.
+  uint64_t target_segments = 0;
+  uint64_t max_samples = 4'000'000'000;  ///< give up (Error) beyond this with a segment target
   uint64_t seed = 1;
   Box3 view_box;  ///< empty: the scene bounds
   /// Empty view space detection (back-face hit: move the origin there and re-cast). kAuto
@@ -37,7 +41,7 @@ struct EmptySpaceDecision {
 EmptySpaceDecision decide_empty_space(const Scene& scene, EmptySpaceMode mode);
 
 struct SamplingStats {
-  uint64_t samples = 0;
+  uint64_t samples = 0;       ///< samples whose segments the output holds
   uint64_t rays = 0;          ///< every ray cast, re-casts included
   uint64_t recast_rays = 0;   ///< rays re-cast by empty space detection
   uint64_t valid_segments = 0;
@@ -56,7 +60,8 @@ struct SamplingResult {
   SamplingStats stats;
 };
 
-/// Draws config.samples samples. Throws Error for an empty scene or a view box of zero volume.
+/// Draws config.samples samples (or until config.target_segments segments exist). Throws
+/// Error for an empty scene, a view box of zero volume, or a segment target out of reach.
 SamplingResult sample_segments(const Scene& scene, const RayCaster& caster, const SamplerConfig& config);
 
 /// The forward and backward rays of every sample, exactly as sample_segments casts them first

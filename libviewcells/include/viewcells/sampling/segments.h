@@ -21,11 +21,16 @@ struct SegmentSet {
   Vec3 b(size_t i) const { return {bx[i], by[i], bz[i]}; }
   void reserve(size_t n);
   void resize(size_t n);
+  /// resize(n) for a large output about to be filled: asks the kernel for transparent huge
+  /// pages first (Linux), which saves most page faults on arrays of hundreds of megabytes.
+  void resize_for_output(size_t n);
   void push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob);
   void set(size_t i, const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob) {
     ax[i] = a.x, ay[i] = a.y, az[i] = a.z, bx[i] = b.x, by[i] = b.y, bz[i] = b.z;
     object_a[i] = oa, object_b[i] = ob;
   }
+  /// Appends all of `o` (view boxes must match).
+  void append(const SegmentSet& o);
   /// Moves segments [from, from + n) to [to, to + n); to <= from (compaction).
   void move_range(size_t from, size_t n, size_t to);
   bool operator==(const SegmentSet& o) const;
