@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake ninja-build pkg-config
+  build-essential cmake ninja-build pkg-config python3
   libembree-dev          # ray casting (Embree 3.13)
   libcgal-dev libgmp-dev libmpfr-dev   # exact predicates (header-only CGAL 5.5)
   libopenmesh-dev        # PLY / OFF / STL loading

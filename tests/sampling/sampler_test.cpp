@@ -102,7 +102,9 @@ TEST(Sampler, SegmentsSatisfyInvariantsInTheOffice) {
   const SamplingResult r = sample(scene, 20000, 1);
   const SamplingStats& st = r.stats;
   EXPECT_TRUE(st.empty_space.enabled) << "generated scenes are solid";
-  EXPECT_EQ(st.valid_segments + st.missed_both + st.stuck_in_solid + st.outside_view_box, st.samples);
+  EXPECT_EQ(st.valid_segments + st.missed_both + st.stuck_in_solid + st.outside_view_box,
+            st.samples + st.two_sided_samples);
+  EXPECT_GT(st.two_sided_samples, 0u);
   EXPECT_EQ(st.rays, 2 * st.samples + st.recast_rays);
   EXPECT_GT(st.recast_rays, 0u) << "some samples start inside walls";
   EXPECT_LT(st.missed_both, 20u) << "a closed building: almost every sample sees something";
@@ -203,29 +205,53 @@ TEST(Sampler, HardCasesKeepInvariants) {
   }
 }
 
-TEST(Sampler, PrimaryRaysAreTheSamplersRays) {
-  const Scene scene = test::cube_grid(3);
+TEST(Sampler, SampledRaysAreTheSamplersRays) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 2, 1});
+  const auto caster = make_embree_caster(scene);
   SamplerConfig config;
   config.samples = 2500;
   config.batch_size = 1000;
-  const std::vector<Ray> rays = primary_rays(scene, config);
-  ASSERT_EQ(rays.size(), 5000u);
-  for (size_t i = 0; i < rays.size(); i += 2) {
+  config.show_progress = false;
+  const SamplingResult r = sample_segments(scene, *caster, config);
+  const std::vector<Ray> rays = sampled_rays(scene, *caster, config);
+  ASSERT_EQ(rays.size(), r.stats.rays) << "primary pairs plus re-casts";
+  // Each batch starts with its samples' forward/backward pairs from points inside the box.
+  for (size_t i = 0; i < 2000; i += 2) {
     EXPECT_EQ(rays[i].origin, rays[i + 1].origin);
     EXPECT_EQ(rays[i].dir, -rays[i + 1].dir);
     EXPECT_NEAR(length(rays[i].dir), 1.0, 1e-12);
     EXPECT_TRUE(scene.bounds.contains(rays[i].origin));
   }
-  // The sampler's rays are the same: casting them by hand reproduces the ray count.
+  // Re-casts start past an exit surface (tnear > 0).
+  size_t recasts = 0;
+  for (const Ray& ray : rays) recasts += ray.tnear > 0;
+  EXPECT_EQ(recasts, r.stats.recast_rays);
+}
+
+TEST(Sampler, DirectionsAreUniformOnTheSphere) {
+  const Scene scene = test::cube_grid(2);
   const auto caster = make_embree_caster(scene);
+  SamplerConfig config;
+  config.samples = 200000;
   config.empty_space = EmptySpaceMode::kOff;
-  config.show_progress = false;
-  const SamplingResult r = sample_segments(scene, *caster, config);
-  std::vector<Hit> hits(rays.size());
-  caster->intersect(rays, hits);
-  uint64_t valid = 0;
-  for (size_t i = 0; i < rays.size(); i += 2) valid += hits[i].hit() || hits[i + 1].hit();
-  EXPECT_EQ(valid, r.stats.valid_segments + r.stats.outside_view_box);
+  const std::vector<Ray> rays = sampled_rays(scene, *caster, config);
+  double mean[3] = {0, 0, 0}, second[3] = {0, 0, 0};
+  int octant[8] = {0};
+  for (size_t i = 0; i < rays.size(); i += 2) {
+    const Vec3& d = rays[i].dir;
+    ASSERT_NEAR(length(d), 1.0, 1e-12);
+    for (int a = 0; a < 3; ++a) {
+      mean[a] += d[a];
+      second[a] += d[a] * d[a];
+    }
+    ++octant[(d.x > 0) | ((d.y > 0) << 1) | ((d.z > 0) << 2)];
+  }
+  const double n = config.samples;
+  for (int a = 0; a < 3; ++a) {
+    EXPECT_NEAR(mean[a] / n, 0.0, 0.01) << "axis " << a;
+    EXPECT_NEAR(second[a] / n, 1.0 / 3.0, 0.01) << "axis " << a;  // E[d_a^2] = 1/3 when uniform
+  }
+  for (int o : octant) EXPECT_NEAR(o / n, 0.125, 0.005);
 }
 
 TEST(Sampler, SegmentTargetIsAPrefixOfTheSampleStream) {

@@ -2,10 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdint>
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
 
 #include "viewcells/io/binary_file.h"
 
@@ -21,21 +17,6 @@ void SegmentSet::resize(size_t n) {
   for (auto* v : {&ax, &ay, &az, &bx, &by, &bz}) v->resize(n);
   object_a.resize(n);
   object_b.resize(n);
-}
-
-void SegmentSet::resize_for_output(size_t n) {
-  reserve(n);
-#ifdef __linux__
-  auto advise = [](void* p, size_t bytes) {
-    const uintptr_t page = 4096, begin = (reinterpret_cast<uintptr_t>(p) + page - 1) & ~(page - 1);
-    const uintptr_t end = (reinterpret_cast<uintptr_t>(p) + bytes) & ~(page - 1);
-    if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);  // a hint only
-  };
-  for (auto* v : {&ax, &ay, &az, &bx, &by, &bz}) advise(v->data(), n * sizeof(double));
-  advise(object_a.data(), n * sizeof(uint32_t));
-  advise(object_b.data(), n * sizeof(uint32_t));
-#endif
-  resize(n);
 }
 
 void SegmentSet::push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob) {
@@ -113,9 +94,9 @@ SegmentSet read_segments(const std::string& path, SegmentFileHeader* header) {
   h.object_count = r.get<uint32_t>();
   h.empty_space_detection = r.get<uint8_t>() != 0;
   const uint64_t max_count = payload.size() / sizeof(uint32_t);
-  for (auto* v : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) *v = r.get_array<double>(max_count);
-  s.object_a = r.get_array<uint32_t>(max_count);
-  s.object_b = r.get_array<uint32_t>(max_count);
+  for (auto* v : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) r.get_array(*v, max_count);
+  r.get_array(s.object_a, max_count);
+  r.get_array(s.object_b, max_count);
   if (!r.at_end()) r.fail("trailing bytes after the segment arrays");
   const size_t n = s.ax.size();
   for (const auto* v : {&s.ay, &s.az, &s.bx, &s.by, &s.bz})

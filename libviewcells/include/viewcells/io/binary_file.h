@@ -22,8 +22,8 @@ class ByteWriter {
     const auto* p = reinterpret_cast<const char*>(&v);
     data_.append(p, sizeof(T));
   }
-  template <class T>
-  void put_array(const std::vector<T>& v) {
+  template <class T, class A>
+  void put_array(const std::vector<T, A>& v) {
     static_assert(std::is_trivially_copyable_v<T>);
     put<uint64_t>(v.size());
     data_.append(reinterpret_cast<const char*>(v.data()), v.size() * sizeof(T));
@@ -52,14 +52,20 @@ class ByteReader {
     return v;
   }
   /// max_count guards against absurd sizes in a corrupt file before allocating.
-  template <class T>
-  std::vector<T> get_array(uint64_t max_count) {
+  template <class T, class A>
+  void get_array(std::vector<T, A>& v, uint64_t max_count) {
+    static_assert(std::is_trivially_copyable_v<T>);
     const uint64_t n = get<uint64_t>();
     if (n > max_count) fail("array of " + std::to_string(n) + " elements exceeds " + std::to_string(max_count));
     need(n * sizeof(T));
-    std::vector<T> v(n);
+    v.resize(n);
     if (n) std::memcpy(v.data(), data_.data() + pos_, n * sizeof(T));
     pos_ += n * sizeof(T);
+  }
+  template <class T>
+  std::vector<T> get_array(uint64_t max_count) {
+    std::vector<T> v;
+    get_array(v, max_count);
     return v;
   }
   std::string get_string() {

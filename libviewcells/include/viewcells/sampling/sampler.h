@@ -27,6 +27,7 @@ struct SamplerConfig {
   Box3 view_box;  ///< empty: the scene bounds
   /// Empty view space detection (back-face hit: move the origin there and re-cast). kAuto
   /// enables it only when every object is a closed, consistently outward-oriented solid.
+  /// A sample inside a solid re-casts from both exits and may give two segments.
   EmptySpaceMode empty_space = EmptySpaceMode::kAuto;
   int max_recasts = 8;        ///< re-casts per sample before it is dropped as stuck in solids
   uint32_t batch_size = 1024; ///< samples per random stream: fixes the output, not the threads
@@ -48,6 +49,9 @@ struct SamplingStats {
   uint64_t missed_both = 0;       ///< neither ray hit anything: not a visibility segment
   uint64_t stuck_in_solid = 0;    ///< still inside solids after max_recasts
   uint64_t outside_view_box = 0;  ///< no length inside the view box (re-cast past its boundary)
+  /// Samples inside a solid re-cast from both exits: each has two outcomes, so
+  /// valid + missed_both + stuck + outside == samples + two_sided_samples.
+  uint64_t two_sided_samples = 0;
   EmptySpaceDecision empty_space;
   Box3 view_box;
   bool view_box_from_scene = true;
@@ -64,8 +68,9 @@ struct SamplingResult {
 /// Error for an empty scene, a view box of zero volume, or a segment target out of reach.
 SamplingResult sample_segments(const Scene& scene, const RayCaster& caster, const SamplerConfig& config);
 
-/// The forward and backward rays of every sample, exactly as sample_segments casts them first
-/// (interleaved: forward of sample i at 2i, backward at 2i + 1). For raw ray-rate measurement.
-std::vector<Ray> primary_rays(const Scene& scene, const SamplerConfig& config);
+/// Every ray sample_segments(scene, caster, config) casts, re-casts included, in batch order
+/// (the forward and backward ray of a sample first, then its batch's re-casts). Runs the
+/// sampler again, untimed: for measuring bare Embree on exactly the sampler's rays.
+std::vector<Ray> sampled_rays(const Scene& scene, const RayCaster& caster, const SamplerConfig& config);
 
 }  // namespace viewcells

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "viewcells/core/default_init.h"
 #include "viewcells/core/vec3.h"
 #include "viewcells/scene/scene.h"
 
@@ -13,17 +14,15 @@ namespace viewcells {
 
 struct SegmentSet {
   Box3 view_box;
-  std::vector<double> ax, ay, az, bx, by, bz;
-  std::vector<uint32_t> object_a, object_b;
+  // Uninitialised growth: resize() of a fresh output costs no memset.
+  RawVector<double> ax, ay, az, bx, by, bz;
+  RawVector<uint32_t> object_a, object_b;
 
   size_t size() const { return ax.size(); }
   Vec3 a(size_t i) const { return {ax[i], ay[i], az[i]}; }
   Vec3 b(size_t i) const { return {bx[i], by[i], bz[i]}; }
   void reserve(size_t n);
   void resize(size_t n);
-  /// resize(n) for a large output about to be filled: asks the kernel for transparent huge
-  /// pages first (Linux), which saves most page faults on arrays of hundreds of megabytes.
-  void resize_for_output(size_t n);
   void push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob);
   void set(size_t i, const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob) {
     ax[i] = a.x, ay[i] = a.y, az[i] = a.z, bx[i] = b.x, by[i] = b.y, bz[i] = b.z;

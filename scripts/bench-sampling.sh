@@ -1,0 +1,70 @@
+#!/usr/bin/env bash
+# Sampling benchmark (issue: foundation): a generated city of >= 1M triangles, 1M segments,
+# segments per second against half the raw Embree rays per second measured in the same run.
+# Three runs per configuration; the table shows medians. Rewrites the sampling section of
+# BENCHMARKS.md. Usage: scripts/bench-sampling.sh [CITY_SIZE] [RUNS]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+size="${1:-23}"
+runs="${2:-3}"
+bash scripts/install-deps.sh >/dev/null
+bash scripts/build.sh build-release Release -DVIEWCELLS_BUILD_TESTS=OFF -DVIEWCELLS_BUILD_BENCH=ON
+vc=build-release/cli/viewcells
+dir=out/bench
+mkdir -p "$dir"
+scene="$dir/city$size.obj"
+[ -f "$scene" ] || "$vc" generate city --size "$size" --seed 1 -o "$scene"
+# The street band: the whole footprint, from the ground to 30 m (where people and cars are).
+bounds=$("$vc" info "$scene" --json "$dir/info.json" >/dev/null && python3 -c "
+import json; b=json.load(open('$dir/info.json'))['bounds']; print(','.join(str(v) for v in b['min'][:2]+[0.0]+b['max'][:2]+[30.0]))")
+
+declare -A box=([scene-bounds]="" [street-band]="--view-box $bounds")
+for name in scene-bounds street-band; do
+  for r in $(seq 1 "$runs"); do
+    # shellcheck disable=SC2086
+    "$vc" sample "$scene" --segments 1000000 --seed "$r" --measure-raw -q ${box[$name]} \
+      --report "$dir/sample-$name-$r.json"
+  done
+done
+
+python3 - "$dir" "$runs" "$size" <<'PY' > "$dir/sampling-table.md"
+import json, statistics, sys
+d, runs, size = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+rows = []
+for name in ["scene-bounds", "street-band"]:
+    reps = [json.load(open(f"{d}/sample-{name}-{r}.json")) for r in range(1, runs + 1)]
+    med = lambda f: statistics.median(f(x) for x in reps)
+    t = lambda x: x["timings"]
+    c = lambda x: x["counts"]
+    half_raw = lambda x: t(x)["raw_rays_per_second"] / 2
+    rows.append((name,
+                 reps[0]["scene"]["triangles"],
+                 med(lambda x: c(x)["valid_segments"]),
+                 med(lambda x: c(x)["samples"]),
+                 med(lambda x: c(x)["valid_segments"] / c(x)["samples"]),
+                 med(lambda x: t(x)["raw_rays_per_second"]) / 1e6,
+                 med(lambda x: t(x)["samples_per_second"]) / 1e6,
+                 med(lambda x: t(x)["segments_per_second"]) / 1e6,
+                 med(lambda x: t(x)["samples_per_second"] / half_raw(x)),
+                 med(lambda x: t(x)["segments_per_second"] / half_raw(x)),
+                 reps[0]["settings"]["threads"]))
+print(f"City size {size}, seed 1; {runs} runs per row (seeds 1..{runs}), medians; threads = {rows[0][10]}.\n")
+print("| view space | triangles | segments | samples | valid share | raw Embree Mrays/s | Msamples/s | Msegments/s | samples/s ÷ ½ raw | segments/s ÷ ½ raw |")
+print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+for r in rows:
+    print(f"| {r[0]} | {r[1]:,} | {r[2]:,.0f} | {r[3]:,.0f} | {r[4]:.3f} | {r[5]:.2f} | {r[6]:.2f} | {r[7]:.2f} | {r[8]:.3f} | {r[9]:.3f} |")
+PY
+
+# Replace the section between the markers in BENCHMARKS.md.
+python3 - "$dir/sampling-table.md" "$size" <<'PY'
+import re, sys
+table = open(sys.argv[1]).read()
+size = sys.argv[2]
+path = "BENCHMARKS.md"
+text = open(path).read()
+begin, end = "<!-- sampling:begin -->", "<!-- sampling:end -->"
+block = f"{begin}\nCommand: `scripts/bench-sampling.sh {size}`\n\n{table}{end}"
+text = re.sub(re.escape(begin) + ".*?" + re.escape(end), lambda m: block, text, flags=re.S)
+open(path, "w").write(text)
+PY
+cat "$dir/sampling-table.md"
