@@ -258,10 +258,19 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
   while (!done) {
     uint64_t round_samples = config.samples;
     if (by_segments) {
+      // A small first round measures the yield (segments per sample: below 1 where rays escape,
+      // above 1 where samples inside solids give two); later rounds ask for what is missing, so
+      // little work is cast past the target. Whole batches, so that the output is a prefix of
+      // what a large enough sample count gives.
       const uint64_t remaining = config.target_segments - segs.size();
-      const double rate = stats.samples ? std::max(0.02, double(stats.valid_segments) / stats.samples) : 0.9;
-      // Whole batches, so that the output is a prefix of what a large enough sample count gives.
-      round_samples = (static_cast<uint64_t>(remaining / rate * 1.05) / config.batch_size + 1) * config.batch_size;
+      const uint64_t calibration = 32 * static_cast<uint64_t>(config.batch_size);
+      if (stats.samples == 0) {
+        round_samples = std::min<uint64_t>(remaining, calibration);
+      } else {
+        const double rate = std::max(0.02, double(stats.valid_segments) / stats.samples);
+        round_samples = static_cast<uint64_t>(remaining / rate);
+      }
+      round_samples = (round_samples / config.batch_size + 1) * config.batch_size;
       if (stats.samples + round_samples > config.max_samples)
         round_samples = config.max_samples > stats.samples ? config.max_samples - stats.samples : 0;
       if (round_samples == 0)
@@ -275,7 +284,7 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
     // arrays grow without being zeroed, so slots a batch leaves unused are never even touched.
     const size_t slots = BatchSampler::segments_per_sample(stats.empty_space.enabled);
     const size_t base = segs.size();
-    segs.resize(base + round_samples * slots);
+    segs.grow_for_output(base + round_samples * slots);
     tbb::parallel_for(tbb::blocked_range<uint64_t>(0, batches, 1), [&](const tbb::blocked_range<uint64_t>& r) {
       BatchSampler& sampler = samplers.local();  // scratch buffers only: no effect on the output
       for (uint64_t b = r.begin(); b < r.end(); ++b) {

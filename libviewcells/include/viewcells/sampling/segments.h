@@ -23,6 +23,9 @@ struct SegmentSet {
   Vec3 b(size_t i) const { return {bx[i], by[i], bz[i]}; }
   void reserve(size_t n);
   void resize(size_t n);
+  /// resize(n) for an output about to be written: on Linux, asks for transparent huge pages
+  /// first, which saves most page faults on arrays of hundreds of megabytes.
+  void grow_for_output(size_t n);
   void push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob);
   void set(size_t i, const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob) {
     ax[i] = a.x, ay[i] = a.y, az[i] = a.z, bx[i] = b.x, by[i] = b.y, bz[i] = b.z;
