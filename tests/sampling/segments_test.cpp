@@ -13,9 +13,9 @@ namespace {
 SegmentSet small_set() {
   SegmentSet s;
   s.view_box = {{0, 0, 0}, {10, 10, 10}};
-  s.push_back({1, 2, 3}, {4, 5, 6}, 0, kNoObject);
-  s.push_back({0, 0, 0}, {10, 10, 10}, 2, 1);
-  s.push_back({1.0 / 3, 2, 3}, {9, 9, 9}, kNoObject, 2);
+  s.push_back({1, 2, 3}, {4, 5, 6}, 0, kNoObject, 7, kNoObject);
+  s.push_back({0, 0, 0}, {10, 10, 10}, 2, 1, 8, 9);
+  s.push_back({1.0 / 3, 2, 3}, {9, 9, 9}, kNoObject, 2, kNoObject, 10);
   return s;
 }
 

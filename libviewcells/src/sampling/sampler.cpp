@@ -127,12 +127,12 @@ class BatchSampler {
         // rays, where the paper's forward-only shift gives one for three. The PVS of a cell
         // is a union, so what matters is which segments are found, not how often.
         out.two_sided += fwd_inside && bwd_inside;
-        if (fwd_inside) pending_.push_back({points_[i] + dirs_[i] * fwd.t, dirs_[i], fwd.object, 1});
-        if (bwd_inside) pending_.push_back({points_[i] - dirs_[i] * bwd.t, -dirs_[i], bwd.object, 1});
+        if (fwd_inside) pending_.push_back({points_[i] + dirs_[i] * fwd.t, dirs_[i], fwd.object, fwd.triangle, 1});
+        if (bwd_inside) pending_.push_back({points_[i] - dirs_[i] * bwd.t, -dirs_[i], bwd.object, bwd.triangle, 1});
         continue;
       }
-      emit(points_[i], dirs_[i], bwd.hit() ? -bwd.t : -INFINITY, bwd.object, fwd.hit() ? fwd.t : INFINITY,
-           fwd.object, out);
+      emit(points_[i], dirs_[i], bwd.hit() ? -bwd.t : -INFINITY, bwd.object, bwd.triangle,
+           fwd.hit() ? fwd.t : INFINITY, fwd.object, fwd.triangle, out);
     }
 
     // Re-cast from the exit points, in batches, until every sample has left the solids.
@@ -153,12 +153,13 @@ class BatchSampler {
           if (p.depth >= max_recasts_) {
             ++out.stuck;
           } else {
-            next_.push_back({p.origin + p.dir * h.t, p.dir, h.object, p.depth + 1});
+            next_.push_back({p.origin + p.dir * h.t, p.dir, h.object, h.triangle, p.depth + 1});
           }
           continue;
         }
         // The near end is the exit surface, seen (front side) from the segment.
-        emit(p.origin, p.dir, 0.0, p.exit_object, h.hit() ? h.t : INFINITY, h.object, out);
+        emit(p.origin, p.dir, 0.0, p.exit_object, p.exit_triangle, h.hit() ? h.t : INFINITY, h.object, h.triangle,
+             out);
       }
       pending_.swap(next_);
     }
@@ -167,12 +168,13 @@ class BatchSampler {
  private:
   struct Pending {
     Vec3 origin, dir;
-    uint32_t exit_object;
+    uint32_t exit_object, exit_triangle;
     int depth;
   };
 
   /// The segment o + t*d, t in [t0, t1], seeing object o0 at t0 and o1 at t1, clipped to the box.
-  void emit(const Vec3& o, const Vec3& d, double t0, uint32_t o0, double t1, uint32_t o1, BatchOutput& out) {
+  void emit(const Vec3& o, const Vec3& d, double t0, uint32_t o0, uint32_t tri0, double t1, uint32_t o1, uint32_t tri1,
+            BatchOutput& out) {
     if (o0 == kNoObject && o1 == kNoObject) {
       ++out.missed_both;
       return;
@@ -182,7 +184,7 @@ class BatchSampler {
     if (std::isfinite(t0) && std::isfinite(t1) && t1 - t0 > eps_) {
       const Vec3 a = o + d * t0, b = o + d * t1;
       if (box_.contains(a, eps_) && box_.contains(b, eps_)) {
-        segs_->set(out.first + out.valid++, clamp_to_box(a, box_), clamp_to_box(b, box_), o0, o1);
+        segs_->set(out.first + out.valid++, clamp_to_box(a, box_), clamp_to_box(b, box_), o0, o1, tri0, tri1);
         return;
       }
     }
@@ -196,7 +198,7 @@ class BatchSampler {
     // Hits beyond the box keep their object: it is visible from the part inside the box.
     const Vec3 a = clamp_to_box(o + d * std::max(t0, c0), box_);
     const Vec3 b = clamp_to_box(o + d * std::min(t1, c1), box_);
-    segs_->set(out.first + out.valid++, a, b, o0, o1);
+    segs_->set(out.first + out.valid++, a, b, o0, o1, tri0, tri1);
   }
 
   const RayCaster& caster_;

@@ -13,14 +13,12 @@ namespace viewcells {
 
 void SegmentSet::reserve(size_t n) {
   for (auto* v : {&ax, &ay, &az, &bx, &by, &bz}) v->reserve(n);
-  object_a.reserve(n);
-  object_b.reserve(n);
+  for (auto* v : {&object_a, &object_b, &triangle_a, &triangle_b}) v->reserve(n);
 }
 
 void SegmentSet::resize(size_t n) {
   for (auto* v : {&ax, &ay, &az, &bx, &by, &bz}) v->resize(n);
-  object_a.resize(n);
-  object_b.resize(n);
+  for (auto* v : {&object_a, &object_b, &triangle_a, &triangle_b}) v->resize(n);
 }
 
 void SegmentSet::grow_for_output(size_t n) {
@@ -34,13 +32,12 @@ void SegmentSet::grow_for_output(size_t n) {
     if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);  // a hint
   };
   for (auto* v : {&ax, &ay, &az, &bx, &by, &bz}) advise(v->data(), sizeof(double));
-  advise(object_a.data(), sizeof(uint32_t));
-  advise(object_b.data(), sizeof(uint32_t));
+  for (auto* v : {&object_a, &object_b, &triangle_a, &triangle_b}) advise(v->data(), sizeof(uint32_t));
 #endif
   resize(n);
 }
 
-void SegmentSet::push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob) {
+void SegmentSet::push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob, uint32_t ta, uint32_t tb) {
   ax.push_back(a.x);
   ay.push_back(a.y);
   az.push_back(a.z);
@@ -49,6 +46,8 @@ void SegmentSet::push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t o
   bz.push_back(b.z);
   object_a.push_back(oa);
   object_b.push_back(ob);
+  triangle_a.push_back(ta);
+  triangle_b.push_back(tb);
 }
 
 void SegmentSet::append(const SegmentSet& o) {
@@ -61,6 +60,8 @@ void SegmentSet::append(const SegmentSet& o) {
   add(bz, o.bz);
   add(object_a, o.object_a);
   add(object_b, o.object_b);
+  add(triangle_a, o.triangle_a);
+  add(triangle_b, o.triangle_b);
 }
 
 void SegmentSet::move_range(size_t from, size_t n, size_t to) {
@@ -74,16 +75,19 @@ void SegmentSet::move_range(size_t from, size_t n, size_t to) {
   move(bz);
   move(object_a);
   move(object_b);
+  move(triangle_a);
+  move(triangle_b);
 }
 
 bool SegmentSet::operator==(const SegmentSet& o) const {
   return view_box == o.view_box && ax == o.ax && ay == o.ay && az == o.az && bx == o.bx && by == o.by &&
-         bz == o.bz && object_a == o.object_a && object_b == o.object_b;
+         bz == o.bz && object_a == o.object_a && object_b == o.object_b && triangle_a == o.triangle_a &&
+         triangle_b == o.triangle_b;
 }
 
 namespace {
 constexpr char kMagic[5] = "VSEG";
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 1;  // layout: header, 6 coordinate arrays, objects a/b, triangles a/b
 }  // namespace
 
 void write_segments(const std::string& path, const SegmentSet& s, const SegmentFileHeader& h) {
@@ -98,6 +102,8 @@ void write_segments(const std::string& path, const SegmentSet& s, const SegmentF
   for (const auto* v : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) w.put_array(*v);
   w.put_array(s.object_a);
   w.put_array(s.object_b);
+  w.put_array(s.triangle_a);
+  w.put_array(s.triangle_b);
   write_container(path, kMagic, kVersion, w.data());
 }
 
@@ -118,11 +124,14 @@ SegmentSet read_segments(const std::string& path, SegmentFileHeader* header) {
   for (auto* v : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) r.get_array(*v, max_count);
   r.get_array(s.object_a, max_count);
   r.get_array(s.object_b, max_count);
+  r.get_array(s.triangle_a, max_count);
+  r.get_array(s.triangle_b, max_count);
   if (!r.at_end()) r.fail("trailing bytes after the segment arrays");
   const size_t n = s.ax.size();
   for (const auto* v : {&s.ay, &s.az, &s.bx, &s.by, &s.bz})
     if (v->size() != n) r.fail("segment arrays differ in length");
-  if (s.object_a.size() != n || s.object_b.size() != n) r.fail("object arrays differ in length");
+  if (s.object_a.size() != n || s.object_b.size() != n || s.triangle_a.size() != n || s.triangle_b.size() != n)
+    r.fail("object or triangle arrays differ in length");
   if (s.view_box.empty() || !is_finite(s.view_box.lo) || !is_finite(s.view_box.hi)) r.fail("invalid view box");
   for (size_t i = 0; i < n; ++i) {
     if (!s.view_box.contains(s.a(i)) || !s.view_box.contains(s.b(i)))
@@ -131,6 +140,9 @@ SegmentSet read_segments(const std::string& path, SegmentFileHeader* header) {
       if (o != kNoObject && o >= h.object_count)
         r.fail("segment " + std::to_string(i) + " names object " + std::to_string(o) + " of " +
                std::to_string(h.object_count));
+    if ((s.object_a[i] == kNoObject) != (s.triangle_a[i] == kNoObject) ||
+        (s.object_b[i] == kNoObject) != (s.triangle_b[i] == kNoObject))
+      r.fail("segment " + std::to_string(i) + " has an object without a triangle or the reverse");
     if (s.object_a[i] == kNoObject && s.object_b[i] == kNoObject)
       r.fail("segment " + std::to_string(i) + " sees no object");
   }

@@ -17,6 +17,7 @@ struct SegmentSet {
   // Uninitialised growth: resize() of a fresh output costs no memset.
   RawVector<double> ax, ay, az, bx, by, bz;
   RawVector<uint32_t> object_a, object_b;
+  RawVector<uint32_t> triangle_a, triangle_b;  ///< the triangle hit at each end, or kNoObject
 
   size_t size() const { return ax.size(); }
   Vec3 a(size_t i) const { return {ax[i], ay[i], az[i]}; }
@@ -26,10 +27,12 @@ struct SegmentSet {
   /// resize(n) for an output about to be written: on Linux, asks for transparent huge pages
   /// first, which saves most page faults on arrays of hundreds of megabytes.
   void grow_for_output(size_t n);
-  void push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob);
-  void set(size_t i, const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob) {
+  void push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob, uint32_t ta = kNoObject,
+                 uint32_t tb = kNoObject);
+  void set(size_t i, const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob, uint32_t ta, uint32_t tb) {
     ax[i] = a.x, ay[i] = a.y, az[i] = a.z, bx[i] = b.x, by[i] = b.y, bz[i] = b.z;
     object_a[i] = oa, object_b[i] = ob;
+    triangle_a[i] = ta, triangle_b[i] = tb;
   }
   /// Appends all of `o` (view boxes must match).
   void append(const SegmentSet& o);
@@ -37,7 +40,7 @@ struct SegmentSet {
   void move_range(size_t from, size_t n, size_t to);
   bool operator==(const SegmentSet& o) const;
   /// Bytes used by the arrays.
-  size_t memory_bytes() const { return size() * (6 * sizeof(double) + 2 * sizeof(uint32_t)); }
+  size_t memory_bytes() const { return size() * (6 * sizeof(double) + 4 * sizeof(uint32_t)); }
 };
 
 /// What a segment file records besides the segments.

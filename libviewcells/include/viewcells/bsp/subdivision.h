@@ -1,0 +1,91 @@
+#pragma once
+/// Adaptive view space subdivision, AV-S (view-cell-construction paper, section 4.2): a BSP of
+/// the view space refined greedily, always splitting the leaf whose best plane reduces the
+/// expected render cost c(S) the most (priority: reduction + 1% of the leaf's own cost).
+/// Axis-aligned candidates lie at the clipped segment endpoints and are evaluated by a sweep
+/// with per-object first-seen marks (O(n log n) per node); geometry-aligned candidates are
+/// planes of scene triangles hit inside the node, a random subset of at most ga_candidates.
+/// Deterministic: the same inputs and seed give the same tree for any number of threads.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "viewcells/bsp/cost_model.h"
+#include "viewcells/bsp/plane.h"
+#include "viewcells/bsp/polyhedron.h"
+#include "viewcells/sampling/segments.h"
+#include "viewcells/scene/scene.h"
+
+namespace viewcells {
+
+enum class GeometryAlignedMode { kAuto, kOn, kOff };
+
+struct SubdivisionConfig {
+  uint32_t max_cells = 1000;           ///< stop at this many leaves
+  uint32_t max_axis_candidates = 200;  ///< positions per axis (a random subset of segment ends beyond)
+  GeometryAlignedMode geometry_aligned = GeometryAlignedMode::kAuto;
+  uint32_t ga_candidates = 150;       ///< geometry-aligned planes per node at most (paper: 150)
+  /// kAuto enables geometry-aligned candidates when at least this share of the surface area
+  /// is not axis-aligned.
+  double ga_auto_share = 0.05;
+  /// Stop when the best reduction stayed below min_reduction * (cost of the whole view space)
+  /// for stagnation_steps successive splits.
+  double min_reduction = 1e-6;
+  uint32_t stagnation_steps = 50;
+  uint64_t seed = 1;
+  bool show_progress = true;
+};
+
+struct BspNode {
+  int32_t plane = -1;            ///< split plane (index into planes); -1 for a leaf
+  int32_t child[2] = {-1, -1};   ///< negative side, positive side
+  int32_t parent = -1;
+  double volume = 0;
+  double pvs_cost = 0;           ///< r(PVS) from the segments in the node
+};
+
+/// One split, in the order it happened: replaying the first k gives the subdivision with
+/// k + 1 cells exactly. Split k creates nodes 2k + 1 (negative side) and 2k + 2.
+struct SplitRecord {
+  int32_t node = -1;
+  double reduction = 0;   ///< c(S) before minus after
+  double cost_after = 0;  ///< c(S) after this split
+};
+
+struct SubdivisionStats {
+  uint64_t axis_candidates = 0;      ///< candidate planes evaluated, by kind
+  uint64_t geometry_candidates = 0;
+  bool geometry_aligned = false;
+  std::string geometry_aligned_reason;
+  std::string stop_reason;
+  double seconds = 0;
+};
+
+struct Subdivision {
+  Box3 view_box;
+  std::vector<Plane> planes;  ///< 0..5: the view box faces; then one per split
+  std::vector<BspNode> nodes;
+  std::vector<SplitRecord> splits;
+  std::vector<ConvexPolyhedron> cells;          ///< per node; filled for leaves only
+  std::vector<std::vector<uint32_t>> segments;  ///< per node: ids of the segments it holds (leaves)
+  double initial_cost = 0;                      ///< c(S) of the single cell
+  SubdivisionStats stats;
+
+  size_t leaf_count() const { return splits.size() + 1; }
+  std::vector<int32_t> leaves() const;
+  /// c(S) of the current leaves: sum of volume / V * r(PVS).
+  double cost() const;
+  /// The leaf containing p (points on a plane go to its negative side); -1 outside the box.
+  int32_t locate(const Vec3& p) const;
+  /// The leaves of the subdivision after its first k splits (k <= splits.size()).
+  std::vector<int32_t> leaves_after(size_t k) const;
+};
+
+/// Decides whether geometry-aligned candidates are used, and why.
+bool use_geometry_aligned(const Scene& scene, const SubdivisionConfig& config, std::string& reason);
+
+/// Builds AV-S over segments.view_box. `object_costs` is per_object_costs(scene, model).
+Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const std::vector<double>& object_costs,
+                      const SubdivisionConfig& config);
+
+}  // namespace viewcells

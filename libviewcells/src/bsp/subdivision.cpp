@@ -1,0 +1,451 @@
+// Adaptive view space subdivision (view-cell-construction paper, section 4.2).
+//
+// Each node holds its segments as (id, t0, t1): the part of segment id inside the node. A
+// segment goes to the negative child when part of it lies strictly on the negative side, to
+// the positive child likewise, and to both when it lies in the plane (so it has length in both
+// closed halves); a segment that only ends on the plane goes to one side. The same rule, in
+// classify() below, decides candidate costs and actual splits, so the two always agree; for
+// axis-aligned planes the sweep applies it through the segments' coordinate extents.
+#include "viewcells/bsp/subdivision.h"
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <queue>
+
+#include "viewcells/core/error.h"
+#include "viewcells/core/progress.h"
+#include "viewcells/core/rng.h"
+
+namespace viewcells {
+
+std::vector<int32_t> Subdivision::leaves() const { return leaves_after(splits.size()); }
+
+std::vector<int32_t> Subdivision::leaves_after(size_t k) const {
+  VC_CHECK(k <= splits.size());
+  // After k splits the nodes are 0 .. 2k; a node is a leaf then unless split among the first k.
+  std::vector<char> split_done(2 * k + 1, 0);
+  for (size_t i = 0; i < k; ++i) split_done[splits[i].node] = 1;
+  std::vector<int32_t> out;
+  for (size_t n = 0; n <= 2 * k; ++n)
+    if (!split_done[n]) out.push_back(static_cast<int32_t>(n));
+  return out;
+}
+
+double Subdivision::cost() const {
+  const double v = view_box.volume();
+  double c = 0;
+  for (int32_t n : leaves()) c += nodes[n].volume / v * nodes[n].pvs_cost;
+  return c;
+}
+
+int32_t Subdivision::locate(const Vec3& p) const {
+  if (nodes.empty() || !view_box.contains(p)) return -1;
+  int32_t n = 0;
+  while (nodes[n].plane >= 0) n = nodes[n].child[planes[nodes[n].plane].side(p) > 0 ? 1 : 0];
+  return n;
+}
+
+bool use_geometry_aligned(const Scene& scene, const SubdivisionConfig& config, std::string& reason) {
+  const double share = scene.non_axis_aligned_share();
+  const std::string pct = std::to_string(static_cast<int>(std::round(100 * share))) + "%";
+  switch (config.geometry_aligned) {
+    case GeometryAlignedMode::kOn: reason = "enabled by the user (" + pct + " of the surface is not axis-aligned)"; return true;
+    case GeometryAlignedMode::kOff: reason = "disabled by the user"; return false;
+    case GeometryAlignedMode::kAuto: break;
+  }
+  if (share >= config.ga_auto_share) {
+    reason = "enabled: " + pct + " of the surface area is not axis-aligned";
+    return true;
+  }
+  reason = "disabled: only " + pct + " of the surface area is not axis-aligned (axis-aligned candidates cover it)";
+  return false;
+}
+
+namespace {
+
+struct SegRef {
+  uint32_t id;
+  double t0, t1;
+};
+
+inline Vec3 point_at(const SegmentSet& s, uint32_t i, double t) { return s.a(i) * (1.0 - t) + s.b(i) * t; }
+
+/// Which children a segment part goes to, from the exact sides of its two ends:
+/// bit 0 negative, bit 1 positive.
+inline int classify(int s0, int s1) {
+  if (s0 == 0 && s1 == 0) return 3;  // lies in the plane: length in both closed halves
+  return ((s0 < 0 || s1 < 0) ? 1 : 0) | ((s0 > 0 || s1 > 0) ? 2 : 0);
+}
+
+/// First-seen marks per object, reset in O(1) by bumping an epoch.
+struct Marks {
+  std::vector<uint32_t> stamp;
+  uint32_t epoch = 0;
+  void reset(size_t n) {
+    if (stamp.size() < n) stamp.assign(n, 0);
+    if (++epoch == 0) {
+      std::fill(stamp.begin(), stamp.end(), 0);
+      epoch = 1;
+    }
+  }
+  /// Cost added by seeing object o (0 if already seen or none).
+  double add(uint32_t o, const std::vector<double>& r) {
+    if (o == kNoObject || stamp[o] == epoch) return 0.0;
+    stamp[o] = epoch;
+    return r[o];
+  }
+};
+
+struct Candidate {
+  bool valid = false;
+  Plane plane;
+  double reduction = 0;
+};
+
+struct Evaluation {
+  Candidate best;
+  uint64_t axis = 0, geometry = 0;
+};
+
+class Builder {
+ public:
+  Builder(const Scene& scene, const SegmentSet& segs, const std::vector<double>& r, const SubdivisionConfig& config,
+          Subdivision& out)
+      : scene_(scene), segs_(segs), r_(r), config_(config), out_(out), total_volume_(segs.view_box.volume()) {}
+
+  void run() {
+    const auto start = std::chrono::steady_clock::now();
+    out_.view_box = segs_.view_box;
+    out_.stats.geometry_aligned = use_geometry_aligned(scene_, config_, out_.stats.geometry_aligned_reason);
+    ga_ = out_.stats.geometry_aligned;
+    if (!(total_volume_ > 0)) throw Error("the view space box has zero volume");
+    const Box3& b = out_.view_box;
+    for (int a = 0; a < 3; ++a) {
+      out_.planes.push_back(Plane::axis_aligned(a, b.lo[a]));
+      out_.planes.push_back(Plane::axis_aligned(a, b.hi[a]));
+    }
+    // Box faces: -x, +x, -y, +y, -z, +z match planes 0..5.
+    ConvexPolyhedron root = ConvexPolyhedron::box(b, 0);
+    std::vector<SegRef> refs(segs_.size());
+    for (uint32_t i = 0; i < segs_.size(); ++i) refs[i] = {i, 0.0, 1.0};
+    add_node(-1, std::move(root), std::move(refs));
+    out_.initial_cost = node_cost(0);
+    double cost = out_.initial_cost;
+
+    using Entry = std::pair<double, int32_t>;  // priority, node
+    auto lower = [](const Entry& x, const Entry& y) {
+      return x.first < y.first || (x.first == y.first && x.second > y.second);  // ties: older node first
+    };
+    std::priority_queue<Entry, std::vector<Entry>, decltype(lower)> queue(lower);
+    best_.resize(1);
+    evaluate_into(0);
+    if (best_[0].valid) queue.push({priority(0), 0});
+
+    Progress progress("subdividing", config_.max_cells);
+    progress.advance(1);
+    uint32_t stagnant = 0;
+    out_.stats.stop_reason = "reached the maximum number of cells";
+    while (out_.leaf_count() < config_.max_cells) {
+      if (queue.empty()) {
+        out_.stats.stop_reason = "no cell can be split further (no candidate reduces the cost)";
+        break;
+      }
+      const int32_t node = queue.top().second;
+      queue.pop();
+      const Candidate cand = best_[node];
+      stagnant = cand.reduction < config_.min_reduction * out_.initial_cost ? stagnant + 1 : 0;
+      if (stagnant >= config_.stagnation_steps) {
+        out_.stats.stop_reason = "the cost reduction stayed below the threshold for " +
+                                 std::to_string(config_.stagnation_steps) + " successive splits";
+        break;
+      }
+      const double before = node_cost(node);
+      if (!apply_split(node, cand.plane)) continue;  // degenerate after all: leave the cell whole
+      const int32_t c0 = out_.nodes[node].child[0], c1 = out_.nodes[node].child[1];
+      const double after = node_cost(c0) + node_cost(c1);
+      cost += after - before;
+      out_.splits.push_back({node, before - after, cost});
+      best_.resize(out_.nodes.size());
+      tbb::parallel_invoke([&] { evaluate_into(c0); }, [&] { evaluate_into(c1); });
+      for (int32_t c : {c0, c1})
+        if (best_[c].valid) queue.push({priority(c), c});
+      if (config_.show_progress) progress.advance(1);
+    }
+    if (config_.show_progress) progress.finish();
+    out_.segments.resize(out_.nodes.size());
+    for (size_t n = 0; n < out_.nodes.size(); ++n) {
+      if (out_.nodes[n].plane >= 0) continue;
+      auto& ids = out_.segments[n];
+      ids.reserve(refs_[n].size());
+      for (const SegRef& s : refs_[n]) ids.push_back(s.id);
+    }
+    out_.stats.axis_candidates = axis_evaluated_;
+    out_.stats.geometry_candidates = geometry_evaluated_;
+    out_.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+
+ private:
+  double node_cost(int32_t n) const { return out_.nodes[n].volume / total_volume_ * out_.nodes[n].pvs_cost; }
+  double priority(int32_t n) const { return best_[n].reduction + 0.01 * node_cost(n); }
+
+  double pvs_cost(const std::vector<SegRef>& refs) {
+    Marks& m = marks_.local();
+    m.reset(r_.size());
+    double c = 0;
+    for (const SegRef& s : refs) c += m.add(segs_.object_a[s.id], r_) + m.add(segs_.object_b[s.id], r_);
+    return c;
+  }
+
+  int32_t add_node(int32_t parent, ConvexPolyhedron cell, std::vector<SegRef> refs) {
+    BspNode node;
+    node.parent = parent;
+    node.volume = cell.volume();
+    node.pvs_cost = pvs_cost(refs);
+    out_.nodes.push_back(node);
+    out_.cells.push_back(std::move(cell));
+    refs_.push_back(std::move(refs));
+    return static_cast<int32_t>(out_.nodes.size() - 1);
+  }
+
+  bool apply_split(int32_t node, const Plane& plane) {
+    const int32_t plane_id = static_cast<int32_t>(out_.planes.size());
+    auto halves = out_.cells[node].split(plane, plane_id);
+    if (!halves) return false;
+    out_.planes.push_back(plane);
+    std::vector<SegRef> side[2];
+    for (const SegRef& s : refs_[node]) {
+      const Vec3 p0 = point_at(segs_, s.id, s.t0), p1 = point_at(segs_, s.id, s.t1);
+      const int s0 = plane.side(p0), s1 = plane.side(p1);
+      const int to = classify(s0, s1);
+      if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) {
+        // Crosses: each side gets its part (the cut point is rounded; sides stay exact).
+        const double d0 = plane.distance(p0), d1 = plane.distance(p1);
+        double t = s.t0 + (s.t1 - s.t0) * (d0 / (d0 - d1));
+        t = std::clamp(t, s.t0, s.t1);
+        side[s0 < 0 ? 0 : 1].push_back({s.id, s.t0, t});
+        side[s0 < 0 ? 1 : 0].push_back({s.id, t, s.t1});
+        continue;
+      }
+      if (to & 1) side[0].push_back(s);
+      if (to & 2) side[1].push_back(s);
+    }
+    refs_[node].clear();
+    refs_[node].shrink_to_fit();
+    out_.cells[node] = ConvexPolyhedron();
+    out_.nodes[node].plane = plane_id;
+    const int32_t a = add_node(node, std::move(halves->first), std::move(side[0]));
+    const int32_t b = add_node(node, std::move(halves->second), std::move(side[1]));
+    out_.nodes[node].child[0] = a;
+    out_.nodes[node].child[1] = b;
+    return true;
+  }
+
+  void evaluate_into(int32_t node) {
+    const Evaluation e = evaluate(node);
+    best_[node] = e.best;
+    axis_evaluated_ += e.axis;
+    geometry_evaluated_ += e.geometry;
+  }
+
+  Evaluation evaluate(int32_t node) {
+    Evaluation ev;
+    const std::vector<SegRef>& refs = refs_[node];
+    if (refs.empty() || out_.nodes[node].pvs_cost == 0) return ev;
+    Candidate results[4];
+    tbb::parallel_for(0, 4, [&](int task) {
+      if (task < 3) {
+        results[task] = best_axis_candidate(node, task, ev);
+      } else if (ga_) {
+        results[3] = best_geometry_candidate(node, ev);
+      }
+    });
+    for (const Candidate& c : results)  // in a fixed order: ties keep the earlier kind/axis
+      if (c.valid && (!ev.best.valid || c.reduction > ev.best.reduction)) ev.best = c;
+    return ev;
+  }
+
+  /// The sweep: r(PVS) of both sides at every candidate position of one axis in O(n log n).
+  Candidate best_axis_candidate(int32_t node, int axis, Evaluation& ev) {
+    const std::vector<SegRef>& refs = refs_[node];
+    const ConvexPolyhedron& cell = out_.cells[node];
+    const Box3 bounds = cell.bounds();
+    const double lo_b = bounds.lo[axis], hi_b = bounds.hi[axis];
+    struct Extent {
+      double lo, hi;
+      uint32_t id;
+    };
+    std::vector<Extent> ext(refs.size());
+    std::vector<double> positions;
+    positions.reserve(2 * refs.size());
+    for (size_t i = 0; i < refs.size(); ++i) {
+      const double c0 = point_at(segs_, refs[i].id, refs[i].t0)[axis];
+      const double c1 = point_at(segs_, refs[i].id, refs[i].t1)[axis];
+      ext[i] = {std::min(c0, c1), std::max(c0, c1), refs[i].id};
+      for (double c : {c0, c1})
+        if (c > lo_b && c < hi_b) positions.push_back(c);
+    }
+    std::sort(positions.begin(), positions.end());
+    positions.erase(std::unique(positions.begin(), positions.end()), positions.end());
+    if (positions.empty()) return {};
+    if (positions.size() > config_.max_axis_candidates) {
+      // A random subset (paper, section 4.2), reproducible per node and axis.
+      Rng rng(config_.seed, (static_cast<uint64_t>(node) << 2) | static_cast<uint64_t>(axis));
+      for (size_t i = 0; i < config_.max_axis_candidates; ++i)
+        std::swap(positions[i], positions[i + rng.below(positions.size() - i)]);
+      positions.resize(config_.max_axis_candidates);
+      std::sort(positions.begin(), positions.end());
+    }
+    const size_t k = positions.size();
+    std::vector<double> left(k), right(k);
+    Marks& m = marks_.local();
+    // Negative side at x: lo < x, or lying in the plane (lo == hi == x). Sorted by lo, parts
+    // lying in a plane first among equal lo, so they are in when x reaches them.
+    std::vector<uint32_t> order(ext.size());
+    for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
+      const bool fx = ext[x].lo == ext[x].hi, fy = ext[y].lo == ext[y].hi;
+      return ext[x].lo < ext[y].lo || (ext[x].lo == ext[y].lo && fx && !fy);
+    });
+    m.reset(r_.size());
+    double cost = 0;
+    size_t next = 0;
+    for (size_t j = 0; j < k; ++j) {
+      const double x = positions[j];
+      while (next < order.size() &&
+             (ext[order[next]].lo < x || (ext[order[next]].lo == x && ext[order[next]].hi == x))) {
+        const uint32_t id = ext[order[next]].id;
+        cost += m.add(segs_.object_a[id], r_) + m.add(segs_.object_b[id], r_);
+        ++next;
+      }
+      left[j] = cost;
+    }
+    // Positive side at x: hi > x, or lying in the plane.
+    std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
+      const bool fx = ext[x].lo == ext[x].hi, fy = ext[y].lo == ext[y].hi;
+      return ext[x].hi > ext[y].hi || (ext[x].hi == ext[y].hi && fx && !fy);
+    });
+    m.reset(r_.size());
+    cost = 0;
+    next = 0;
+    for (size_t j = k; j-- > 0;) {
+      const double x = positions[j];
+      while (next < order.size() &&
+             (ext[order[next]].hi > x || (ext[order[next]].hi == x && ext[order[next]].lo == x))) {
+        const uint32_t id = ext[order[next]].id;
+        cost += m.add(segs_.object_a[id], r_) + m.add(segs_.object_b[id], r_);
+        ++next;
+      }
+      right[j] = cost;
+    }
+    const double own = node_cost(node);
+    const double volume = out_.nodes[node].volume;
+    const bool box = cell.is_box(out_.planes);
+    Candidate best;
+    for (size_t j = 0; j < k; ++j) {
+      const Plane plane = Plane::axis_aligned(axis, positions[j]);
+      const double vl = box ? volume * (positions[j] - lo_b) / (hi_b - lo_b) : cell.volume_below(plane);
+      const double vr = volume - vl;
+      if (!(vl > 0 && vr > 0)) continue;
+      const double reduction = own - (vl * left[j] + vr * right[j]) / total_volume_;
+      if (!best.valid || reduction > best.reduction) best = {true, plane, reduction};
+    }
+    __atomic_add_fetch(&ev.axis, k, __ATOMIC_RELAXED);
+    return best;
+  }
+
+  /// Planes of non-axis-aligned triangles hit inside the node, a random subset; each costs O(n).
+  Candidate best_geometry_candidate(int32_t node, Evaluation& ev) {
+    const std::vector<SegRef>& refs = refs_[node];
+    // Triangles hit at segment ends inside this node lie (at least partly) inside it.
+    std::vector<uint32_t> tris;
+    for (const SegRef& s : refs) {
+      if (s.t0 == 0.0 && segs_.triangle_a[s.id] != kNoObject) tris.push_back(segs_.triangle_a[s.id]);
+      if (s.t1 == 1.0 && segs_.triangle_b[s.id] != kNoObject) tris.push_back(segs_.triangle_b[s.id]);
+    }
+    std::sort(tris.begin(), tris.end());
+    tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
+    // One candidate per distinct plane (walls are made of several triangles).
+    std::map<std::array<long long, 4>, uint32_t> by_plane;
+    for (uint32_t t : tris) {
+      const Vec3 n = scene_.triangle_normal(t);
+      const double len = length(n);
+      if (!(len > 0)) continue;
+      const Vec3 u = n / len;
+      if (std::max({std::abs(u.x), std::abs(u.y), std::abs(u.z)}) > 1.0 - 1e-9) continue;  // axis-aligned
+      const double d = dot(u, scene_.vertices[scene_.triangles[t][0]]);
+      const double q = 1e6 / std::max(1.0, out_.view_box.diagonal());
+      by_plane.emplace(std::array<long long, 4>{std::llround(u.x * 1e6), std::llround(u.y * 1e6),
+                                                std::llround(u.z * 1e6), std::llround(d * q)},
+                       t);
+    }
+    std::vector<uint32_t> planes;
+    for (const auto& [key, t] : by_plane) planes.push_back(t);
+    if (planes.empty()) return {};
+    if (planes.size() > config_.ga_candidates) {
+      Rng rng(config_.seed, (static_cast<uint64_t>(node) << 2) | 3);
+      for (size_t i = 0; i < config_.ga_candidates; ++i)
+        std::swap(planes[i], planes[i + rng.below(planes.size() - i)]);
+      planes.resize(config_.ga_candidates);
+    }
+    const double own = node_cost(node);
+    const double volume = out_.nodes[node].volume;
+    const ConvexPolyhedron& cell = out_.cells[node];
+    Marks& neg = marks_.local();
+    Marks pos;  // a second set of marks for the positive side
+    Candidate best;
+    for (uint32_t t : planes) {
+      const auto& tri = scene_.triangles[t];
+      const Plane plane = Plane::through(scene_.vertices[tri[0]], scene_.vertices[tri[1]], scene_.vertices[tri[2]]);
+      const double vl = cell.volume_below(plane), vr = volume - vl;
+      if (!(vl > 1e-12 * volume && vr > 1e-12 * volume)) continue;
+      neg.reset(r_.size());
+      pos.reset(r_.size());
+      double cl = 0, cr = 0;
+      for (const SegRef& s : refs) {
+        const int to = classify(plane.side(point_at(segs_, s.id, s.t0)), plane.side(point_at(segs_, s.id, s.t1)));
+        if (to & 1) cl += neg.add(segs_.object_a[s.id], r_) + neg.add(segs_.object_b[s.id], r_);
+        if (to & 2) cr += pos.add(segs_.object_a[s.id], r_) + pos.add(segs_.object_b[s.id], r_);
+      }
+      const double reduction = own - (vl * cl + vr * cr) / total_volume_;
+      if (!best.valid || reduction > best.reduction) best = {true, plane, reduction};
+    }
+    __atomic_add_fetch(&ev.geometry, planes.size(), __ATOMIC_RELAXED);
+    return best;
+  }
+
+  const Scene& scene_;
+  const SegmentSet& segs_;
+  const std::vector<double>& r_;
+  const SubdivisionConfig& config_;
+  Subdivision& out_;
+  double total_volume_;
+  bool ga_ = false;
+  std::vector<std::vector<SegRef>> refs_;
+  std::vector<Candidate> best_;
+  std::atomic<uint64_t> axis_evaluated_{0}, geometry_evaluated_{0};
+  tbb::enumerable_thread_specific<Marks> marks_;
+};
+
+}  // namespace
+
+Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const std::vector<double>& object_costs,
+                      const SubdivisionConfig& config) {
+  if (object_costs.size() != scene.objects.size()) throw Error("object costs do not match the scene");
+  if (config.max_cells < 1) throw Error("the maximum number of cells must be at least 1");
+  for (size_t i = 0; i < segments.size(); ++i)
+    for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
+      if (o != kNoObject && o >= scene.objects.size())
+        throw Error("segment " + std::to_string(i) + " names object " + std::to_string(o) +
+                    ", but the scene has " + std::to_string(scene.objects.size()) + " (segments of another scene?)");
+  Subdivision out;
+  Builder(scene, segments, object_costs, config, out).run();
+  return out;
+}
+
+}  // namespace viewcells

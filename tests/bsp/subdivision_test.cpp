@@ -1,0 +1,252 @@
+// Invariants of the AV-S subdivision on generated scenes, and the sweep against brute force.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "support/test_scenes.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/parallel.h"
+#include "viewcells/core/rng.h"
+#include "viewcells/bsp/subdivision.h"
+#include "viewcells/sampling/sampler.h"
+#include "viewcells/scene/generators.h"
+
+namespace viewcells {
+namespace {
+
+SegmentSet sample(const Scene& scene, uint64_t samples, uint64_t seed = 1) {
+  const auto caster = make_embree_caster(scene);
+  SamplerConfig config;
+  config.samples = samples;
+  config.seed = seed;
+  config.show_progress = false;
+  return sample_segments(scene, *caster, config).segments;
+}
+
+Subdivision build(const Scene& scene, const SegmentSet& segs, uint32_t cells,
+                  GeometryAlignedMode ga = GeometryAlignedMode::kAuto) {
+  SubdivisionConfig config;
+  config.max_cells = cells;
+  config.geometry_aligned = ga;
+  config.show_progress = false;
+  return subdivide(scene, segs, per_object_costs(scene, CostModel{}), config);
+}
+
+/// Length (world units) of segment i inside the closed leaf, from the half-spaces of its path,
+/// computed independently of the builder.
+double length_in_leaf(const Subdivision& s, const SegmentSet& segs, int32_t leaf, size_t i) {
+  double lo = 0, hi = 1;
+  const Vec3 a = segs.a(i), b = segs.b(i);
+  for (int32_t n = leaf; s.nodes[n].parent >= 0; n = s.nodes[n].parent) {
+    const BspNode& parent = s.nodes[s.nodes[n].parent];
+    const Plane& p = s.planes[parent.plane];
+    const double sign = parent.child[0] == n ? -1.0 : 1.0;  // stay on this side: sign * d(t) >= 0
+    const double d0 = sign * p.distance(a), d1 = sign * p.distance(b);
+    if (d0 < 0 && d1 < 0) return -1;
+    if (d0 < 0) lo = std::max(lo, d0 / (d0 - d1));
+    if (d1 < 0) hi = std::min(hi, d0 / (d0 - d1));
+  }
+  return (hi - lo) * length(b - a);
+}
+
+void expect_invariants(const Scene& scene, const SegmentSet& segs, const Subdivision& s) {
+  const double v = s.view_box.volume();
+  // Child volumes sum to the parent's.
+  for (const BspNode& n : s.nodes) {
+    if (n.plane < 0) continue;
+    const double sum = s.nodes[n.child[0]].volume + s.nodes[n.child[1]].volume;
+    EXPECT_NEAR(sum / n.volume, 1.0, 1e-9);
+    EXPECT_GT(s.nodes[n.child[0]].volume, 0);
+    EXPECT_GT(s.nodes[n.child[1]].volume, 0);
+  }
+  double leaves_volume = 0;
+  for (int32_t l : s.leaves()) leaves_volume += s.nodes[l].volume;
+  EXPECT_NEAR(leaves_volume / v, 1.0, 1e-9);
+  // The cost never increases, and the recorded curve matches the leaves.
+  double previous = s.initial_cost;
+  for (const SplitRecord& r : s.splits) {
+    EXPECT_GE(r.reduction, -1e-12 * s.initial_cost);
+    EXPECT_LE(r.cost_after, previous + 1e-12 * s.initial_cost);
+    previous = r.cost_after;
+  }
+  EXPECT_NEAR(s.cost(), previous, 1e-9 * s.initial_cost);
+  // Every segment is listed in exactly the leaves it pierces (ambiguous grazes excepted).
+  const double tol = 1e-7 * s.view_box.diagonal();
+  const std::vector<int32_t> leaves = s.leaves();
+  Rng rng(3);
+  int checked = 0;
+  for (int k = 0; k < 300; ++k) {
+    const size_t i = rng.below(segs.size());
+    for (int32_t leaf : leaves) {
+      const double len = length_in_leaf(s, segs, leaf, i);
+      const auto& ids = s.segments[leaf];
+      const bool listed = std::find(ids.begin(), ids.end(), i) != ids.end();
+      if (len > tol) EXPECT_TRUE(listed) << "segment " << i << " pierces leaf " << leaf << " by " << len;
+      if (len < -tol || (len < 0 && !listed)) EXPECT_FALSE(listed) << "segment " << i << " misses leaf " << leaf;
+      ++checked;
+    }
+  }
+  EXPECT_GT(checked, 0);
+  // Point location finds the leaf whose half-spaces hold the point.
+  for (int k = 0; k < 200; ++k) {
+    const size_t i = rng.below(segs.size());
+    const Vec3 m = (segs.a(i) + segs.b(i)) * 0.5;
+    const int32_t leaf = s.locate(m);
+    ASSERT_GE(leaf, 0);
+    EXPECT_EQ(s.nodes[leaf].plane, -1);
+    const auto& ids = s.segments[leaf];
+    // The midpoint lies in that leaf, so the segment does (unless only grazing it).
+    if (length_in_leaf(s, segs, leaf, i) > tol) EXPECT_NE(std::find(ids.begin(), ids.end(), i), ids.end());
+  }
+}
+
+TEST(Subdivision, InvariantsOnTheOffice) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 2});
+  const SegmentSet segs = sample(scene, 30000);
+  const Subdivision s = build(scene, segs, 200);
+  EXPECT_EQ(s.leaf_count(), 200u);
+  EXPECT_LT(s.cost(), 0.5 * s.initial_cost) << "walls separate rooms: the cost must drop a lot";
+  EXPECT_FALSE(s.stats.geometry_aligned);
+  expect_invariants(scene, segs, s);
+}
+
+TEST(Subdivision, InvariantsOnTheCity) {
+  const Scene scene = generate_scene({GeneratorKind::kCity, 2, 3});
+  const SegmentSet segs = sample(scene, 30000);
+  const Subdivision s = build(scene, segs, 150);
+  expect_invariants(scene, segs, s);
+  // Horizontal splits matter in a city (paper, section 1): some split planes are z = const.
+  int horizontal = 0;
+  for (const SplitRecord& r : s.splits) horizontal += s.planes[s.nodes[r.node].plane].axis == 2;
+  EXPECT_GT(horizontal, 5);
+}
+
+TEST(Subdivision, HardCases) {
+  // Rotated walls with geometry-aligned planes; coordinates at 1e5.
+  Scene rotated = generate_scene({GeneratorKind::kRotatedOffice, 2, 2});
+  Scene far = generate_scene({GeneratorKind::kOffice, 2, 2});
+  translate(far, {1e5, 1e5, 1e5});
+  for (const Scene* scene : {&rotated, &far}) {
+    const SegmentSet segs = sample(*scene, 20000);
+    const Subdivision s = build(*scene, segs, 120);
+    EXPECT_EQ(s.leaf_count(), 120u) << scene->source;
+    expect_invariants(*scene, segs, s);
+  }
+}
+
+TEST(Subdivision, GeometryAlignedPlanesHelpTheRotatedOffice) {
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 2});
+  const SegmentSet segs = sample(scene, 40000);
+  const Subdivision aa = build(scene, segs, 100, GeometryAlignedMode::kOff);
+  const Subdivision ga = build(scene, segs, 100, GeometryAlignedMode::kAuto);
+  EXPECT_TRUE(ga.stats.geometry_aligned) << ga.stats.geometry_aligned_reason;
+  EXPECT_GT(ga.stats.geometry_candidates, 0u);
+  EXPECT_EQ(aa.stats.geometry_candidates, 0u);
+  EXPECT_LT(ga.cost(), 0.98 * aa.cost()) << "aa " << aa.cost() << " ga " << ga.cost();
+  RecordProperty("cost_ratio_aa_over_ga", std::to_string(aa.cost() / ga.cost()));
+  std::printf("rotated office, 100 cells: AA-only cost %.1f, with GA %.1f (AA/GA = %.3f)\n", aa.cost(), ga.cost(),
+              aa.cost() / ga.cost());
+  expect_invariants(scene, segs, ga);
+}
+
+TEST(Subdivision, IdenticalForOneAndTwoThreads) {
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 3, 1});
+  const SegmentSet segs = sample(scene, 15000);
+  Subdivision one, two;
+  {
+    ThreadLimit t(1);
+    one = build(scene, segs, 80);
+  }
+  {
+    ThreadLimit t(2);
+    two = build(scene, segs, 80);
+  }
+  ASSERT_EQ(one.splits.size(), two.splits.size());
+  for (size_t k = 0; k < one.splits.size(); ++k) {
+    EXPECT_EQ(one.splits[k].node, two.splits[k].node);
+    EXPECT_EQ(one.splits[k].cost_after, two.splits[k].cost_after);
+  }
+  for (size_t p = 0; p < one.planes.size(); ++p) EXPECT_EQ(one.planes[p].offset, two.planes[p].offset);
+}
+
+TEST(Subdivision, ReplayGivesEveryCellCount) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
+  const Subdivision s = build(scene, sample(scene, 10000), 40);
+  for (size_t k = 0; k <= s.splits.size(); ++k) {
+    const auto leaves = s.leaves_after(k);
+    EXPECT_EQ(leaves.size(), k + 1);
+    double volume = 0, cost = 0;
+    for (int32_t n : leaves) {
+      volume += s.nodes[n].volume;
+      cost += s.nodes[n].volume / s.view_box.volume() * s.nodes[n].pvs_cost;
+    }
+    EXPECT_NEAR(volume / s.view_box.volume(), 1.0, 1e-9);
+    EXPECT_NEAR(cost, k ? s.splits[k - 1].cost_after : s.initial_cost, 1e-9 * s.initial_cost);
+  }
+}
+
+/// The sweep's best axis-aligned split equals the best found by partitioning every segment
+/// anew for every candidate, on random segments with many ties: endpoints on a coarse grid,
+/// so segments end on candidate planes and lie in them.
+TEST(Subdivision, SweepMatchesBruteForce) {
+  const Scene scene = test::cube_grid(4);  // 16 objects of 12 triangles; only their count matters
+  const std::vector<double> r = per_object_costs(scene, CostModel{});
+  for (uint64_t seed = 1; seed <= 5; ++seed) {
+    Rng rng(seed);
+    SegmentSet segs;
+    segs.view_box = {{0, 0, 0}, {8, 8, 8}};
+    for (int i = 0; i < 400; ++i) {
+      Vec3 a{double(rng.below(9)), double(rng.below(9)), double(rng.below(9))};
+      Vec3 b = a;
+      b[static_cast<int>(rng.below(3))] = double(rng.below(9));  // axis-parallel: lies in planes
+      if (i % 3 == 0) b = {double(rng.below(9)), double(rng.below(9)), double(rng.below(9))};
+      if (a == b) b.x = a.x < 8 ? a.x + 1 : a.x - 1;
+      const uint32_t oa = rng.below(3) ? static_cast<uint32_t>(rng.below(16)) : kNoObject;
+      const uint32_t ob = static_cast<uint32_t>(rng.below(16));
+      segs.push_back(a, b, oa, ob, oa == kNoObject ? kNoObject : 0, 0);
+    }
+    SubdivisionConfig config;
+    config.max_cells = 2;
+    config.max_axis_candidates = 1000;  // no subsampling
+    config.geometry_aligned = GeometryAlignedMode::kOff;
+    config.show_progress = false;
+    const Subdivision s = subdivide(scene, segs, r, config);
+    ASSERT_EQ(s.splits.size(), 1u);
+
+    double best = -1;
+    for (int axis = 0; axis < 3; ++axis) {
+      for (int x = 1; x < 8; ++x) {
+        std::vector<char> seen[2] = {std::vector<char>(16, 0), std::vector<char>(16, 0)};
+        double cost[2] = {0, 0};
+        for (size_t i = 0; i < segs.size(); ++i) {
+          const double c0 = segs.a(i)[axis], c1 = segs.b(i)[axis];
+          const int s0 = c0 > x ? 1 : (c0 < x ? -1 : 0), s1 = c1 > x ? 1 : (c1 < x ? -1 : 0);
+          const bool in_plane = s0 == 0 && s1 == 0;
+          const bool to[2] = {in_plane || s0 < 0 || s1 < 0, in_plane || s0 > 0 || s1 > 0};
+          for (int side = 0; side < 2; ++side)
+            for (uint32_t o : {segs.object_a[i], segs.object_b[i]})
+              if (to[side] && o != kNoObject && !seen[side][o]) {
+                seen[side][o] = 1;
+                cost[side] += r[o];
+              }
+        }
+        const double reduction = s.initial_cost - (x / 8.0) * cost[0] - ((8 - x) / 8.0) * cost[1];
+        best = std::max(best, reduction);
+      }
+    }
+    EXPECT_NEAR(s.splits[0].reduction, best, 1e-9 * s.initial_cost) << "seed " << seed;
+  }
+}
+
+TEST(Subdivision, BadInput) {
+  const Scene scene = test::cube_grid(2);
+  SegmentSet segs;
+  segs.view_box = {{0, 0, 0}, {1, 1, 1}};
+  segs.push_back({0, 0, 0}, {1, 1, 1}, 99, kNoObject, 0, kNoObject);
+  EXPECT_THROW(build(scene, segs, 10), Error);
+  EXPECT_THROW(per_object_costs(scene, CostModel{100, 1, 0.5}), Error);
+}
+
+}  // namespace
+}  // namespace viewcells
