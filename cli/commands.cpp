@@ -3,11 +3,15 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <cstdio>
+#include <memory>
 #include <fstream>
 #include <iostream>
 #include <sstream>
 
+#include "viewcells/bsp/subdivision.h"
+#include "viewcells/bsp/subdivision_io.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
@@ -162,27 +166,51 @@ int run_info(const InfoArgs& a, const Common& c) {
 
 // --------------------------------------------------------------------------------- sample
 
+/// Scene and sampling options shared by `sample` and `build`.
 struct SampleArgs {
   std::string scene;
   std::string objects = "auto";
   uint64_t samples = 1'000'000;
   uint64_t segments = 0;
+  bool segments_given = false;
   uint64_t seed = 1;
-  std::string output;
-  std::string report;
   std::string view_box;
   std::string empty_space = "auto";
   bool fast = false;
-  bool measure_raw = false;
-  bool segments_given = false;
   int max_recasts = 8;
 };
 
-int run_sample(const SampleArgs& a, const Common& c) {
+void add_sampling_options(CLI::App* cmd, SampleArgs& a) {
+  cmd->add_option("scene", a.scene, "Scene file (.obj, .ply, .off, .stl)")->required();
+  auto* samples_opt = cmd->add_option("--samples", a.samples, "Number of samples (two rays each)")->capture_default_str();
+  cmd->add_option("--segments", a.segments, "Sample until this many valid segments exist (instead of --samples)")
+      ->excludes(samples_opt);
+  cmd->add_option("--seed", a.seed, "Random seed (same seed, same result for any --threads)")->capture_default_str();
+  cmd->add_option("--objects", a.objects, "Object grouping: auto | groups | components | triangles")
+      ->capture_default_str();
+  cmd->add_option("--view-box", a.view_box, "View space box xmin,ymin,zmin,xmax,ymax,zmax (default: scene bounds)");
+  cmd->add_option("--empty-space", a.empty_space,
+                  "Empty view space detection: auto (only for closed, outward-oriented scenes) | on | off")
+      ->capture_default_str();
+  cmd->add_option("--max-recasts", a.max_recasts, "Re-casts per sample when empty space detection is on")
+      ->capture_default_str();
+  cmd->add_flag("--fast", a.fast, "Embree without robust mode (faster, may leak through edges)");
+}
+
+/// What loading and sampling produced, with timings.
+struct Sampled {
+  Scene scene;
+  std::unique_ptr<RayCaster> caster;
+  SamplerConfig config;
+  SamplingResult result;
+  double load_s = 0, bvh_s = 0;
+};
+
+Sampled load_and_sample(const SampleArgs& a, const Common& c, int threads) {
   if (a.samples == 0) throw Error("--samples must be positive");
   if (a.segments == 0 && a.segments_given) throw Error("--segments must be positive");
-  ThreadLimit threads(c.threads);
-  SamplerConfig config;
+  Sampled out;
+  SamplerConfig& config = out.config;
   config.samples = a.samples;
   config.target_segments = a.segments;
   config.seed = a.seed;
@@ -192,56 +220,43 @@ int run_sample(const SampleArgs& a, const Common& c) {
   if (!a.view_box.empty()) config.view_box = parse_box(a.view_box);
 
   Stopwatch sw;
-  const Scene scene = load_scene(a.scene, parse_grouping(a.objects));
-  const double load_s = sw.seconds();
-  c.log("viewcells: " + a.scene + ": " + std::to_string(scene.object_count()) + " objects, " +
-        std::to_string(scene.triangle_count()) + " triangles, loaded in " + fmt(load_s, 2) + " s");
-
+  out.scene = load_scene(a.scene, parse_grouping(a.objects));
+  out.load_s = sw.seconds();
+  c.log("viewcells: " + a.scene + ": " + std::to_string(out.scene.object_count()) + " objects, " +
+        std::to_string(out.scene.triangle_count()) + " triangles, loaded in " + fmt(out.load_s, 2) + " s");
   sw.restart();
   EmbreeConfig ec;
   ec.robust = !a.fast;
-  const auto caster = make_embree_caster(scene, ec);
-  const double bvh_s = sw.seconds();
-
-  const EmptySpaceDecision esd = decide_empty_space(scene, config.empty_space);
-  c.log("viewcells: sampling " + (a.segments ? "until " + std::to_string(a.segments) + " segments" : std::to_string(a.samples) + " samples") + ", seed " + std::to_string(a.seed) + ", " +
-        std::to_string(threads.threads()) + " threads, " + caster->name() + "; view box " +
-        (config.view_box.empty() ? "= scene bounds" : describe_box(config.view_box)) +
+  out.caster = make_embree_caster(out.scene, ec);
+  out.bvh_s = sw.seconds();
+  const EmptySpaceDecision esd = decide_empty_space(out.scene, config.empty_space);
+  c.log("viewcells: sampling " +
+        (a.segments ? "until " + std::to_string(a.segments) + " segments" : std::to_string(a.samples) + " samples") +
+        ", seed " + std::to_string(a.seed) + ", " + std::to_string(threads) + " threads, " + out.caster->name() +
+        "; view box " + (config.view_box.empty() ? "= scene bounds" : describe_box(config.view_box)) +
         "; empty space detection " + esd.reason);
-
-  SamplingResult result = sample_segments(scene, *caster, config);
-  const SamplingStats& st = result.stats;
-
-  sw.restart();
-  if (!a.output.empty()) {
-    SegmentFileHeader header;
-    header.seed = a.seed;
-    header.samples = st.samples;
-    header.scene_fingerprint = scene.fingerprint();
-    header.object_count = static_cast<uint32_t>(scene.object_count());
-    header.empty_space_detection = st.empty_space.enabled;
-    write_segments(a.output, result.segments, header);
-  }
-  const double write_s = sw.seconds();
-
-  const double seg_rate = st.valid_segments / st.seconds;
+  out.result = sample_segments(out.scene, *out.caster, config);
+  const SamplingStats& st = out.result.stats;
   c.log("viewcells: " + std::to_string(st.valid_segments) + " valid segments of " + std::to_string(st.samples) +
-        " samples (" + std::to_string(st.rays) + " rays) in " + fmt(st.seconds, 2) + " s: " + fmt(seg_rate / 1e6, 3) +
-        " M segments/s" + (a.output.empty() ? "" : " -> " + a.output));
+        " samples (" + std::to_string(st.rays) + " rays) in " + fmt(st.seconds, 2) + " s: " +
+        fmt(st.valid_segments / st.seconds / 1e6, 3) + " M segments/s");
+  return out;
+}
 
+json sampling_report(const SampleArgs& a, const Sampled& s, int threads) {
+  const SamplingStats& st = s.result.stats;
   json report;
-  report["command"] = "sample";
-  report["scene"] = scene_summary(scene);
+  report["scene"] = scene_summary(s.scene);
   report["settings"] = {{"samples", a.segments ? json(nullptr) : json(a.samples)},
                         {"target_segments", a.segments ? json(a.segments) : json(nullptr)},
                         {"seed", a.seed},
-                        {"threads", threads.threads()},
-                        {"object_grouping", to_string(scene.grouping)},
+                        {"threads", threads},
+                        {"object_grouping", to_string(s.scene.grouping)},
                         {"view_box", to_json(st.view_box)},
                         {"view_box_source", st.view_box_from_scene ? "scene bounds" : "user (--view-box)"},
-                        {"ray_caster", caster->name()},
+                        {"ray_caster", s.caster->name()},
                         {"max_recasts", a.max_recasts},
-                        {"batch_size", config.batch_size}};
+                        {"batch_size", s.config.batch_size}};
   report["effects"] = {
       {"empty_space_detection", {{"enabled", st.empty_space.enabled}, {"reason", st.empty_space.reason}}},
       {"embree_robust_mode",
@@ -262,36 +277,184 @@ int run_sample(const SampleArgs& a, const Common& c) {
                       {"outside_view_box", st.outside_view_box},
                       {"two_sided_samples", st.two_sided_samples},
                       {"objects_hit", objects_hit},
-                      {"objects_never_hit", scene.object_count() - objects_hit},
+                      {"objects_never_hit", s.scene.object_count() - objects_hit},
                       {"max_segments_per_object", max_per_object},
                       {"segments_per_object", st.segments_per_object}};
-  json timing = {{"load_seconds", load_s},
-                 {"bvh_build_seconds", bvh_s},
-                 {"sampling_seconds", st.seconds},
-                 {"write_seconds", write_s},
-                 {"segments_per_second", seg_rate},
-                 {"samples_per_second", st.samples / st.seconds},
-                 {"rays_per_second", st.rays / st.seconds}};
-  if (a.measure_raw) {
-    SamplerConfig same = config;  // every ray of exactly the samples drawn, re-casts included
+  report["timings"] = {{"load_seconds", s.load_s},
+                       {"bvh_build_seconds", s.bvh_s},
+                       {"sampling_seconds", st.seconds},
+                       {"segments_per_second", st.valid_segments / st.seconds},
+                       {"samples_per_second", st.samples / st.seconds},
+                       {"rays_per_second", st.rays / st.seconds}};
+  return report;
+}
+
+struct SampleOnlyArgs {
+  std::string output, report;
+  bool measure_raw = false;
+};
+
+int run_sample(const SampleArgs& a, const SampleOnlyArgs& o, const Common& c) {
+  ThreadLimit threads(c.threads);
+  const Sampled s = load_and_sample(a, c, threads.threads());
+  const SamplingStats& st = s.result.stats;
+  Stopwatch sw;
+  if (!o.output.empty()) {
+    SegmentFileHeader header;
+    header.seed = a.seed;
+    header.samples = st.samples;
+    header.scene_fingerprint = s.scene.fingerprint();
+    header.object_count = static_cast<uint32_t>(s.scene.object_count());
+    header.empty_space_detection = st.empty_space.enabled;
+    write_segments(o.output, s.result.segments, header);
+    c.log("viewcells: segments -> " + o.output);
+  }
+  json report = sampling_report(a, s, threads.threads());
+  report["command"] = "sample";
+  report["timings"]["write_seconds"] = sw.seconds();
+  if (o.measure_raw) {
+    SamplerConfig same = s.config;  // every ray of exactly the samples drawn, re-casts included
     same.samples = st.samples;
     same.target_segments = 0;
-    const std::vector<Ray> rays = sampled_rays(scene, *caster, same);
-    const double raw_s = caster->time_raw(rays);
+    const std::vector<Ray> rays = sampled_rays(s.scene, *s.caster, same);
+    const double raw_s = s.caster->time_raw(rays);
     const double raw_rate = rays.size() / raw_s;
-    timing["raw_rays"] = rays.size();
-    timing["raw_seconds"] = raw_s;
-    timing["raw_rays_per_second"] = raw_rate;
-    timing["segments_per_second_over_half_raw_rays_per_second"] = seg_rate / (0.5 * raw_rate);
-    c.log("viewcells: raw Embree: " + fmt(raw_rate / 1e6, 3) + " M rays/s on the same " +
-          std::to_string(rays.size()) + " rays; segments/s over half of that: " +
-          fmt(seg_rate / (0.5 * raw_rate), 3));
+    const double seg_rate = st.valid_segments / st.seconds;
+    report["timings"]["raw_rays"] = rays.size();
+    report["timings"]["raw_seconds"] = raw_s;
+    report["timings"]["raw_rays_per_second"] = raw_rate;
+    report["timings"]["segments_per_second_over_half_raw_rays_per_second"] = seg_rate / (0.5 * raw_rate);
+    c.log("viewcells: raw Embree: " + fmt(raw_rate / 1e6, 3) + " M rays/s on the same " + std::to_string(rays.size()) +
+          " rays; segments/s over half of that: " + fmt(seg_rate / (0.5 * raw_rate), 3));
   }
-  report["timings"] = timing;
-  if (!a.report.empty()) {
-    write_json(a.report, report);
-    c.log("viewcells: report -> " + a.report);
+  if (!o.report.empty()) {
+    write_json(o.report, report);
+    c.log("viewcells: report -> " + o.report);
   }
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------- build
+
+struct BuildArgs {
+  std::string output, report, mesh, slice_png;
+  uint32_t max_cells = 1000;
+  bool no_ga = false;
+  bool ga = false;
+  uint32_t ga_candidates = 150;
+  uint32_t axis_candidates = 200;
+  double min_reduction = 1e-6;
+  double cost_a = 100, cost_b = 1;
+  double slice_z = NAN;
+  int slice_width = 1024;
+};
+
+void write_views(const Subdivision& s, const Scene* scene, const std::string& mesh, const std::string& png,
+                 double slice_z, int width, const Common& c) {
+  if (!mesh.empty()) {
+    write_cells_ply(mesh, s);
+    c.log("viewcells: cells -> " + mesh + " (coloured by render cost)");
+  }
+  if (!png.empty()) {
+    const double z = std::isnan(slice_z) ? 0.5 * (s.view_box.lo.z + s.view_box.hi.z) : slice_z;
+    write_slice_png(png, s, z, width, scene);
+    c.log("viewcells: slice at z = " + fmt(z, 3) + " -> " + png);
+  }
+}
+
+int run_build(const SampleArgs& a, const BuildArgs& b, const Common& c) {
+  ThreadLimit threads(c.threads);
+  CostModel model{b.cost_a, b.cost_b, 0.0};
+  const Sampled s = load_and_sample(a, c, threads.threads());
+  const std::vector<double> r = per_object_costs(s.scene, model);
+
+  SubdivisionConfig config;
+  config.max_cells = b.max_cells;
+  config.geometry_aligned = b.no_ga ? GeometryAlignedMode::kOff : (b.ga ? GeometryAlignedMode::kOn : GeometryAlignedMode::kAuto);
+  config.ga_candidates = b.ga_candidates;
+  config.max_axis_candidates = b.axis_candidates;
+  config.min_reduction = b.min_reduction;
+  config.seed = a.seed;
+  config.show_progress = !c.quiet;
+  std::string ga_reason;
+  use_geometry_aligned(s.scene, config, ga_reason);
+  c.log("viewcells: subdividing to at most " + std::to_string(b.max_cells) + " cells; geometry-aligned candidates " +
+        ga_reason);
+  Subdivision sub = subdivide(s.scene, s.result.segments, r, config);
+  c.log("viewcells: " + std::to_string(sub.leaf_count()) + " cells in " + fmt(sub.stats.seconds, 2) +
+        " s, render cost " + fmt(sub.initial_cost, 1) + " -> " + fmt(sub.cost(), 1) + " (" + sub.stats.stop_reason + ")");
+
+  Stopwatch sw;
+  SubdivisionFile file;
+  file.leaf_pvs = leaf_pvs(sub, s.result.segments);
+  file.cost_model = model;
+  file.scene_fingerprint = s.scene.fingerprint();
+  file.object_count = static_cast<uint32_t>(s.scene.object_count());
+  if (!b.output.empty()) {
+    file.subdivision = sub;
+    file.subdivision.segments.clear();
+    file.subdivision.cells.clear();
+    write_subdivision(b.output, file);
+    c.log("viewcells: hierarchy -> " + b.output);
+  }
+  const double write_s = sw.seconds();
+  sw.restart();
+  write_views(sub, &s.scene, b.mesh, b.slice_png, b.slice_z, b.slice_width, c);
+  const double views_s = sw.seconds();
+
+  json report = sampling_report(a, s, threads.threads());
+  report["command"] = "build";
+  report["settings"]["max_cells"] = b.max_cells;
+  report["settings"]["axis_candidates_per_axis"] = b.axis_candidates;
+  report["settings"]["ga_candidates"] = b.ga_candidates;
+  report["settings"]["min_reduction"] = b.min_reduction;
+  report["settings"]["cost_model"] = {{"a", model.a}, {"b", model.b}, {"c", model.c}};
+  report["effects"]["geometry_aligned_candidates"] = {{"enabled", sub.stats.geometry_aligned},
+                                                      {"reason", sub.stats.geometry_aligned_reason}};
+  report["effects"]["pixel_cost_term"] = {{"enabled", false}, {"reason", "c = 0: r(o) = max(a, b * triangles)"}};
+  report["effects"]["viewpoint_density"] = {{"enabled", false}, {"reason", "uniform: p(i) = V_i / V"}};
+  json curve = json::array();
+  for (size_t cells = 1; cells <= sub.leaf_count(); cells *= 2)
+    curve.push_back({{"cells", cells}, {"cost", cells == 1 ? sub.initial_cost : sub.splits[cells - 2].cost_after}});
+  report["subdivision"] = {{"cells", sub.leaf_count()},
+                           {"initial_cost", sub.initial_cost},
+                           {"final_cost", sub.cost()},
+                           {"cost_at_power_of_two_cells", curve},
+                           {"axis_candidates_evaluated", sub.stats.axis_candidates},
+                           {"geometry_candidates_evaluated", sub.stats.geometry_candidates},
+                           {"stop_reason", sub.stats.stop_reason}};
+  report["final_cost"] = sub.cost();
+  report["timings"]["subdivision_seconds"] = sub.stats.seconds;
+  report["timings"]["write_seconds"] = write_s;
+  report["timings"]["export_seconds"] = views_s;
+  if (!b.report.empty()) {
+    write_json(b.report, report);
+    c.log("viewcells: report -> " + b.report);
+  }
+  return 0;
+}
+
+// --------------------------------------------------------------------------------- export
+
+struct ExportArgs {
+  std::string input, mesh, png, scene;
+  double slice_z = NAN;
+  int width = 1024;
+};
+
+int run_export(const ExportArgs& e, const Common& c) {
+  if (e.mesh.empty() && e.png.empty()) throw Error("nothing to export: give --mesh and/or --slice-png");
+  SubdivisionFile file = read_subdivision(e.input);
+  rebuild_cells(file.subdivision);
+  c.log("viewcells: " + e.input + ": " + std::to_string(file.subdivision.leaf_count()) + " cells, render cost " +
+        fmt(file.subdivision.cost(), 1));
+  std::unique_ptr<Scene> scene;
+  if (!e.scene.empty()) {
+    scene = std::make_unique<Scene>(load_scene(e.scene));
+    if (scene->fingerprint() != file.scene_fingerprint)
+      c.log("viewcells: warning: " + e.scene + " is not the scene these cells were built from");
+  }
+  write_views(file.subdivision, scene.get(), e.mesh, e.png, e.slice_z, e.width, c);
   return 0;
 }
 
@@ -300,8 +463,8 @@ int run_sample(const SampleArgs& a, const Common& c) {
 int run(int argc, char** argv) {
   CLI::App app{
       "viewcells: builds view cells for visibility preprocessing from the visibility of the scene itself.\n"
-      "Pipeline (stages come online issue by issue): generate or load a scene -> sample visibility\n"
-      "segments -> (subdivide, merge, extract, compress PVS)."};
+      "Pipeline: generate or load a scene -> sample visibility segments -> subdivide the view space\n"
+      "into cells (build) -> (merge, extract, compress PVS: coming)."};
   app.require_subcommand(1);
   app.fallthrough();
   Common common;
@@ -327,25 +490,46 @@ int run(int argc, char** argv) {
   i->add_option("--json", info.json_path, "Also write the description as JSON");
 
   SampleArgs smp;
+  SampleOnlyArgs smp_out;
   auto* s = app.add_subcommand("sample", "Cast visibility segments through the view space (paper section 4.1)");
-  s->add_option("scene", smp.scene, "Scene file (.obj, .ply, .off, .stl)")->required();
-  auto* samples_opt = s->add_option("--samples", smp.samples, "Number of samples (two rays each)")->capture_default_str();
-  s->add_option("--segments", smp.segments, "Sample until this many valid segments exist (instead of --samples)")
-      ->excludes(samples_opt);
-  s->add_option("--seed", smp.seed, "Random seed")->capture_default_str();
-  s->add_option("-o,--output", smp.output, "Segment file to write (.vseg)");
-  s->add_option("--report", smp.report, "JSON report: settings, effects enabled and why, counts, timings");
-  s->add_option("--objects", smp.objects, "Object grouping: auto | groups | components | triangles")
-      ->capture_default_str();
-  s->add_option("--view-box", smp.view_box, "View space box xmin,ymin,zmin,xmax,ymax,zmax (default: scene bounds)");
-  s->add_option("--empty-space", smp.empty_space,
-                "Empty view space detection: auto (only for closed, outward-oriented scenes) | on | off")
-      ->capture_default_str();
-  s->add_option("--max-recasts", smp.max_recasts, "Re-casts per sample when empty space detection is on")
-      ->capture_default_str();
-  s->add_flag("--fast", smp.fast, "Embree without robust mode (faster, may leak through edges)");
-  s->add_flag("--measure-raw", smp.measure_raw,
+  add_sampling_options(s, smp);
+  s->add_option("-o,--output", smp_out.output, "Segment file to write (.vseg)");
+  s->add_option("--report", smp_out.report, "JSON report: settings, effects enabled and why, counts, timings");
+  s->add_flag("--measure-raw", smp_out.measure_raw,
               "Also cast the same rays (re-casts included) through Embree alone; report raw_rays_per_second");
+
+  SampleArgs bsmp;
+  BuildArgs bld;
+  auto* bc = app.add_subcommand("build", "Sample visibility and subdivide the view space into cells (AV-S, section 4.2)");
+  add_sampling_options(bc, bsmp);
+  bc->add_option("--max-cells", bld.max_cells, "Stop at this many cells")->capture_default_str()->check(CLI::PositiveNumber);
+  auto* no_ga = bc->add_flag("--no-ga", bld.no_ga, "No geometry-aligned split candidates");
+  bc->add_flag("--ga", bld.ga, "Geometry-aligned candidates even for mostly axis-aligned scenes")->excludes(no_ga);
+  bc->add_option("--ga-candidates", bld.ga_candidates, "Geometry-aligned planes tried per cell at most")
+      ->capture_default_str();
+  bc->add_option("--axis-candidates", bld.axis_candidates, "Axis-aligned positions tried per axis and cell at most")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  bc->add_option("--min-reduction", bld.min_reduction,
+                 "Stop when splits reduce the cost by less than this share of the initial cost for 50 splits running")
+      ->capture_default_str();
+  bc->add_option("--cost-a", bld.cost_a, "Render cost model: minimum cost of an object (r = max(a, b * triangles))")
+      ->capture_default_str();
+  bc->add_option("--cost-b", bld.cost_b, "Render cost model: cost per triangle")->capture_default_str();
+  bc->add_option("-o,--output", bld.output, "Hierarchy file to write (.vcells)");
+  bc->add_option("--report", bld.report, "JSON report: settings, effects and why, costs, candidates, timings");
+  bc->add_option("--mesh", bld.mesh, "Also write the cells as a PLY coloured by render cost");
+  bc->add_option("--slice-png", bld.slice_png, "Also write a PNG of a horizontal slice through the cells");
+  bc->add_option("--slice-z", bld.slice_z, "Height of the slice (default: middle of the view space)");
+  bc->add_option("--slice-width", bld.slice_width, "Slice image width in pixels")->capture_default_str();
+
+  ExportArgs exp;
+  auto* ex = app.add_subcommand("export", "Look at a built hierarchy: cells as PLY, or a slice as PNG");
+  ex->add_option("cells", exp.input, "Hierarchy file (.vcells)")->required();
+  ex->add_option("--mesh", exp.mesh, "PLY of the cells, coloured by render cost");
+  ex->add_option("--slice-png", exp.png, "PNG of a horizontal slice");
+  ex->add_option("--slice-z", exp.slice_z, "Height of the slice (default: middle of the view space)");
+  ex->add_option("--slice-width", exp.width, "Slice image width in pixels")->capture_default_str();
+  ex->add_option("--scene", exp.scene, "Draw this scene's cross-section into the slice");
 
   try {
     app.parse(argc, argv);
@@ -357,8 +541,13 @@ int run(int argc, char** argv) {
     if (*i) return run_info(info, common);
     if (*s) {
       smp.segments_given = s->count("--segments") > 0;
-      return run_sample(smp, common);
+      return run_sample(smp, smp_out, common);
     }
+    if (*bc) {
+      bsmp.segments_given = bc->count("--segments") > 0;
+      return run_build(bsmp, bld, common);
+    }
+    if (*ex) return run_export(exp, common);
   } catch (const Error& e) {
     std::cerr << "viewcells: error: " << e.what() << '\n';
     return 1;

@@ -3,11 +3,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 
 #include "support/test_scenes.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/rng.h"
+#include "viewcells/bsp/adjacency.h"
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/sampling/sampler.h"
 #include "viewcells/scene/generators.h"
@@ -237,6 +239,43 @@ TEST(Subdivision, SweepMatchesBruteForce) {
     }
     EXPECT_NEAR(s.splits[0].reduction, best, 1e-9 * s.initial_cost) << "seed " << seed;
   }
+}
+
+/// Neighbours share faces of positive area; on every split plane, the shared areas add up to
+/// the area of the leaves' faces on either side (both sides tile the same cross-section).
+void expect_adjacency_consistent(const Subdivision& s) {
+  const std::vector<LeafAdjacency> adj = leaf_adjacency(s);
+  const std::vector<int32_t> leaves = s.leaves();
+  std::map<int32_t, int> degree;
+  for (const LeafAdjacency& e : adj) {
+    EXPECT_LT(e.a, e.b);
+    EXPECT_GT(e.area, 0);
+    EXPECT_EQ(s.nodes[e.a].plane, -1);
+    EXPECT_EQ(s.nodes[e.b].plane, -1);
+    ++degree[e.a];
+    ++degree[e.b];
+  }
+  for (int32_t l : leaves) EXPECT_GT(degree[l], 0) << "leaf " << l << " has no neighbour";
+  std::map<int32_t, double> side_area[2];
+  for (int32_t l : leaves)
+    for (size_t f = 0; f < s.cells[l].faces().size(); ++f) {
+      const PolyFace& face = s.cells[l].faces()[f];
+      if (face.plane >= 6) side_area[face.outward_positive ? 0 : 1][face.plane] += s.cells[l].face_area(f);
+    }
+  // Shared area per plane, through the plane of either leaf's face: sum over all pairs.
+  double shared = 0, faces_neg = 0, faces_pos = 0;
+  for (const LeafAdjacency& e : adj) shared += e.area;
+  for (const auto& [p, a] : side_area[0]) faces_neg += a;
+  for (const auto& [p, a] : side_area[1]) faces_pos += a;
+  EXPECT_NEAR(faces_neg / faces_pos, 1.0, 1e-9);
+  EXPECT_NEAR(shared / faces_neg, 1.0, 1e-6);
+}
+
+TEST(Subdivision, AdjacencyIsSymmetricWithPositiveAreas) {
+  const Scene office = generate_scene({GeneratorKind::kOffice, 1, 2});
+  expect_adjacency_consistent(build(office, sample(office, 20000), 150));
+  const Scene rotated = generate_scene({GeneratorKind::kRotatedOffice, 1, 2});
+  expect_adjacency_consistent(build(rotated, sample(rotated, 20000), 150));
 }
 
 TEST(Subdivision, BadInput) {

@@ -1,0 +1,287 @@
+#include "viewcells/bsp/subdivision_io.h"
+
+#include <png.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+
+#include "viewcells/core/error.h"
+#include "viewcells/io/binary_file.h"
+
+namespace viewcells {
+
+std::vector<std::vector<uint32_t>> leaf_pvs(const Subdivision& s, const SegmentSet& segments) {
+  std::vector<std::vector<uint32_t>> pvs(s.nodes.size());
+  for (int32_t leaf : s.leaves()) {
+    auto& ids = pvs[leaf];
+    for (uint32_t i : s.segments[leaf])
+      for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
+        if (o != kNoObject) ids.push_back(o);
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  }
+  return pvs;
+}
+
+namespace {
+constexpr char kMagic[5] = "VCEL";
+constexpr uint32_t kVersion = 1;
+}  // namespace
+
+void write_subdivision(const std::string& path, const SubdivisionFile& f) {
+  const Subdivision& s = f.subdivision;
+  ByteWriter w;
+  w.put(s.view_box.lo);
+  w.put(s.view_box.hi);
+  w.put(f.cost_model.a);
+  w.put(f.cost_model.b);
+  w.put(f.cost_model.c);
+  w.put<uint64_t>(f.scene_fingerprint);
+  w.put<uint32_t>(f.object_count);
+  w.put(s.initial_cost);
+  w.put<uint64_t>(s.planes.size());
+  for (const Plane& p : s.planes) {
+    w.put<int32_t>(p.axis);
+    w.put(p.normal);
+    w.put(p.offset);
+    for (const Vec3& q : p.points) w.put(q);
+  }
+  w.put<uint64_t>(s.nodes.size());
+  for (const BspNode& n : s.nodes) {
+    w.put<int32_t>(n.plane);
+    w.put<int32_t>(n.child[0]);
+    w.put<int32_t>(n.child[1]);
+    w.put<int32_t>(n.parent);
+    w.put(n.volume);
+    w.put(n.pvs_cost);
+  }
+  w.put<uint64_t>(s.splits.size());
+  for (const SplitRecord& r : s.splits) {
+    w.put<int32_t>(r.node);
+    w.put(r.reduction);
+    w.put(r.cost_after);
+  }
+  for (size_t n = 0; n < s.nodes.size(); ++n) w.put_array(n < f.leaf_pvs.size() ? f.leaf_pvs[n] : std::vector<uint32_t>{});
+  write_container(path, kMagic, kVersion, w.data());
+}
+
+SubdivisionFile read_subdivision(const std::string& path) {
+  uint32_t version = 0;
+  const std::string payload = read_container(path, kMagic, kVersion, version);
+  ByteReader r(payload, path);
+  SubdivisionFile f;
+  Subdivision& s = f.subdivision;
+  s.view_box.lo = r.get<Vec3>();
+  s.view_box.hi = r.get<Vec3>();
+  f.cost_model.a = r.get<double>();
+  f.cost_model.b = r.get<double>();
+  f.cost_model.c = r.get<double>();
+  f.scene_fingerprint = r.get<uint64_t>();
+  f.object_count = r.get<uint32_t>();
+  s.initial_cost = r.get<double>();
+  if (!(s.view_box.volume() > 0) || !is_finite(s.view_box.lo) || !is_finite(s.view_box.hi)) r.fail("invalid view box");
+  const uint64_t max_items = payload.size() / 8;
+  const uint64_t planes = r.get<uint64_t>();
+  if (planes < 6 || planes > max_items) r.fail("invalid plane count");
+  s.planes.resize(planes);
+  for (Plane& p : s.planes) {
+    p.axis = r.get<int32_t>();
+    p.normal = r.get<Vec3>();
+    p.offset = r.get<double>();
+    for (Vec3& q : p.points) q = r.get<Vec3>();
+    if (p.axis < -1 || p.axis > 2 || !is_finite(p.normal) || !std::isfinite(p.offset)) r.fail("invalid plane");
+  }
+  const uint64_t nodes = r.get<uint64_t>();
+  if (nodes == 0 || nodes > max_items || nodes % 2 == 0) r.fail("invalid node count");
+  s.nodes.resize(nodes);
+  for (BspNode& n : s.nodes) {
+    n.plane = r.get<int32_t>();
+    n.child[0] = r.get<int32_t>();
+    n.child[1] = r.get<int32_t>();
+    n.parent = r.get<int32_t>();
+    n.volume = r.get<double>();
+    n.pvs_cost = r.get<double>();
+  }
+  const uint64_t splits = r.get<uint64_t>();
+  if (2 * splits + 1 != nodes) r.fail("split count does not match the node count");
+  s.splits.resize(splits);
+  for (SplitRecord& rec : s.splits) {
+    rec.node = r.get<int32_t>();
+    rec.reduction = r.get<double>();
+    rec.cost_after = r.get<double>();
+  }
+  f.leaf_pvs.resize(nodes);
+  for (auto& pvs : f.leaf_pvs) r.get_array(pvs, max_items);
+  if (!r.at_end()) r.fail("trailing bytes");
+  // Structure: split k splits an existing leaf into nodes 2k+1 and 2k+2 on plane 6 + k.
+  const int32_t n_nodes = static_cast<int32_t>(nodes);
+  if (s.nodes[0].parent != -1) r.fail("the root has a parent");
+  for (size_t k = 0; k < splits; ++k) {
+    const int32_t node = s.splits[k].node;
+    if (node < 0 || node > static_cast<int32_t>(2 * k)) r.fail("split " + std::to_string(k) + " names a node not yet created");
+    const BspNode& n = s.nodes[node];
+    const int32_t c0 = static_cast<int32_t>(2 * k + 1), c1 = c0 + 1;
+    if (n.plane != static_cast<int32_t>(6 + k) || n.child[0] != c0 || n.child[1] != c1 || s.nodes[c0].parent != node ||
+        s.nodes[c1].parent != node)
+      r.fail("split " + std::to_string(k) + " does not match the tree");
+  }
+  for (int32_t i = 0; i < n_nodes; ++i) {
+    const BspNode& n = s.nodes[i];
+    if (n.plane >= static_cast<int32_t>(planes) || !(n.volume > 0) || !(n.pvs_cost >= 0))
+      r.fail("node " + std::to_string(i) + " is invalid");
+    if (n.plane < 0 && (n.child[0] != -1 || n.child[1] != -1)) r.fail("leaf " + std::to_string(i) + " has children");
+    for (uint32_t o : f.leaf_pvs[i])
+      if (o >= f.object_count) r.fail("node " + std::to_string(i) + " lists object " + std::to_string(o));
+    if (!std::is_sorted(f.leaf_pvs[i].begin(), f.leaf_pvs[i].end())) r.fail("unsorted PVS");
+  }
+  if (planes != 6 + splits) r.fail("plane count does not match the split count");
+  return f;
+}
+
+void rebuild_cells(Subdivision& s) {
+  s.cells.assign(s.nodes.size(), ConvexPolyhedron());
+  s.cells[0] = ConvexPolyhedron::box(s.view_box, 0);
+  for (const SplitRecord& r : s.splits) {
+    const BspNode& n = s.nodes[r.node];
+    auto halves = s.cells[r.node].split(s.planes[n.plane], n.plane);
+    if (!halves) throw Error("replaying split of node " + std::to_string(r.node) + " failed (corrupt file?)");
+    s.cells[n.child[0]] = std::move(halves->first);
+    s.cells[n.child[1]] = std::move(halves->second);
+    s.cells[r.node] = ConvexPolyhedron();
+  }
+}
+
+namespace {
+
+/// Blue -> cyan -> green -> yellow -> red for t in [0, 1].
+void cost_colour(double t, unsigned char rgb[3]) {
+  t = std::clamp(t, 0.0, 1.0);
+  const double r = std::clamp(std::min(4 * t - 1.5, -4 * t + 4.5), 0.0, 1.0);
+  const double g = std::clamp(std::min(4 * t - 0.5, -4 * t + 3.5), 0.0, 1.0);
+  const double b = std::clamp(std::min(4 * t + 0.5, -4 * t + 2.5), 0.0, 1.0);
+  rgb[0] = static_cast<unsigned char>(255 * r);
+  rgb[1] = static_cast<unsigned char>(255 * g);
+  rgb[2] = static_cast<unsigned char>(255 * b);
+}
+
+double max_leaf_cost(const Subdivision& s) {
+  double m = 0;
+  for (int32_t l : s.leaves()) m = std::max(m, s.nodes[l].pvs_cost);
+  return m > 0 ? m : 1.0;
+}
+
+}  // namespace
+
+void write_cells_ply(const std::string& path, const Subdivision& s, double shrink) {
+  const std::vector<int32_t> leaves = s.leaves();
+  const double max_cost = max_leaf_cost(s);
+  std::string body;
+  size_t nv = 0, nf = 0;
+  std::string faces;
+  for (int32_t l : leaves) {
+    const ConvexPolyhedron& cell = s.cells[l];
+    if (cell.empty()) throw Error(path, 0, "cell geometry missing (rebuild_cells first)");
+    unsigned char rgb[3];
+    cost_colour(s.nodes[l].pvs_cost / max_cost, rgb);
+    const Vec3 c = cell.centroid();
+    const size_t base = nv;
+    for (const Vec3& p : cell.vertices()) {
+      const Vec3 q = c + (p - c) * shrink;
+      const float xyz[3] = {static_cast<float>(q.x), static_cast<float>(q.y), static_cast<float>(q.z)};
+      body.append(reinterpret_cast<const char*>(xyz), sizeof xyz);
+      body.append(reinterpret_cast<const char*>(rgb), 3);
+      ++nv;
+    }
+    for (const PolyFace& f : cell.faces()) {
+      const unsigned char count = static_cast<unsigned char>(std::min<size_t>(f.vertices.size(), 255));
+      faces.push_back(static_cast<char>(count));
+      for (size_t k = 0; k < count; ++k) {
+        const int32_t id = static_cast<int32_t>(base + f.vertices[k]);
+        faces.append(reinterpret_cast<const char*>(&id), 4);
+      }
+      ++nf;
+    }
+  }
+  std::string header = "ply\nformat binary_little_endian 1.0\ncomment viewcells: cells coloured by render cost\n";
+  header += "element vertex " + std::to_string(nv) +
+            "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\n"
+            "property uchar blue\nelement face " +
+            std::to_string(nf) + "\nproperty list uchar int vertex_indices\nend_header\n";
+  write_text_file(path, header + body + faces);
+}
+
+void write_slice_png(const std::string& path, const Subdivision& s, double height, int width, const Scene* scene) {
+  const Box3& b = s.view_box;
+  if (!(height >= b.lo.z && height <= b.hi.z))
+    throw Error("slice height " + std::to_string(height) + " is outside the view space (" + std::to_string(b.lo.z) +
+                " to " + std::to_string(b.hi.z) + ")");
+  if (width < 16 || width > 16384) throw Error("slice width must be between 16 and 16384 pixels");
+  const double scale = width / (b.hi.x - b.lo.x);
+  const int h = std::max(16, static_cast<int>(std::ceil((b.hi.y - b.lo.y) * scale)));
+  const double max_cost = max_leaf_cost(s);
+  std::vector<int32_t> leaf(static_cast<size_t>(width) * h);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < width; ++x)
+      leaf[static_cast<size_t>(y) * width + x] =
+          s.locate({b.lo.x + (x + 0.5) / scale, b.hi.y - (y + 0.5) / scale, height});
+  std::vector<unsigned char> rgb(static_cast<size_t>(width) * h * 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < width; ++x) {
+      const size_t i = static_cast<size_t>(y) * width + x;
+      unsigned char* px = &rgb[3 * i];
+      const int32_t l = leaf[i];
+      cost_colour(l >= 0 ? s.nodes[l].pvs_cost / max_cost : 0.0, px);
+      const bool border = (x + 1 < width && leaf[i + 1] != l) || (y + 1 < h && leaf[i + width] != l);
+      if (border)
+        for (int c = 0; c < 3; ++c) px[c] = static_cast<unsigned char>(px[c] / 3);
+    }
+  if (scene) {
+    // The scene's cross-section: where triangles cross z = height, drawn in black.
+    auto plot = [&](double wx, double wy) {
+      const int x = static_cast<int>((wx - b.lo.x) * scale), y = static_cast<int>((b.hi.y - wy) * scale);
+      if (x >= 0 && x < width && y >= 0 && y < h) std::memset(&rgb[3 * (static_cast<size_t>(y) * width + x)], 0, 3);
+    };
+    for (const auto& tri : scene->triangles) {
+      Vec3 pts[2];
+      int k = 0;
+      for (int e = 0; e < 3 && k < 2; ++e) {
+        const Vec3 p = scene->vertices[tri[e]], q = scene->vertices[tri[(e + 1) % 3]];
+        if ((p.z - height) * (q.z - height) < 0) pts[k++] = p + (q - p) * ((height - p.z) / (q.z - p.z));
+      }
+      if (k < 2) continue;
+      const double len = length(pts[1] - pts[0]) * scale;
+      const int steps = std::max(1, static_cast<int>(len * 2));
+      for (int i = 0; i <= steps; ++i) {
+        const Vec3 p = pts[0] + (pts[1] - pts[0]) * (static_cast<double>(i) / steps);
+        plot(p.x, p.y);
+      }
+    }
+  }
+  const std::string tmp = path + ".tmp";
+  FILE* fp = std::fopen(tmp.c_str(), "wb");
+  if (!fp) throw Error(path, 0, "cannot open for writing");
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!png || !info || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    std::fclose(fp);
+    std::remove(tmp.c_str());
+    throw Error(path, 0, "PNG encoding failed");
+  }
+  png_init_io(png, fp);
+  png_set_IHDR(png, info, width, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int y = 0; y < h; ++y) png_write_row(png, &rgb[3 * static_cast<size_t>(y) * width]);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  if (std::fclose(fp) != 0 || std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    throw Error(path, 0, "cannot write PNG");
+  }
+}
+
+}  // namespace viewcells
