@@ -3,6 +3,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <map>
 
 #include "support/test_scenes.h"
@@ -11,6 +12,7 @@
 #include "viewcells/core/rng.h"
 #include "viewcells/bsp/adjacency.h"
 #include "viewcells/bsp/subdivision.h"
+#include "viewcells/bsp/subdivision_io.h"
 #include "viewcells/sampling/sampler.h"
 #include "viewcells/scene/generators.h"
 
@@ -285,6 +287,90 @@ TEST(Subdivision, BadInput) {
   segs.push_back({0, 0, 0}, {1, 1, 1}, 99, kNoObject, 0, kNoObject);
   EXPECT_THROW(build(scene, segs, 10), Error);
   EXPECT_THROW(per_object_costs(scene, CostModel{100, 1, 0.5}), Error);
+}
+
+}  // namespace
+}  // namespace viewcells
+
+namespace viewcells {
+namespace {
+
+TEST(SubdivisionFile, RoundTripAndReplay) {
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 2, 1});
+  const SegmentSet segs = sample(scene, 15000);
+  const Subdivision s = build(scene, segs, 60);
+  SubdivisionFile file;
+  file.subdivision = s;
+  file.leaf_pvs = leaf_pvs(s, segs);
+  file.scene_fingerprint = scene.fingerprint();
+  file.object_count = static_cast<uint32_t>(scene.object_count());
+  const std::string path = test::temp_path("level.vcells");
+  write_subdivision(path, file);
+  SubdivisionFile back = read_subdivision(path);
+  Subdivision& r = back.subdivision;
+  ASSERT_EQ(r.nodes.size(), s.nodes.size());
+  ASSERT_EQ(r.splits.size(), s.splits.size());
+  EXPECT_EQ(back.leaf_pvs, file.leaf_pvs);
+  EXPECT_EQ(back.scene_fingerprint, scene.fingerprint());
+  EXPECT_EQ(r.cost(), s.cost());
+  for (size_t n = 0; n < s.nodes.size(); ++n) {
+    EXPECT_EQ(r.nodes[n].volume, s.nodes[n].volume);
+    EXPECT_EQ(r.nodes[n].plane, s.nodes[n].plane);
+  }
+  // Replaying the splits rebuilds the same cells, so the same volumes and the same locations.
+  rebuild_cells(r);
+  for (int32_t l : r.leaves()) EXPECT_NEAR(r.cells[l].volume() / s.nodes[l].volume, 1.0, 1e-12);
+  Rng rng(4);
+  for (int k = 0; k < 500; ++k) {
+    const Vec3 p{rng.uniform(s.view_box.lo.x, s.view_box.hi.x), rng.uniform(s.view_box.lo.y, s.view_box.hi.y),
+                 rng.uniform(s.view_box.lo.z, s.view_box.hi.z)};
+    EXPECT_EQ(r.locate(p), s.locate(p));
+  }
+  // Every leaf's PVS holds the objects of its segments.
+  for (int32_t l : s.leaves())
+    for (uint32_t i : s.segments[l])
+      if (segs.object_a[i] != kNoObject)
+        EXPECT_TRUE(std::binary_search(back.leaf_pvs[l].begin(), back.leaf_pvs[l].end(), segs.object_a[i]));
+  // Views of the cells can be written.
+  write_cells_ply(test::temp_path("cells.ply"), r);
+  write_slice_png(test::temp_path("slice.png"), r, 1.5, 256, &scene);
+  EXPECT_THROW(write_slice_png(test::temp_path("bad.png"), r, 1e9, 256), Error);
+}
+
+TEST(SubdivisionFile, CorruptFilesAreRejected) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 2, 1});
+  const SegmentSet segs = sample(scene, 5000);
+  SubdivisionFile file;
+  file.subdivision = build(scene, segs, 20);
+  file.leaf_pvs = leaf_pvs(file.subdivision, segs);
+  file.object_count = static_cast<uint32_t>(scene.object_count());
+  const std::string path = test::temp_path("good.vcells");
+  write_subdivision(path, file);
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string truncated = test::temp_path("truncated.vcells");
+  test::write_file(truncated, bytes.substr(0, bytes.size() / 2));
+  EXPECT_THROW(read_subdivision(truncated), Error);
+  std::string flipped = bytes;
+  flipped[bytes.size() - 5] ^= 0x40;
+  const std::string flipped_path = test::temp_path("flipped.vcells");
+  test::write_file(flipped_path, flipped);
+  EXPECT_THROW(read_subdivision(flipped_path), Error);
+  // A well-formed file whose tree is inconsistent (checksum recomputed by writing it).
+  SubdivisionFile bad = file;
+  bad.subdivision.splits[3].node = 40;
+  const std::string bad_path = test::temp_path("bad_tree.vcells");
+  write_subdivision(bad_path, bad);
+  try {
+    read_subdivision(bad_path);
+    FAIL();
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("split 3"), std::string::npos) << e.what();
+  }
+  bad = file;
+  bad.object_count = 1;
+  write_subdivision(bad_path, bad);
+  EXPECT_THROW(read_subdivision(bad_path), Error);
 }
 
 }  // namespace

@@ -27,7 +27,7 @@ json_get() { python3 -c "import json,sys; d=json.load(open('$1')); print(eval('d
 
 # --help explains every subcommand.
 expect_ok "$VC" --help
-for sub in generate info sample; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
+for sub in generate info sample build export; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
 expect_ok "$VC" sample --help
 grep -q -- "--measure-raw" out.txt && ok || bad "sample --help lacks --measure-raw"
 
@@ -79,6 +79,34 @@ expect_error "view-box" "$VC" sample office.obj --view-box 1,2,3
 expect_error "min < max" "$VC" sample office.obj --view-box 0,0,0,1,1,0
 expect_error "empty-space" "$VC" sample office.obj --empty-space maybe
 expect_error "samples" "$VC" sample office.obj --samples 0
+
+# build -> export: cells, report, mesh, slice; the reloaded hierarchy gives the same slice.
+expect_ok "$VC" build office.obj --samples 30000 --max-cells 64 -o office.vcells --report build.json \
+  --mesh cells.ply --slice-png slice.png --slice-z 1.5 -q
+for f in office.vcells cells.ply slice.png; do [ -s "$f" ] && ok || bad "build did not write $f"; done
+head -c 8 slice.png | od -c | grep -q "P   N   G" && ok || bad "slice.png is not a PNG"
+head -n 1 cells.ply | grep -q "^ply" && ok || bad "cells.ply is not a PLY"
+[ "$(json_get build.json "['subdivision']['cells']")" = "64" ] && ok || bad "build should give 64 cells"
+python3 -c "
+import json; r=json.load(open('build.json')); s=r['subdivision']
+assert r['final_cost'] < s['initial_cost'], 'the cost must drop'
+c=[p['cost'] for p in s['cost_at_power_of_two_cells']]
+assert all(b <= a for a, b in zip(c, c[1:])), 'cost must not increase with cells'
+assert [p['cells'] for p in s['cost_at_power_of_two_cells']] == [1, 2, 4, 8, 16, 32, 64]
+assert r['effects']['geometry_aligned_candidates']['enabled'] is False
+assert s['axis_candidates_evaluated'] > 0 and s['geometry_candidates_evaluated'] == 0
+for k in ['load_seconds', 'sampling_seconds', 'subdivision_seconds', 'write_seconds']: assert k in r['timings'], k
+" && ok || bad "build report"
+expect_ok "$VC" export office.vcells --slice-png slice2.png --slice-z 1.5 --scene office.obj -q
+cmp -s slice.png slice2.png && ok || bad "the reloaded hierarchy gives another slice"
+expect_ok "$VC" build rotated.obj --samples 20000 --max-cells 32 --report rot.json -q
+[ "$(json_get rot.json "['effects']['geometry_aligned_candidates']['enabled']")" = "True" ] && ok || bad "GA should be on for the rotated office"
+expect_ok "$VC" build rotated.obj --samples 20000 --max-cells 32 --no-ga --report rot_aa.json -q
+[ "$(json_get rot_aa.json "['subdivision']['geometry_candidates_evaluated']")" = "0" ] && ok || bad "--no-ga"
+head -c 100 office.vcells > cut.vcells
+expect_error "cut.vcells" "$VC" export cut.vcells --mesh x.ply
+expect_error "nothing to export" "$VC" export office.vcells
+expect_error "outside the view space" "$VC" export office.vcells --slice-png x.png --slice-z 1000
 
 # A failing run leaves what was already written untouched.
 cp a.vseg keep.vseg
