@@ -29,7 +29,8 @@ using nlohmann::json;
 json to_json(const Vec3& v) { return json::array({v.x, v.y, v.z}); }
 json to_json(const Box3& b) { return {{"min", to_json(b.lo)}, {"max", to_json(b.hi)}}; }
 
-Box3 parse_box(const std::string& text) {
+/// Comma-separated numbers of option `option`; throws Error naming the option.
+std::vector<double> parse_numbers(const std::string& text, const std::string& option) {
   std::vector<double> v;
   std::stringstream ss(text);
   std::string item;
@@ -39,12 +40,17 @@ Box3 parse_box(const std::string& text) {
       v.push_back(std::stod(item, &used));
       if (used != item.size()) throw std::invalid_argument(item);
     } catch (const std::exception&) {
-      throw Error("--view-box: '" + item + "' is not a number");
+      throw Error(option + ": '" + item + "' is not a number");
     }
+    if (!std::isfinite(v.back())) throw Error(option + ": '" + item + "' is not finite");
   }
+  return v;
+}
+
+Box3 parse_box(const std::string& text) {
+  const std::vector<double> v = parse_numbers(text, "--view-box");
   if (v.size() != 6) throw Error("--view-box needs six numbers: xmin,ymin,zmin,xmax,ymax,zmax");
   Box3 b{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
-  if (!is_finite(b.lo) || !is_finite(b.hi)) throw Error("--view-box has non-finite coordinates");
   if (!(b.volume() > 0)) throw Error("--view-box must have min < max on every axis");
   return b;
 }
@@ -347,7 +353,21 @@ struct BuildArgs {
   double cost_a = 100, cost_b = 1;
   double slice_z = NAN;
   int slice_width = 1024;
+  std::string density_band;
 };
+
+HeightBandDensity parse_density_band(const std::string& text) {
+  HeightBandDensity d;
+  if (text.empty()) return d;
+  const std::vector<double> v = parse_numbers(text, "--density-band");
+  if (v.size() < 2 || v.size() > 3) throw Error("--density-band needs zlo,zhi[,outside_weight]");
+  d.enabled = true;
+  d.lo = v[0];
+  d.hi = v[1];
+  if (v.size() == 3) d.outside = v[2];
+  if (!(d.lo < d.hi) || !(d.outside >= 0)) throw Error("--density-band needs zlo < zhi and outside_weight >= 0");
+  return d;
+}
 
 void write_views(const Subdivision& s, const Scene* scene, const std::string& mesh, const std::string& png,
                  double slice_z, int width, const Common& c) {
@@ -374,6 +394,7 @@ int run_build(const SampleArgs& a, const BuildArgs& b, const Common& c) {
   config.ga_candidates = b.ga_candidates;
   config.max_axis_candidates = b.axis_candidates;
   config.min_reduction = b.min_reduction;
+  config.density = parse_density_band(b.density_band);
   config.seed = a.seed;
   config.show_progress = !c.quiet;
   std::string ga_reason;
@@ -412,7 +433,12 @@ int run_build(const SampleArgs& a, const BuildArgs& b, const Common& c) {
   report["effects"]["geometry_aligned_candidates"] = {{"enabled", sub.stats.geometry_aligned},
                                                       {"reason", sub.stats.geometry_aligned_reason}};
   report["effects"]["pixel_cost_term"] = {{"enabled", false}, {"reason", "c = 0: r(o) = max(a, b * triangles)"}};
-  report["effects"]["viewpoint_density"] = {{"enabled", false}, {"reason", "uniform: p(i) = V_i / V"}};
+  report["effects"]["viewpoint_density"] =
+      config.density.enabled
+          ? json{{"enabled", true},
+                 {"reason", "--density-band: weight 1 for " + fmt(config.density.lo, 2) + " <= z <= " +
+                                fmt(config.density.hi, 2) + ", " + fmt(config.density.outside, 3) + " elsewhere"}}
+          : json{{"enabled", false}, {"reason", "uniform: p(i) = V_i / V (no --density-band)"}};
   json curve = json::array();
   for (size_t cells = 1; cells <= sub.leaf_count(); cells *= 2)
     curve.push_back({{"cells", cells}, {"cost", cells == 1 ? sub.initial_cost : sub.splits[cells - 2].cost_after}});
@@ -515,6 +541,8 @@ int run(int argc, char** argv) {
   bc->add_option("--cost-a", bld.cost_a, "Render cost model: minimum cost of an object (r = max(a, b * triangles))")
       ->capture_default_str();
   bc->add_option("--cost-b", bld.cost_b, "Render cost model: cost per triangle")->capture_default_str();
+  bc->add_option("--density-band", bld.density_band,
+                 "Viewpoint density zlo,zhi[,outside]: weight 1 between the heights, outside (default 0.1) elsewhere");
   bc->add_option("-o,--output", bld.output, "Hierarchy file to write (.vcells)");
   bc->add_option("--report", bld.report, "JSON report: settings, effects and why, costs, candidates, timings");
   bc->add_option("--mesh", bld.mesh, "Also write the cells as a PLY coloured by render cost");

@@ -55,16 +55,5 @@ for r in rows:
     print(f"| {r[0]} | {r[1]:,} | {r[2]:,.0f} | {r[3]:,.0f} | {r[4]:.3f} | {r[5]:.2f} | {r[6]:.2f} | {r[7]:.2f} | {r[8]:.3f} | {r[9]:.3f} |")
 PY
 
-# Replace the section between the markers in BENCHMARKS.md.
-python3 - "$dir/sampling-table.md" "$size" <<'PY'
-import re, sys
-table = open(sys.argv[1]).read()
-size = sys.argv[2]
-path = "BENCHMARKS.md"
-text = open(path).read()
-begin, end = "<!-- sampling:begin -->", "<!-- sampling:end -->"
-block = f"{begin}\nCommand: `scripts/bench-sampling.sh {size}`\n\n{table}{end}"
-text = re.sub(re.escape(begin) + ".*?" + re.escape(end), lambda m: block, text, flags=re.S)
-open(path, "w").write(text)
-PY
+python3 scripts/replace-section.py BENCHMARKS.md sampling "scripts/bench-sampling.sh $size" "$dir/sampling-table.md"
 cat "$dir/sampling-table.md"

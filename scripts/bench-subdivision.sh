@@ -32,14 +32,5 @@ ts = {n: json.load(open(f"{d}/build-{n}.json"))["timings"]["subdivision_seconds"
 print(f"\nSubdivision time ratios: 1M / 0.5M = {ts[1000000] / ts[500000]:.2f}, 2M / 1M = {ts[2000000] / ts[1000000]:.2f} "
       "(2.0 would be linear in the number of segments).")
 PY
-python3 - "$dir/subdivision-table.md" "$size" "$cells" <<'PY'
-import re, sys
-table = open(sys.argv[1]).read()
-path = "BENCHMARKS.md"
-text = open(path).read()
-begin, end = "<!-- subdivision:begin -->", "<!-- subdivision:end -->"
-block = f"{begin}\nCommand: `scripts/bench-subdivision.sh {sys.argv[2]} {sys.argv[3]}`\n\n{table}{end}"
-text = re.sub(re.escape(begin) + ".*?" + re.escape(end), lambda m: block, text, flags=re.S)
-open(path, "w").write(text)
-PY
+python3 scripts/replace-section.py BENCHMARKS.md subdivision "scripts/bench-subdivision.sh $size $cells" "$dir/subdivision-table.md"
 cat "$dir/subdivision-table.md"

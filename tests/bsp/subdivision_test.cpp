@@ -174,6 +174,37 @@ TEST(Subdivision, IdenticalForOneAndTwoThreads) {
   for (size_t p = 0; p < one.planes.size(); ++p) EXPECT_EQ(one.planes[p].offset, two.planes[p].offset);
 }
 
+TEST(Subdivision, ViewpointDensityConcentratesCellsInTheBand) {
+  // A two-storey office; viewpoints mostly at eye height on the ground floor.
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 4});
+  const SegmentSet segs = sample(scene, 30000);
+  SubdivisionConfig config;
+  config.max_cells = 150;
+  config.show_progress = false;
+  const std::vector<double> r = per_object_costs(scene, CostModel{});
+  const Subdivision uniform = subdivide(scene, segs, r, config);
+  config.density = {true, 1.0, 2.0, 0.01};
+  const Subdivision banded = subdivide(scene, segs, r, config);
+  expect_invariants(scene, segs, banded);
+  // Weights: children add up; the root's weight is the band's volume plus 1% of the rest.
+  for (const BspNode& n : banded.nodes)
+    if (n.plane >= 0)
+      EXPECT_NEAR((banded.nodes[n.child[0]].weight + banded.nodes[n.child[1]].weight) / n.weight, 1.0, 1e-9);
+  const Box3 b = banded.view_box;
+  const double band = (b.hi.x - b.lo.x) * (b.hi.y - b.lo.y) * 1.0;
+  EXPECT_NEAR(banded.nodes[0].weight, band + 0.01 * (b.volume() - band), 1e-9 * b.volume());
+  auto cells_touching_band = [](const Subdivision& s) {
+    int n = 0;
+    for (int32_t l : s.leaves()) {
+      const Box3 c = s.cells[l].bounds();
+      n += c.lo.z < 2.0 && c.hi.z > 1.0;
+    }
+    return n;
+  };
+  EXPECT_GT(cells_touching_band(banded), cells_touching_band(uniform) + 20)
+      << "cells gather where the viewpoints are";
+}
+
 TEST(Subdivision, ReplayGivesEveryCellCount) {
   const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
   const Subdivision s = build(scene, sample(scene, 10000), 40);
@@ -183,7 +214,7 @@ TEST(Subdivision, ReplayGivesEveryCellCount) {
     double volume = 0, cost = 0;
     for (int32_t n : leaves) {
       volume += s.nodes[n].volume;
-      cost += s.nodes[n].volume / s.view_box.volume() * s.nodes[n].pvs_cost;
+      cost += s.nodes[n].weight / s.nodes[0].weight * s.nodes[n].pvs_cost;
     }
     EXPECT_NEAR(volume / s.view_box.volume(), 1.0, 1e-9);
     EXPECT_NEAR(cost, k ? s.splits[k - 1].cost_after : s.initial_cost, 1e-9 * s.initial_cost);

@@ -38,10 +38,37 @@ std::vector<int32_t> Subdivision::leaves_after(size_t k) const {
 }
 
 double Subdivision::cost() const {
-  const double v = view_box.volume();
+  const double w = nodes[0].weight;
   double c = 0;
-  for (int32_t n : leaves()) c += nodes[n].volume / v * nodes[n].pvs_cost;
+  for (int32_t n : leaves()) c += nodes[n].weight / w * nodes[n].pvs_cost;
   return c;
+}
+
+ConvexPolyhedron HeightBandDensity::band_part(const ConvexPolyhedron& cell) const {
+  ConvexPolyhedron part = cell;
+  const Box3 b = cell.bounds();
+  if (b.hi.z <= lo || b.lo.z >= hi) return ConvexPolyhedron();
+  if (b.lo.z < lo)
+    if (auto halves = part.split(Plane::axis_aligned(2, lo), -1)) part = std::move(halves->second);
+  if (b.hi.z > hi)
+    if (auto halves = part.split(Plane::axis_aligned(2, hi), -1)) part = std::move(halves->first);
+  return part;
+}
+
+double HeightBandDensity::weight(const ConvexPolyhedron& cell) const {
+  const double v = cell.volume();
+  if (!enabled) return v;
+  const ConvexPolyhedron part = band_part(cell);
+  const double in_band = part.empty() ? 0.0 : part.volume();
+  return outside * (v - in_band) + in_band;
+}
+
+double HeightBandDensity::weight_below(const ConvexPolyhedron& cell, const ConvexPolyhedron& part,
+                                       const Plane& plane) const {
+  const double v = cell.volume_below(plane);
+  if (!enabled) return v;
+  const double in_band = part.empty() ? 0.0 : part.volume_below(plane);
+  return outside * (v - in_band) + in_band;
 }
 
 int32_t Subdivision::locate(const Vec3& p) const {
@@ -135,6 +162,8 @@ class Builder {
     std::vector<SegRef> refs(segs_.size());
     for (uint32_t i = 0; i < segs_.size(); ++i) refs[i] = {i, 0.0, 1.0};
     add_node(-1, std::move(root), std::move(refs));
+    total_weight_ = out_.nodes[0].weight;
+    if (!(total_weight_ > 0)) throw Error("the viewpoint density is zero everywhere in the view space");
     out_.initial_cost = node_cost(0);
     double cost = out_.initial_cost;
 
@@ -191,7 +220,7 @@ class Builder {
   }
 
  private:
-  double node_cost(int32_t n) const { return out_.nodes[n].volume / total_volume_ * out_.nodes[n].pvs_cost; }
+  double node_cost(int32_t n) const { return out_.nodes[n].weight / total_weight_ * out_.nodes[n].pvs_cost; }
   double priority(int32_t n) const { return best_[n].reduction + 0.01 * node_cost(n); }
 
   double pvs_cost(const std::vector<SegRef>& refs) {
@@ -206,6 +235,7 @@ class Builder {
     BspNode node;
     node.parent = parent;
     node.volume = cell.volume();
+    node.weight = config_.density.weight(cell);
     node.pvs_cost = pvs_cost(refs);
     out_.nodes.push_back(node);
     out_.cells.push_back(std::move(cell));
@@ -344,15 +374,26 @@ class Builder {
       right[j] = cost;
     }
     const double own = node_cost(node);
-    const double volume = out_.nodes[node].volume;
+    const double volume = out_.nodes[node].volume, weight = out_.nodes[node].weight;
+    const HeightBandDensity& density = config_.density;
     const bool box = cell.is_box(out_.planes);
+    // Boxes: weights are linear along x and y, and piecewise linear along z.
+    auto box_weight_below = [&](double x) {
+      const double frac = (x - lo_b) / (hi_b - lo_b);
+      if (!density.enabled || axis != 2) return weight * frac;
+      const double area = volume / (hi_b - lo_b);
+      const double in_band = std::max(0.0, std::min(x, density.hi) - std::max(lo_b, density.lo));
+      return area * (density.outside * ((x - lo_b) - in_band) + in_band);
+    };
+    const ConvexPolyhedron part = (!box && density.enabled) ? density.band_part(cell) : ConvexPolyhedron();
     Candidate best;
     for (size_t j = 0; j < k; ++j) {
       const Plane plane = Plane::axis_aligned(axis, positions[j]);
       const double vl = box ? volume * (positions[j] - lo_b) / (hi_b - lo_b) : cell.volume_below(plane);
-      const double vr = volume - vl;
-      if (!(vl > 0 && vr > 0)) continue;
-      const double reduction = own - (vl * left[j] + vr * right[j]) / total_volume_;
+      if (!(vl > 0 && volume - vl > 0)) continue;
+      const double wl = box ? box_weight_below(positions[j]) : density.weight_below(cell, part, plane);
+      const double wr = weight - wl;
+      const double reduction = own - (wl * left[j] + wr * right[j]) / total_weight_;
       if (!best.valid || reduction > best.reduction) best = {true, plane, reduction};
     }
     __atomic_add_fetch(&ev.axis, k, __ATOMIC_RELAXED);
@@ -394,8 +435,9 @@ class Builder {
       planes.resize(config_.ga_candidates);
     }
     const double own = node_cost(node);
-    const double volume = out_.nodes[node].volume;
+    const double volume = out_.nodes[node].volume, weight = out_.nodes[node].weight;
     const ConvexPolyhedron& cell = out_.cells[node];
+    const ConvexPolyhedron part = config_.density.enabled ? config_.density.band_part(cell) : ConvexPolyhedron();
     Marks& neg = marks_.local();
     Marks pos;  // a second set of marks for the positive side
     Candidate best;
@@ -412,7 +454,8 @@ class Builder {
         if (to & 1) cl += neg.add(segs_.object_a[s.id], r_) + neg.add(segs_.object_b[s.id], r_);
         if (to & 2) cr += pos.add(segs_.object_a[s.id], r_) + pos.add(segs_.object_b[s.id], r_);
       }
-      const double reduction = own - (vl * cl + vr * cr) / total_volume_;
+      const double wl = config_.density.enabled ? config_.density.weight_below(cell, part, plane) : vl;
+      const double reduction = own - (wl * cl + (weight - wl) * cr) / total_weight_;
       if (!best.valid || reduction > best.reduction) best = {true, plane, reduction};
     }
     __atomic_add_fetch(&ev.geometry, planes.size(), __ATOMIC_RELAXED);
@@ -425,6 +468,7 @@ class Builder {
   const SubdivisionConfig& config_;
   Subdivision& out_;
   double total_volume_;
+  double total_weight_ = 0;
   bool ga_ = false;
   std::vector<std::vector<SegRef>> refs_;
   std::vector<Candidate> best_;
@@ -438,6 +482,9 @@ Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const std:
                       const SubdivisionConfig& config) {
   if (object_costs.size() != scene.objects.size()) throw Error("object costs do not match the scene");
   if (config.max_cells < 1) throw Error("the maximum number of cells must be at least 1");
+  if (config.density.enabled &&
+      !(config.density.lo < config.density.hi && config.density.outside >= 0 && std::isfinite(config.density.outside)))
+    throw Error("viewpoint density band needs lo < hi and a finite, non-negative outside weight");
   for (size_t i = 0; i < segments.size(); ++i)
     for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
       if (o != kNoObject && o >= scene.objects.size())

@@ -56,6 +56,7 @@ void write_subdivision(const std::string& path, const SubdivisionFile& f) {
     w.put<int32_t>(n.child[1]);
     w.put<int32_t>(n.parent);
     w.put(n.volume);
+    w.put(n.weight);
     w.put(n.pvs_cost);
   }
   w.put<uint64_t>(s.splits.size());
@@ -103,6 +104,7 @@ SubdivisionFile read_subdivision(const std::string& path) {
     n.child[1] = r.get<int32_t>();
     n.parent = r.get<int32_t>();
     n.volume = r.get<double>();
+    n.weight = r.get<double>();
     n.pvs_cost = r.get<double>();
   }
   const uint64_t splits = r.get<uint64_t>();
@@ -130,7 +132,7 @@ SubdivisionFile read_subdivision(const std::string& path) {
   }
   for (int32_t i = 0; i < n_nodes; ++i) {
     const BspNode& n = s.nodes[i];
-    if (n.plane >= static_cast<int32_t>(planes) || !(n.volume > 0) || !(n.pvs_cost >= 0))
+    if (n.plane >= static_cast<int32_t>(planes) || !(n.volume > 0) || !(n.weight >= 0) || !(n.pvs_cost >= 0))
       r.fail("node " + std::to_string(i) + " is invalid");
     if (n.plane < 0 && (n.child[0] != -1 || n.child[1] != -1)) r.fail("leaf " + std::to_string(i) + " has children");
     for (uint32_t o : f.leaf_pvs[i])
@@ -138,6 +140,7 @@ SubdivisionFile read_subdivision(const std::string& path) {
     if (!std::is_sorted(f.leaf_pvs[i].begin(), f.leaf_pvs[i].end())) r.fail("unsorted PVS");
   }
   if (planes != 6 + splits) r.fail("plane count does not match the split count");
+  if (!(s.nodes[0].weight > 0)) r.fail("the view space has zero weight");
   return f;
 }
 

@@ -20,6 +20,22 @@ namespace viewcells {
 
 enum class GeometryAlignedMode { kAuto, kOn, kOff };
 
+/// Optional viewpoint density (paper, section 3.3): weight 1 for viewpoints whose height lies
+/// in [lo, hi] (where players walk, say), `outside` (>= 0) elsewhere. Then
+/// p(i) = integral of the density over cell i / integral over the view space.
+struct HeightBandDensity {
+  bool enabled = false;
+  double lo = 0, hi = 0;
+  double outside = 0.1;
+  /// Integral of the density over a convex cell (its volume when disabled).
+  double weight(const ConvexPolyhedron& cell) const;
+  /// Integral of the density over the negative side of `plane` within `cell`; `band_part` is
+  /// the cell clipped to the band (see band_part()).
+  double weight_below(const ConvexPolyhedron& cell, const ConvexPolyhedron& band_part, const Plane& plane) const;
+  /// The part of `cell` with lo <= z <= hi (empty if none).
+  ConvexPolyhedron band_part(const ConvexPolyhedron& cell) const;
+};
+
 struct SubdivisionConfig {
   uint32_t max_cells = 1000;           ///< stop at this many leaves
   uint32_t max_axis_candidates = 200;  ///< positions per axis (a random subset of segment ends beyond)
@@ -34,6 +50,7 @@ struct SubdivisionConfig {
   uint32_t stagnation_steps = 50;
   uint64_t seed = 1;
   bool show_progress = true;
+  HeightBandDensity density;  ///< uniform (p(i) = V_i / V) unless enabled
 };
 
 struct BspNode {
@@ -41,6 +58,7 @@ struct BspNode {
   int32_t child[2] = {-1, -1};   ///< negative side, positive side
   int32_t parent = -1;
   double volume = 0;
+  double weight = 0;             ///< integral of the viewpoint density (= volume when uniform)
   double pvs_cost = 0;           ///< r(PVS) from the segments in the node
 };
 
@@ -73,7 +91,7 @@ struct Subdivision {
 
   size_t leaf_count() const { return splits.size() + 1; }
   std::vector<int32_t> leaves() const;
-  /// c(S) of the current leaves: sum of volume / V * r(PVS).
+  /// c(S) of the current leaves: sum of p(i) r(PVS_i), p(i) = weight_i / weight of the root.
   double cost() const;
   /// The leaf containing p (points on a plane go to its negative side); -1 outside the box.
   int32_t locate(const Vec3& p) const;
