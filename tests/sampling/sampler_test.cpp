@@ -281,6 +281,14 @@ TEST(Sampler, SegmentTargetIsAPrefixOfTheSampleStream) {
   config.target_segments = 10;
   config.max_samples = 20000;
   EXPECT_THROW(sample_segments(scene, *caster, config), Error);
+  // Without a sample cap it gives up after a million samples that saw nothing.
+  config.max_samples = SamplerConfig{}.max_samples;
+  try {
+    sample_segments(scene, *caster, config);
+    ADD_FAILURE() << "an unreachable target must throw";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("gave up after 1000448 samples"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Sampler, BadInput) {

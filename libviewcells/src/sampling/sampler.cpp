@@ -3,7 +3,11 @@
 #include "viewcells/sampling/sampler.h"
 
 #include <tbb/enumerable_thread_specific.h>
-#include <tbb/parallel_for.h>
+#include <tbb/parallel_pipeline.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <atomic>
 
 #include <cmath>
 
@@ -127,8 +131,8 @@ class BatchSampler {
         // rays, where the paper's forward-only shift gives one for three. The PVS of a cell
         // is a union, so what matters is which segments are found, not how often.
         out.two_sided += fwd_inside && bwd_inside;
-        if (fwd_inside) pending_.push_back({points_[i] + dirs_[i] * fwd.t, dirs_[i], fwd.object, fwd.triangle, 1});
-        if (bwd_inside) pending_.push_back({points_[i] - dirs_[i] * bwd.t, -dirs_[i], bwd.object, bwd.triangle, 1});
+        if (fwd_inside) recast_from(points_[i] + dirs_[i] * fwd.t, dirs_[i], fwd.object, fwd.triangle, 1, out);
+        if (bwd_inside) recast_from(points_[i] - dirs_[i] * bwd.t, -dirs_[i], bwd.object, bwd.triangle, 1, out);
         continue;
       }
       emit(points_[i], dirs_[i], bwd.hit() ? -bwd.t : -INFINITY, bwd.object, bwd.triangle,
@@ -153,7 +157,7 @@ class BatchSampler {
           if (p.depth >= max_recasts_) {
             ++out.stuck;
           } else {
-            next_.push_back({p.origin + p.dir * h.t, p.dir, h.object, h.triangle, p.depth + 1});
+            recast_from(p.origin + p.dir * h.t, p.dir, h.object, h.triangle, p.depth + 1, out);
           }
           continue;
         }
@@ -163,6 +167,18 @@ class BatchSampler {
       }
       pending_.swap(next_);
     }
+  }
+
+  /// Queues a re-cast from the exit point `origin` of a solid (into next_ while re-casting,
+  /// else pending_). An exit point outside the (convex) view box means the ray has left the
+  /// box for good, so the segment it would give has no length inside: not worth a ray.
+  void recast_from(const Vec3& origin, const Vec3& dir, uint32_t object, uint32_t triangle, int depth,
+                   BatchOutput& out) {
+    if (!box_.contains(origin, eps_)) {
+      ++out.outside;
+      return;
+    }
+    (depth == 1 ? pending_ : next_).push_back({origin, dir, object, triangle, depth});
   }
 
  private:
@@ -229,7 +245,9 @@ Box3 resolve_view_box(const Scene& scene, const SamplerConfig& config, bool& fro
 
 namespace {
 
-/// The sampler; `logs`, when given, receives every ray each batch cast (index: batch).
+/// The sampler; `logs`, when given, receives the rays of each batch in the output, in order.
+constexpr uint64_t kGiveUpSamples = 1'000'000;
+
 SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const SamplerConfig& config,
                            std::vector<std::vector<Ray>>* logs) {
   if (config.batch_size == 0) throw Error("batch size must be positive");
@@ -251,77 +269,78 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
   const bool show = config.show_progress;
   const auto start = std::chrono::steady_clock::now();
 
-  // Rounds of batches. With a sample count there is one round; with a segment target, rounds
-  // continue until the target is reached and the output is cut at the target-th segment in
-  // batch order, so it still does not depend on the thread count.
+  // A pipeline over the stream of batches: drawn in order, sampled in parallel, appended to
+  // the output in batch order. The output is therefore a prefix of the same stream for any
+  // thread count; with a segment target it is cut at the target-th segment and the stream
+  // stops there, so no more than the batches in flight are cast past the target. Each batch
+  // writes into scratch slots of its token, reused: the output is written once, densely.
+  const uint64_t limit = by_segments ? config.max_samples : config.samples;
+  const size_t slots = BatchSampler::segments_per_sample(stats.empty_space.enabled) * config.batch_size;
+  struct Token {
+    SegmentSet segments;
+    BatchOutput out;
+    uint64_t batch = 0;
+    size_t count = 0;
+    std::vector<Ray> log;
+  };
+  const size_t token_count = 4 * static_cast<size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+  std::vector<Token> tokens(token_count);
+  for (Token& t : tokens) t.segments.resize(slots);
+  // Room for the expected output (virtual until touched), capped: beyond it the arrays grow.
+  segs.reserve_for_output(std::min<uint64_t>(by_segments ? config.target_segments : config.samples, 1ull << 25));
   uint64_t next_batch = 0;
-  std::vector<BatchOutput> outputs;
-  bool done = false;
-  while (!done) {
-    uint64_t round_samples = config.samples;
-    if (by_segments) {
-      // A small first round measures the yield (segments per sample: below 1 where rays escape,
-      // above 1 where samples inside solids give two); later rounds ask for what is missing, so
-      // little work is cast past the target. Whole batches, so that the output is a prefix of
-      // what a large enough sample count gives.
-      const uint64_t remaining = config.target_segments - segs.size();
-      const uint64_t calibration = 32 * static_cast<uint64_t>(config.batch_size);
-      if (stats.samples == 0) {
-        round_samples = std::min<uint64_t>(remaining, calibration);
-      } else {
-        const double rate = std::max(0.02, double(stats.valid_segments) / stats.samples);
-        round_samples = static_cast<uint64_t>(remaining / rate);
-      }
-      round_samples = (round_samples / config.batch_size + 1) * config.batch_size;
-      if (stats.samples + round_samples > config.max_samples)
-        round_samples = config.max_samples > stats.samples ? config.max_samples - stats.samples : 0;
-      if (round_samples == 0)
-        throw Error("gave up after " + std::to_string(stats.samples) + " samples with only " +
-                    std::to_string(segs.size()) + " segments: do rays hit anything in this view box?");
-    }
-    const uint64_t batches = (round_samples + config.batch_size - 1) / config.batch_size;
-    outputs.assign(batches, BatchOutput{});
-    if (logs) logs->resize(next_batch + batches);
-    // Every batch owns slots for its worst case right after what earlier rounds produced; the
-    // arrays grow without being zeroed, so slots a batch leaves unused are never even touched.
-    const size_t slots = BatchSampler::segments_per_sample(stats.empty_space.enabled);
-    const size_t base = segs.size();
-    segs.grow_for_output(base + round_samples * slots);
-    tbb::parallel_for(tbb::blocked_range<uint64_t>(0, batches, 1), [&](const tbb::blocked_range<uint64_t>& r) {
-      BatchSampler& sampler = samplers.local();  // scratch buffers only: no effect on the output
-      for (uint64_t b = r.begin(); b < r.end(); ++b) {
-        const uint64_t first = b * config.batch_size;
-        const size_t count = std::min<uint64_t>(config.batch_size, round_samples - first);
-        outputs[b].first = base + first * slots;
-        sampler.run(config.seed, next_batch + b, count, segs, outputs[b], logs ? &(*logs)[next_batch + b] : nullptr);
-        if (show) progress.advance(by_segments ? outputs[b].valid : count);
-      }
-    });
-    next_batch += batches;
-
-    // Compact in batch order: the output does not depend on which thread ran what. With a
-    // segment target, batches after the one that reaches it are dropped.
-    size_t valid = base;
-    for (uint64_t b = 0; b < batches && !done; ++b) {
-      BatchOutput& out = outputs[b];
-      if (by_segments && valid + out.valid >= config.target_segments) {
-        out.valid = config.target_segments - valid;  // the rest of this batch is dropped
-        done = true;
-      }
-      segs.move_range(out.first, out.valid, valid);
-      valid += out.valid;
-      stats.samples += std::min<uint64_t>(config.batch_size, round_samples - b * config.batch_size);
-      stats.rays += out.rays;
-      stats.recast_rays += out.recast_rays;
-      stats.missed_both += out.missed_both;
-      stats.stuck_in_solid += out.stuck;
-      stats.outside_view_box += out.outside;
-      stats.two_sided_samples += out.two_sided;
-    }
-    if (!by_segments) done = true;
-    segs.resize(valid);
-    stats.valid_segments = valid;
-  }
+  bool done = false;      // the target is reached (output stage only)
+  bool finished = false;  // nothing more goes into the output (output stage only)
+  std::atomic<bool> stop{false};
+  tbb::parallel_pipeline(
+      token_count,
+      tbb::make_filter<void, Token*>(tbb::filter_mode::serial_in_order,
+                                     [&](tbb::flow_control& fc) -> Token* {
+                                       const uint64_t first = next_batch * config.batch_size;
+                                       if (stop.load(std::memory_order_relaxed) || first >= limit) {
+                                         fc.stop();
+                                         return nullptr;
+                                       }
+                                       // In-flight batches are consecutive and at most token_count.
+                                       Token* t = &tokens[next_batch % token_count];
+                                       t->batch = next_batch++;
+                                       t->count = std::min<uint64_t>(config.batch_size, limit - first);
+                                       return t;
+                                     }) &
+          tbb::make_filter<Token*, Token*>(tbb::filter_mode::parallel,
+                                           [&](Token* t) {
+                                             t->out = BatchOutput{};
+                                             t->log.clear();
+                                             if (stop.load(std::memory_order_relaxed)) return t;
+                                             samplers.local().run(config.seed, t->batch, t->count, t->segments, t->out,
+                                                                  logs ? &t->log : nullptr);
+                                             return t;
+                                           }) &
+          tbb::make_filter<Token*, void>(tbb::filter_mode::serial_in_order, [&](Token* t) {
+            if (finished) return;  // in flight when the stream stopped: not part of the output
+            BatchOutput& out = t->out;
+            if (by_segments && segs.size() + out.valid >= config.target_segments) {
+              out.valid = config.target_segments - segs.size();  // the rest of this batch is dropped
+              done = finished = true;
+            }
+            segs.append(t->segments, 0, out.valid);
+            if (logs) logs->push_back(std::move(t->log));
+            stats.samples += t->count;
+            stats.rays += out.rays;
+            stats.recast_rays += out.recast_rays;
+            stats.missed_both += out.missed_both;
+            stats.stuck_in_solid += out.stuck;
+            stats.outside_view_box += out.outside;
+            stats.two_sided_samples += out.two_sided;
+            if (show) progress.advance(by_segments ? out.valid : t->count);
+            // Nothing seen after a million samples: the target is out of reach, say so now.
+            if (by_segments && segs.size() == 0 && stats.samples >= kGiveUpSamples) finished = true;
+            if (finished) stop.store(true, std::memory_order_relaxed);
+          }));
+  stats.valid_segments = segs.size();
+  if (by_segments && !done)
+    throw Error("gave up after " + std::to_string(stats.samples) + " samples with only " +
+                std::to_string(segs.size()) + " segments: do rays hit anything in this view box?");
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (show) progress.finish();
 

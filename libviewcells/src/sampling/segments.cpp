@@ -21,7 +21,7 @@ void SegmentSet::resize(size_t n) {
   for (auto* v : {&object_a, &object_b, &triangle_a, &triangle_b}) v->resize(n);
 }
 
-void SegmentSet::grow_for_output(size_t n) {
+void SegmentSet::reserve_for_output(size_t n) {
   reserve(n);
 #ifdef __linux__
   // Ask for transparent huge pages before the arrays are touched: a few hundred faults of
@@ -34,7 +34,6 @@ void SegmentSet::grow_for_output(size_t n) {
   for (auto* v : {&ax, &ay, &az, &bx, &by, &bz}) advise(v->data(), sizeof(double));
   for (auto* v : {&object_a, &object_b, &triangle_a, &triangle_b}) advise(v->data(), sizeof(uint32_t));
 #endif
-  resize(n);
 }
 
 void SegmentSet::push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob, uint32_t ta, uint32_t tb) {
@@ -50,8 +49,10 @@ void SegmentSet::push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t o
   triangle_b.push_back(tb);
 }
 
-void SegmentSet::append(const SegmentSet& o) {
-  auto add = [](auto& to, const auto& from) { to.insert(to.end(), from.begin(), from.end()); };
+void SegmentSet::append(const SegmentSet& o) { append(o, 0, o.size()); }
+
+void SegmentSet::append(const SegmentSet& o, size_t first, size_t n) {
+  auto add = [&](auto& to, const auto& from) { to.insert(to.end(), from.begin() + first, from.begin() + first + n); };
   add(ax, o.ax);
   add(ay, o.ay);
   add(az, o.az);
@@ -62,21 +63,6 @@ void SegmentSet::append(const SegmentSet& o) {
   add(object_b, o.object_b);
   add(triangle_a, o.triangle_a);
   add(triangle_b, o.triangle_b);
-}
-
-void SegmentSet::move_range(size_t from, size_t n, size_t to) {
-  if (from == to || n == 0) return;
-  auto move = [&](auto& v) { std::copy(v.begin() + from, v.begin() + from + n, v.begin() + to); };
-  move(ax);
-  move(ay);
-  move(az);
-  move(bx);
-  move(by);
-  move(bz);
-  move(object_a);
-  move(object_b);
-  move(triangle_a);
-  move(triangle_b);
 }
 
 bool SegmentSet::operator==(const SegmentSet& o) const {

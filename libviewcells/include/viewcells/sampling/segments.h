@@ -24,9 +24,9 @@ struct SegmentSet {
   Vec3 b(size_t i) const { return {bx[i], by[i], bz[i]}; }
   void reserve(size_t n);
   void resize(size_t n);
-  /// resize(n) for an output about to be written: on Linux, asks for transparent huge pages
-  /// first, which saves most page faults on arrays of hundreds of megabytes.
-  void grow_for_output(size_t n);
+  /// reserve(n) for an output about to be appended to: on Linux, also asks for transparent
+  /// huge pages, which saves most page faults on arrays of hundreds of megabytes.
+  void reserve_for_output(size_t n);
   void push_back(const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob, uint32_t ta = kNoObject,
                  uint32_t tb = kNoObject);
   void set(size_t i, const Vec3& a, const Vec3& b, uint32_t oa, uint32_t ob, uint32_t ta, uint32_t tb) {
@@ -36,8 +36,8 @@ struct SegmentSet {
   }
   /// Appends all of `o` (view boxes must match).
   void append(const SegmentSet& o);
-  /// Moves segments [from, from + n) to [to, to + n); to <= from (compaction).
-  void move_range(size_t from, size_t n, size_t to);
+  /// Appends segments [first, first + n) of `o`.
+  void append(const SegmentSet& o, size_t first, size_t n);
   bool operator==(const SegmentSet& o) const;
   /// Bytes used by the arrays.
   size_t memory_bytes() const { return size() * (6 * sizeof(double) + 4 * sizeof(uint32_t)); }
