@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Sampling benchmark (issue: foundation): a generated city of >= 1M triangles, 1M segments,
 # segments per second against half the raw Embree rays per second measured in the same run.
-# Three runs per configuration; the table shows medians. Rewrites the sampling section of
+# Five runs per configuration by default; the table shows medians. Rewrites the sampling section of
 # BENCHMARKS.md. Usage: scripts/bench-sampling.sh [CITY_SIZE] [RUNS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 size="${1:-23}"
-runs="${2:-3}"
+runs="${2:-5}"
 bash scripts/install-deps.sh >/dev/null
 bash scripts/build.sh build-release Release -DVIEWCELLS_BUILD_TESTS=OFF -DVIEWCELLS_BUILD_BENCH=ON
 vc=build-release/cli/viewcells
@@ -55,5 +55,5 @@ for r in rows:
     print(f"| {r[0]} | {r[1]:,} | {r[2]:,.0f} | {r[3]:,.0f} | {r[4]:.3f} | {r[5]:.2f} | {r[6]:.2f} | {r[7]:.2f} | {r[8]:.3f} | {r[9]:.3f} |")
 PY
 
-python3 scripts/replace-section.py BENCHMARKS.md sampling "scripts/bench-sampling.sh $size" "$dir/sampling-table.md"
+python3 scripts/replace-section.py BENCHMARKS.md sampling "scripts/bench-sampling.sh $size $runs" "$dir/sampling-table.md"
 cat "$dir/sampling-table.md"
