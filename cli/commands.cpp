@@ -350,11 +350,22 @@ struct BuildArgs {
   uint32_t ga_candidates = 150;
   uint32_t axis_candidates = 200;
   double min_reduction = 1e-6;
-  double cost_a = 100, cost_b = 1;
+  double cost_a = 100, cost_b = 1, cost_c = 0;
+  std::string screen = "1024x768";
+  double fov = 90;
   double slice_z = NAN;
   int slice_width = 1024;
   std::string density_band;
 };
+
+void parse_screen(const std::string& text, CostModel& model) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
+    throw Error("--screen needs WIDTHxHEIGHT, e.g. 1024x768 (got '" + text + "')");
+  model.screen_width = w;
+  model.screen_height = h;
+}
 
 HeightBandDensity parse_density_band(const std::string& text) {
   HeightBandDensity d;
@@ -384,9 +395,15 @@ void write_views(const Subdivision& s, const Scene* scene, const std::string& me
 
 int run_build(const SampleArgs& a, const BuildArgs& b, const Common& c) {
   ThreadLimit threads(c.threads);
-  CostModel model{b.cost_a, b.cost_b, 0.0};
+  CostModel model;
+  model.a = b.cost_a;
+  model.b = b.cost_b;
+  model.c = b.cost_c;
+  parse_screen(b.screen, model);
+  model.fov_degrees = b.fov;
+  model.validate();  // before the sampling, not after
+  const HeightBandDensity density = parse_density_band(b.density_band);
   const Sampled s = load_and_sample(a, c, threads.threads());
-  const std::vector<double> r = per_object_costs(s.scene, model);
 
   SubdivisionConfig config;
   config.max_cells = b.max_cells;
@@ -394,14 +411,15 @@ int run_build(const SampleArgs& a, const BuildArgs& b, const Common& c) {
   config.ga_candidates = b.ga_candidates;
   config.max_axis_candidates = b.axis_candidates;
   config.min_reduction = b.min_reduction;
-  config.density = parse_density_band(b.density_band);
+  config.density = density;
   config.seed = a.seed;
   config.show_progress = !c.quiet;
   std::string ga_reason;
   use_geometry_aligned(s.scene, config, ga_reason);
   c.log("viewcells: subdividing to at most " + std::to_string(b.max_cells) + " cells; geometry-aligned candidates " +
         ga_reason);
-  Subdivision sub = subdivide(s.scene, s.result.segments, r, config);
+  c.log("viewcells: pixel cost term " + model.describe_pixel_term());
+  Subdivision sub = subdivide(s.scene, s.result.segments, model, config);
   c.log("viewcells: " + std::to_string(sub.leaf_count()) + " cells in " + fmt(sub.stats.seconds, 2) +
         " s, render cost " + fmt(sub.initial_cost, 1) + " -> " + fmt(sub.cost(), 1) + " (" + sub.stats.stop_reason + ")");
 
@@ -430,9 +448,12 @@ int run_build(const SampleArgs& a, const BuildArgs& b, const Common& c) {
   report["settings"]["ga_candidates"] = b.ga_candidates;
   report["settings"]["min_reduction"] = b.min_reduction;
   report["settings"]["cost_model"] = {{"a", model.a}, {"b", model.b}, {"c", model.c}};
+  if (model.pixel_term())
+    report["settings"]["cost_model"]["screen"] = {
+        {"width", model.screen_width}, {"height", model.screen_height}, {"fov_degrees", model.fov_degrees}};
   report["effects"]["geometry_aligned_candidates"] = {{"enabled", sub.stats.geometry_aligned},
                                                       {"reason", sub.stats.geometry_aligned_reason}};
-  report["effects"]["pixel_cost_term"] = {{"enabled", false}, {"reason", "c = 0: r(o) = max(a, b * triangles)"}};
+  report["effects"]["pixel_cost_term"] = {{"enabled", model.pixel_term()}, {"reason", model.describe_pixel_term()}};
   report["effects"]["viewpoint_density"] =
       config.density.enabled
           ? json{{"enabled", true},
@@ -541,6 +562,14 @@ int run(int argc, char** argv) {
   bc->add_option("--cost-a", bld.cost_a, "Render cost model: minimum cost of an object (r = max(a, b * triangles))")
       ->capture_default_str();
   bc->add_option("--cost-b", bld.cost_b, "Render cost model: cost per triangle")->capture_default_str();
+  bc->add_option("--cost-c", bld.cost_c,
+                 "Render cost model: cost per projected pixel, estimated per cell from its corners and centre "
+                 "(0: no pixel term, nothing estimated)")
+      ->capture_default_str();
+  bc->add_option("--screen", bld.screen, "Screen WIDTHxHEIGHT the pixel term assumes (with --cost-c)")
+      ->capture_default_str();
+  bc->add_option("--fov", bld.fov, "Horizontal field of view in degrees the pixel term assumes (with --cost-c)")
+      ->capture_default_str();
   bc->add_option("--density-band", bld.density_band,
                  "Viewpoint density zlo,zhi[,outside]: weight 1 between the heights, outside (default 0.1) elsewhere");
   bc->add_option("-o,--output", bld.output, "Hierarchy file to write (.vcells)");

@@ -28,13 +28,20 @@ SegmentSet sample(const Scene& scene, uint64_t samples, uint64_t seed = 1) {
   return sample_segments(scene, *caster, config).segments;
 }
 
+Subdivision build_with(const Scene& scene, const SegmentSet& segs, const CostModel& model) {
+  SubdivisionConfig config;
+  config.max_cells = 10;
+  config.show_progress = false;
+  return subdivide(scene, segs, model, config);
+}
+
 Subdivision build(const Scene& scene, const SegmentSet& segs, uint32_t cells,
                   GeometryAlignedMode ga = GeometryAlignedMode::kAuto) {
   SubdivisionConfig config;
   config.max_cells = cells;
   config.geometry_aligned = ga;
   config.show_progress = false;
-  return subdivide(scene, segs, per_object_costs(scene, CostModel{}), config);
+  return subdivide(scene, segs, CostModel{}, config);
 }
 
 /// Length (world units) of segment i inside the closed leaf, from the half-spaces of its path,
@@ -181,10 +188,9 @@ TEST(Subdivision, ViewpointDensityConcentratesCellsInTheBand) {
   SubdivisionConfig config;
   config.max_cells = 150;
   config.show_progress = false;
-  const std::vector<double> r = per_object_costs(scene, CostModel{});
-  const Subdivision uniform = subdivide(scene, segs, r, config);
+  const Subdivision uniform = subdivide(scene, segs, CostModel{}, config);
   config.density = {true, 1.0, 2.0, 0.01};
-  const Subdivision banded = subdivide(scene, segs, r, config);
+  const Subdivision banded = subdivide(scene, segs, CostModel{}, config);
   expect_invariants(scene, segs, banded);
   // Weights: children add up; the root's weight is the band's volume plus 1% of the rest.
   for (const BspNode& n : banded.nodes)
@@ -246,7 +252,7 @@ TEST(Subdivision, SweepMatchesBruteForce) {
     config.max_axis_candidates = 1000;  // no subsampling
     config.geometry_aligned = GeometryAlignedMode::kOff;
     config.show_progress = false;
-    const Subdivision s = subdivide(scene, segs, r, config);
+    const Subdivision s = subdivide(scene, segs, CostModel{}, config);
     ASSERT_EQ(s.splits.size(), 1u);
 
     double best = -1;
@@ -317,7 +323,96 @@ TEST(Subdivision, BadInput) {
   segs.view_box = {{0, 0, 0}, {1, 1, 1}};
   segs.push_back({0, 0, 0}, {1, 1, 1}, 99, kNoObject, 0, kNoObject);
   EXPECT_THROW(build(scene, segs, 10), Error);
-  EXPECT_THROW(per_object_costs(scene, CostModel{100, 1, 0.5}), Error);
+  EXPECT_THROW(per_object_costs(scene, CostModel{100, -1, 0}), Error);
+  EXPECT_THROW(per_object_costs(scene, CostModel{NAN, 1, 0}), Error);
+  CostModel bad_screen{100, 1, 0.5};
+  bad_screen.fov_degrees = 180;
+  EXPECT_THROW(build_with(scene, segs, bad_screen), Error);
+}
+
+// ------------------------------------------------------------------------ the pixel term
+
+TEST(PixelTerm, ProjectedPixelsFallWithTheSquaredDistanceAndFillAtMostTheScreen) {
+  ObjectInfo wall;
+  wall.bounds = {{0, 0, 0}, {1, 1, 1}};
+  wall.surface_area = 6;  // a unit cube
+  CostModel m{0, 0, 1};
+  m.screen_width = 800;
+  m.screen_height = 600;
+  m.fov_degrees = 90;  // focal length 400 pixels
+  // 10 units in front of the box: 6/4 steradian-units / 100 * 400^2 = 2400 pixels.
+  EXPECT_NEAR(projected_pixels(wall, {0.5, 0.5, 11}, m), 2400.0, 1e-9);
+  EXPECT_NEAR(projected_pixels(wall, {0.5, 0.5, 21}, m), 600.0, 1e-9);
+  // Diagonal distance to the box, not to its centre.
+  EXPECT_NEAR(projected_pixels(wall, {4, 5, 1}, m), 1.5 / 25 * 160000, 1e-9);
+  // Close or inside: the whole screen, never more.
+  EXPECT_EQ(projected_pixels(wall, {0.5, 0.5, 1.001}, m), 800.0 * 600.0);
+  EXPECT_EQ(projected_pixels(wall, {0.5, 0.5, 0.5}, m), 800.0 * 600.0);
+  // The cell cost is the mean over its points, and never below max(a, b t).
+  const std::vector<Vec3> points = {{0.5, 0.5, 11}, {0.5, 0.5, 21}};
+  EXPECT_NEAR(cell_object_cost(wall, 5.0, points, CostModel{0, 0, 0.5, 800, 600, 90}), 0.5 * 1500, 1e-9);
+  EXPECT_EQ(cell_object_cost(wall, 5000.0, points, CostModel{0, 0, 0.5, 800, 600, 90}), 5000.0);
+  EXPECT_EQ(cell_object_cost(wall, 5.0, points, CostModel{}), 5.0) << "c = 0: nothing estimated";
+}
+
+/// r(PVS) of a leaf recomputed from scratch: the objects its segments see, each at
+/// max(a, b t, c * mean pixels over the octant centres of the leaf's bounding box).
+double leaf_cost_from_scratch(const Scene& scene, const SegmentSet& segs, const Subdivision& s, int32_t leaf,
+                              const CostModel& m) {
+  const Box3 b = s.cells[leaf].bounds();
+  const Vec3 q = b.extent() * 0.25;
+  std::vector<Vec3> points;
+  for (double x : {b.lo.x + q.x, b.hi.x - q.x})
+    for (double y : {b.lo.y + q.y, b.hi.y - q.y})
+      for (double z : {b.lo.z + q.z, b.hi.z - q.z}) points.push_back({x, y, z});
+  std::vector<uint32_t> objects;
+  for (uint32_t i : s.segments[leaf])
+    for (uint32_t o : {segs.object_a[i], segs.object_b[i]})
+      if (o != kNoObject) objects.push_back(o);
+  std::sort(objects.begin(), objects.end());
+  objects.erase(std::unique(objects.begin(), objects.end()), objects.end());
+  double c = 0;
+  for (uint32_t o : objects) {
+    const ObjectInfo& info = scene.objects[o];
+    double pixels = 0;
+    for (const Vec3& p : points) pixels += projected_pixels(info, p, m);
+    c += std::max({m.a, m.b * info.triangle_count, m.c * pixels / points.size()});
+  }
+  return c;
+}
+
+TEST(PixelTerm, EveryCellCostsWhatTheModelGivesForItAlone) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 2});
+  const SegmentSet segs = sample(scene, 30000);
+  SubdivisionConfig config;
+  config.max_cells = 120;
+  config.show_progress = false;
+  CostModel pixel{100, 1, 0.01};
+  const Subdivision s = subdivide(scene, segs, pixel, config);
+  const Subdivision plain = subdivide(scene, segs, CostModel{}, config);
+  ASSERT_EQ(s.leaf_count(), 120u);
+  // Every leaf's r(PVS) is what the model gives for that leaf alone, and c(S) adds them up.
+  double total = 0;
+  for (int32_t leaf : s.leaves()) {
+    const double own = leaf_cost_from_scratch(scene, segs, s, leaf, pixel);
+    EXPECT_NEAR(s.nodes[leaf].pvs_cost, own, 1e-9 * own) << "leaf " << leaf;
+    total += s.nodes[leaf].weight / s.nodes[0].weight * own;
+  }
+  EXPECT_NEAR(s.cost(), total, 1e-9 * total);
+  EXPECT_NEAR(s.splits.back().cost_after, total, 1e-9 * total);
+  // The pixel term only adds: every leaf costs at least max(a, b t) of its objects.
+  EXPECT_GT(s.initial_cost, plain.initial_cost);
+  // Volumes and segment lists keep their invariants (the cost may rise where estimates erred).
+  const double v = s.view_box.volume();
+  double leaves_volume = 0;
+  for (int32_t l : s.leaves()) leaves_volume += s.nodes[l].volume;
+  EXPECT_NEAR(leaves_volume / v, 1.0, 1e-9);
+  // Overall the splits pay, though less than without pixels: nearby objects stay nearby.
+  EXPECT_LT(s.cost(), 0.9 * s.initial_cost);
+  // Without c the pixel machinery is off: the same tree as before, split for split.
+  const Subdivision plain_again = subdivide(scene, segs, CostModel{100, 1, 0, 640, 480, 60}, config);
+  ASSERT_EQ(plain_again.splits.size(), plain.splits.size());
+  for (size_t k = 0; k < plain.splits.size(); ++k) EXPECT_EQ(plain_again.splits[k].cost_after, plain.splits[k].cost_after);
 }
 
 }  // namespace

@@ -103,6 +103,20 @@ expect_ok "$VC" build rotated.obj --samples 20000 --max-cells 32 --report rot.js
 [ "$(json_get rot.json "['effects']['geometry_aligned_candidates']['enabled']")" = "True" ] && ok || bad "GA should be on for the rotated office"
 expect_ok "$VC" build rotated.obj --samples 20000 --max-cells 32 --no-ga --report rot_aa.json -q
 [ "$(json_get rot_aa.json "['subdivision']['geometry_candidates_evaluated']")" = "0" ] && ok || bad "--no-ga"
+[ "$(json_get build.json "['effects']['pixel_cost_term']['enabled']")" = "False" ] && ok || bad "pixel term must be off by default"
+# The pixel term: on with --cost-c, said so in the report, the screen recorded.
+expect_ok "$VC" build office.obj --samples 20000 --max-cells 32 --cost-c 0.01 --screen 640x480 --fov 70 \
+  -o pixel.vcells --report pixel.json -q
+python3 -c "
+import json; r=json.load(open('pixel.json'))
+e=r['effects']['pixel_cost_term']; assert e['enabled'] is True and '640x480' in e['reason'], e
+assert r['settings']['cost_model']['screen'] == {'width': 640, 'height': 480, 'fov_degrees': 70.0}
+assert r['final_cost'] < r['subdivision']['initial_cost']
+" && ok || bad "pixel term report"
+expect_ok "$VC" export pixel.vcells --mesh pixel.ply -q
+expect_error "--screen" "$VC" build office.obj --samples 1000 --cost-c 1 --screen 640-480
+expect_error "field of view" "$VC" build office.obj --samples 1000 --cost-c 1 --fov 200
+expect_error "must be finite and non-negative" "$VC" build office.obj --samples 1000 --cost-c -1
 head -c 100 office.vcells > cut.vcells
 expect_error "cut.vcells" "$VC" export cut.vcells --mesh x.ply
 expect_error "nothing to export" "$VC" export office.vcells

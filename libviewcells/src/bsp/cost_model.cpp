@@ -2,20 +2,70 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 #include "viewcells/core/error.h"
 
 namespace viewcells {
 
+void CostModel::validate() const {
+  for (const auto& [name, v] : {std::pair{"a", a}, std::pair{"b", b}, std::pair{"c", c}})
+    if (!(v >= 0) || !std::isfinite(v))
+      throw Error(std::string("cost model: ") + name + " must be finite and non-negative (got " + std::to_string(v) +
+                  ")");
+  if (!pixel_term()) return;
+  if (screen_width < 1 || screen_height < 1 || screen_width > 65536 || screen_height > 65536)
+    throw Error("cost model: the screen must be between 1x1 and 65536x65536 pixels");
+  if (!(fov_degrees > 0 && fov_degrees < 180))
+    throw Error("cost model: the field of view must lie strictly between 0 and 180 degrees");
+}
+
+std::string CostModel::describe_pixel_term() const {
+  if (!pixel_term()) return "disabled: c = 0, so r(o) = max(a, b * triangles) and no pixels are estimated";
+  return "enabled: c > 0; pixels estimated from the octant centres of each cell's bounding box on a " +
+         std::to_string(screen_width) + "x" + std::to_string(screen_height) + " screen with a " +
+         std::to_string(static_cast<int>(std::lround(fov_degrees))) + " degree horizontal field of view";
+}
+
 std::vector<double> per_object_costs(const Scene& scene, const CostModel& model) {
-  if (!(model.a >= 0) || !(model.b >= 0) || !std::isfinite(model.a) || !std::isfinite(model.b))
-    throw Error("cost model: a and b must be finite and non-negative");
-  if (model.c != 0.0)
-    throw Error("cost model: the pixel term (c > 0) is not implemented yet; use c = 0");
+  model.validate();
   std::vector<double> r(scene.objects.size());
   for (size_t o = 0; o < r.size(); ++o)
     r[o] = std::max(model.a, model.b * static_cast<double>(scene.objects[o].triangle_count));
   return r;
+}
+
+double projected_pixels(const ObjectInfo& object, const Vec3& eye, const CostModel& model) {
+  const double screen = static_cast<double>(model.screen_width) * model.screen_height;
+  // Squared distance from the eye to the bounding box (0 inside).
+  double d2 = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double d = std::max({object.bounds.lo[k] - eye[k], 0.0, eye[k] - object.bounds.hi[k]});
+    d2 += d * d;
+  }
+  if (!(d2 > 0)) return screen;
+  // Pixels per steradian at the centre of the view: the focal length in pixels, squared.
+  const double f = 0.5 * model.screen_width / std::tan(0.5 * model.fov_degrees * std::numbers::pi / 180.0);
+  const double steradians = 0.25 * object.surface_area / d2;
+  return std::min(screen, steradians * f * f);
+}
+
+std::vector<Vec3> pixel_estimation_points(const Box3& b) {
+  std::vector<Vec3> points;
+  points.reserve(8);
+  const Vec3 e = b.extent();
+  for (int k = 0; k < 8; ++k)
+    points.push_back({b.lo.x + e.x * (k & 1 ? 0.75 : 0.25), b.lo.y + e.y * (k & 2 ? 0.75 : 0.25),
+                      b.lo.z + e.z * (k & 4 ? 0.75 : 0.25)});
+  return points;
+}
+
+double cell_object_cost(const ObjectInfo& object, double base, const std::vector<Vec3>& points,
+                        const CostModel& model) {
+  if (!model.pixel_term() || points.empty()) return base;
+  double sum = 0;
+  for (const Vec3& p : points) sum += projected_pixels(object, p, model);
+  return std::max(base, model.c * sum / static_cast<double>(points.size()));
 }
 
 }  // namespace viewcells

@@ -18,6 +18,7 @@
 #include <map>
 #include <queue>
 
+#include "viewcells/core/default_init.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/core/rng.h"
@@ -121,8 +122,14 @@ struct Marks {
       epoch = 1;
     }
   }
+  /// True the first time object o is seen (never for kNoObject).
+  bool first(uint32_t o) {
+    if (o == kNoObject || stamp[o] == epoch) return false;
+    stamp[o] = epoch;
+    return true;
+  }
   /// Cost added by seeing object o (0 if already seen or none).
-  double add(uint32_t o, const std::vector<double>& r) {
+  double add(uint32_t o, const double* r) {
     if (o == kNoObject || stamp[o] == epoch) return 0.0;
     stamp[o] = epoch;
     return r[o];
@@ -142,9 +149,15 @@ struct Evaluation {
 
 class Builder {
  public:
-  Builder(const Scene& scene, const SegmentSet& segs, const std::vector<double>& r, const SubdivisionConfig& config,
+  Builder(const Scene& scene, const SegmentSet& segs, const CostModel& model, const SubdivisionConfig& config,
           Subdivision& out)
-      : scene_(scene), segs_(segs), r_(r), config_(config), out_(out), total_volume_(segs.view_box.volume()) {}
+      : scene_(scene),
+        segs_(segs),
+        model_(model),
+        r_(per_object_costs(scene, model)),
+        config_(config),
+        out_(out),
+        total_volume_(segs.view_box.volume()) {}
 
   void run() {
     const auto start = std::chrono::steady_clock::now();
@@ -223,12 +236,39 @@ class Builder {
   double node_cost(int32_t n) const { return out_.nodes[n].weight / total_weight_ * out_.nodes[n].pvs_cost; }
   double priority(int32_t n) const { return best_[n].reduction + 0.01 * node_cost(n); }
 
-  double pvs_cost(const std::vector<SegRef>& refs) {
+  double pvs_cost(const ConvexPolyhedron& cell, const std::vector<SegRef>& refs) {
+    if (model_.pixel_term()) {
+      double c = 0;
+      for_each_cell_cost(cell, refs, [&](uint32_t, double r) { c += r; });
+      return c;
+    }
     Marks& m = marks_.local();
     m.reset(r_.size());
     double c = 0;
-    for (const SegRef& s : refs) c += m.add(segs_.object_a[s.id], r_) + m.add(segs_.object_b[s.id], r_);
+    for (const SegRef& s : refs) c += m.add(segs_.object_a[s.id], r_.data()) + m.add(segs_.object_b[s.id], r_.data());
     return c;
+  }
+
+  /// With the pixel term: calls f(object, r(o) in this cell) once for every object the cell's
+  /// segments see (pixels estimated from the cell's bounding box, cost_model.h).
+  template <typename F>
+  void for_each_cell_cost(const ConvexPolyhedron& cell, const std::vector<SegRef>& refs, F&& f) {
+    const std::vector<Vec3> points = pixel_estimation_points(cell.bounds());
+    Marks& m = marks_.local();
+    m.reset(r_.size());
+    for (const SegRef& s : refs)
+      for (uint32_t o : {segs_.object_a[s.id], segs_.object_b[s.id]})
+        if (m.first(o)) f(o, cell_object_cost(scene_.objects[o], r_[o], points, model_));
+  }
+
+  /// The object costs candidate splits of `node` are evaluated with: the node's own (pixel
+  /// term estimated from the node's points, used for both sides), else the global ones.
+  /// Only the entries of objects the node's segments see are written.
+  const double* candidate_costs(int32_t node, RawVector<double>& storage) {
+    if (!model_.pixel_term()) return r_.data();
+    storage.resize(r_.size());
+    for_each_cell_cost(out_.cells[node], refs_[node], [&](uint32_t o, double r) { storage[o] = r; });
+    return storage.data();
   }
 
   int32_t add_node(int32_t parent, ConvexPolyhedron cell, std::vector<SegRef> refs) {
@@ -236,7 +276,7 @@ class Builder {
     node.parent = parent;
     node.volume = cell.volume();
     node.weight = config_.density.weight(cell);
-    node.pvs_cost = pvs_cost(refs);
+    node.pvs_cost = pvs_cost(cell, refs);
     out_.nodes.push_back(node);
     out_.cells.push_back(std::move(cell));
     refs_.push_back(std::move(refs));
@@ -287,12 +327,14 @@ class Builder {
     Evaluation ev;
     const std::vector<SegRef>& refs = refs_[node];
     if (refs.empty() || out_.nodes[node].pvs_cost == 0) return ev;
+    RawVector<double> storage;
+    const double* r = candidate_costs(node, storage);
     Candidate results[4];
     tbb::parallel_for(0, 4, [&](int task) {
       if (task < 3) {
-        results[task] = best_axis_candidate(node, task, ev);
+        results[task] = best_axis_candidate(node, task, ev, r);
       } else if (ga_) {
-        results[3] = best_geometry_candidate(node, ev);
+        results[3] = best_geometry_candidate(node, ev, r);
       }
     });
     for (const Candidate& c : results)  // in a fixed order: ties keep the earlier kind/axis
@@ -301,7 +343,7 @@ class Builder {
   }
 
   /// The sweep: r(PVS) of both sides at every candidate position of one axis in O(n log n).
-  Candidate best_axis_candidate(int32_t node, int axis, Evaluation& ev) {
+  Candidate best_axis_candidate(int32_t node, int axis, Evaluation& ev, const double* r) {
     const std::vector<SegRef>& refs = refs_[node];
     const ConvexPolyhedron& cell = out_.cells[node];
     const Box3 bounds = cell.bounds();
@@ -350,7 +392,7 @@ class Builder {
       while (next < order.size() &&
              (ext[order[next]].lo < x || (ext[order[next]].lo == x && ext[order[next]].hi == x))) {
         const uint32_t id = ext[order[next]].id;
-        cost += m.add(segs_.object_a[id], r_) + m.add(segs_.object_b[id], r_);
+        cost += m.add(segs_.object_a[id], r) + m.add(segs_.object_b[id], r);
         ++next;
       }
       left[j] = cost;
@@ -368,7 +410,7 @@ class Builder {
       while (next < order.size() &&
              (ext[order[next]].hi > x || (ext[order[next]].hi == x && ext[order[next]].lo == x))) {
         const uint32_t id = ext[order[next]].id;
-        cost += m.add(segs_.object_a[id], r_) + m.add(segs_.object_b[id], r_);
+        cost += m.add(segs_.object_a[id], r) + m.add(segs_.object_b[id], r);
         ++next;
       }
       right[j] = cost;
@@ -401,7 +443,7 @@ class Builder {
   }
 
   /// Planes of non-axis-aligned triangles hit inside the node, a random subset; each costs O(n).
-  Candidate best_geometry_candidate(int32_t node, Evaluation& ev) {
+  Candidate best_geometry_candidate(int32_t node, Evaluation& ev, const double* r) {
     const std::vector<SegRef>& refs = refs_[node];
     // Triangles hit at segment ends inside this node lie (at least partly) inside it.
     std::vector<uint32_t> tris;
@@ -451,8 +493,8 @@ class Builder {
       double cl = 0, cr = 0;
       for (const SegRef& s : refs) {
         const int to = classify(plane.side(point_at(segs_, s.id, s.t0)), plane.side(point_at(segs_, s.id, s.t1)));
-        if (to & 1) cl += neg.add(segs_.object_a[s.id], r_) + neg.add(segs_.object_b[s.id], r_);
-        if (to & 2) cr += pos.add(segs_.object_a[s.id], r_) + pos.add(segs_.object_b[s.id], r_);
+        if (to & 1) cl += neg.add(segs_.object_a[s.id], r) + neg.add(segs_.object_b[s.id], r);
+        if (to & 2) cr += pos.add(segs_.object_a[s.id], r) + pos.add(segs_.object_b[s.id], r);
       }
       const double wl = config_.density.enabled ? config_.density.weight_below(cell, part, plane) : vl;
       const double reduction = own - (wl * cl + (weight - wl) * cr) / total_weight_;
@@ -464,7 +506,8 @@ class Builder {
 
   const Scene& scene_;
   const SegmentSet& segs_;
-  const std::vector<double>& r_;
+  const CostModel& model_;
+  const std::vector<double> r_;  ///< max(a, b t_o) per object
   const SubdivisionConfig& config_;
   Subdivision& out_;
   double total_volume_;
@@ -478,9 +521,9 @@ class Builder {
 
 }  // namespace
 
-Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const std::vector<double>& object_costs,
+Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const CostModel& model,
                       const SubdivisionConfig& config) {
-  if (object_costs.size() != scene.objects.size()) throw Error("object costs do not match the scene");
+  model.validate();
   if (config.max_cells < 1) throw Error("the maximum number of cells must be at least 1");
   if (config.density.enabled &&
       !(config.density.lo < config.density.hi && config.density.outside >= 0 && std::isfinite(config.density.outside)))
@@ -491,7 +534,7 @@ Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const std:
         throw Error("segment " + std::to_string(i) + " names object " + std::to_string(o) +
                     ", but the scene has " + std::to_string(scene.objects.size()) + " (segments of another scene?)");
   Subdivision out;
-  Builder(scene, segments, object_costs, config, out).run();
+  Builder(scene, segments, model, config, out).run();
   return out;
 }
 

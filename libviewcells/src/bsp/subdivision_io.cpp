@@ -28,7 +28,8 @@ std::vector<std::vector<uint32_t>> leaf_pvs(const Subdivision& s, const SegmentS
 
 namespace {
 constexpr char kMagic[5] = "VCEL";
-constexpr uint32_t kVersion = 1;
+// 1: first layout; 2: adds the pixel term's screen (width, height, field of view) after c.
+constexpr uint32_t kVersion = 2;
 }  // namespace
 
 void write_subdivision(const std::string& path, const SubdivisionFile& f) {
@@ -39,6 +40,9 @@ void write_subdivision(const std::string& path, const SubdivisionFile& f) {
   w.put(f.cost_model.a);
   w.put(f.cost_model.b);
   w.put(f.cost_model.c);
+  w.put<int32_t>(f.cost_model.screen_width);
+  w.put<int32_t>(f.cost_model.screen_height);
+  w.put(f.cost_model.fov_degrees);
   w.put<uint64_t>(f.scene_fingerprint);
   w.put<uint32_t>(f.object_count);
   w.put(s.initial_cost);
@@ -80,6 +84,16 @@ SubdivisionFile read_subdivision(const std::string& path) {
   f.cost_model.a = r.get<double>();
   f.cost_model.b = r.get<double>();
   f.cost_model.c = r.get<double>();
+  if (version >= 2) {
+    f.cost_model.screen_width = r.get<int32_t>();
+    f.cost_model.screen_height = r.get<int32_t>();
+    f.cost_model.fov_degrees = r.get<double>();
+  }
+  try {
+    f.cost_model.validate();
+  } catch (const Error& e) {
+    r.fail(std::string("invalid cost model (") + e.what() + ")");
+  }
   f.scene_fingerprint = r.get<uint64_t>();
   f.object_count = r.get<uint32_t>();
   s.initial_cost = r.get<double>();

@@ -2,9 +2,19 @@
 /// The render-cost model (view-cell-construction paper, section 3.3; DESIGN.md):
 /// r(o) = max(a, b * t_o, c * p_o), r(PVS) = sum of r(o), c(S) = sum_i p(i) r(PVS_i) with
 /// p(i) = V_i / V.
+///
+/// The pixel term p_o depends on where the viewer is, so with c > 0 the cost of an object
+/// depends on the cell: p_o is estimated from some points of the cell, each seeing the object
+/// as a convex body of its surface area at the distance of its bounding box, on a screen of
+/// the model's size and field of view. The points are the centres of the eight octants of the
+/// cell's bounding box (the same rule for BSP leaves, merged cells and any other partition):
+/// a midpoint rule for the mean over the cell, so a cell and its halves estimate alike, where
+/// corner points would bias small cells upwards. With c = 0 (the default) nothing of this is
+/// computed and r(o) is one number per object.
 #include <string>
 #include <vector>
 
+#include "viewcells/core/vec3.h"
 #include "viewcells/scene/scene.h"
 
 namespace viewcells {
@@ -14,12 +24,35 @@ struct CostModel {
   double a = 100.0;
   /// Cost per triangle.
   double b = 1.0;
-  /// Cost per projected pixel. The pixel term needs a renderer's estimate per cell and is not
-  /// computed yet: values other than 0 are rejected (see per_object_costs).
+  /// Cost per projected pixel (0: no pixel term).
   double c = 0.0;
+  /// The screen the pixel term assumes (only used when c > 0).
+  int screen_width = 1024, screen_height = 768;
+  double fov_degrees = 90.0;  ///< horizontal field of view
+
+  bool pixel_term() const { return c > 0; }
+  /// Throws Error for negative, non-finite or otherwise unusable parameters.
+  void validate() const;
+  /// One line saying whether the pixel term is computed, and with which screen.
+  std::string describe_pixel_term() const;
 };
 
-/// r(o) for every object of the scene. Throws Error when c != 0 (pixel term not available).
+/// The part of r(o) that does not depend on the viewpoint, max(a, b * t_o), per object.
 std::vector<double> per_object_costs(const Scene& scene, const CostModel& model);
+
+/// Estimated pixels covered by `object` seen from `eye` when the viewer looks at it: its
+/// mean projected area (surface area / 4, exact for convex bodies) over the squared distance
+/// to its bounding box, times the screen's pixels per steradian; at most the whole screen
+/// (also when the eye is inside the bounding box).
+double projected_pixels(const ObjectInfo& object, const Vec3& eye, const CostModel& model);
+
+/// The points the pixel term of a cell is estimated from: the centres of the 8 octants of the
+/// cell's bounding box.
+std::vector<Vec3> pixel_estimation_points(const Box3& cell_bounds);
+
+/// r(o) for a cell: max(base, c * mean over `points` of projected_pixels). `base` is the
+/// object's per_object_costs entry. Without the pixel term, returns base.
+double cell_object_cost(const ObjectInfo& object, double base, const std::vector<Vec3>& points,
+                        const CostModel& model);
 
 }  // namespace viewcells

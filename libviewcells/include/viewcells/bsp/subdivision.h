@@ -102,8 +102,11 @@ struct Subdivision {
 /// Decides whether geometry-aligned candidates are used, and why.
 bool use_geometry_aligned(const Scene& scene, const SubdivisionConfig& config, std::string& reason);
 
-/// Builds AV-S over segments.view_box. `object_costs` is per_object_costs(scene, model).
-Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const std::vector<double>& object_costs,
+/// Builds AV-S over segments.view_box under the render-cost model `model`. With its pixel
+/// term (c > 0) every cell has its own object costs (cost_model.h); candidate planes of a cell
+/// are then evaluated with the cell's costs on both sides, and the split's recorded cost uses
+/// each child's own, so a split can then raise c(S) a little where an estimate was off.
+Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const CostModel& model,
                       const SubdivisionConfig& config);
 
 }  // namespace viewcells

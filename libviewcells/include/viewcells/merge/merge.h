@@ -1,0 +1,104 @@
+#pragma once
+/// View space merging and the merge history tree (view-cell-construction paper, section 4.3),
+/// and view cell extraction from it (section 5.1).
+///
+/// Merging is greedy: always merge the pair of neighbouring cells whose merge raises the
+/// expected render cost c(S) the least, delta(x, y) = c({x + y}) - c({x, y}). Each merge is a
+/// node of the merge history tree (MHT): nodes 0 .. L-1 are the elementary cells, node L + k
+/// is merge k, and cutting the tree after k merges gives the L - k cells the greedy found.
+/// It works on any partition of the view space into cells with PVSs and a neighbour relation:
+/// the leaves of our AV-S subdivision, or a kD-tree's cells.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "viewcells/bsp/cost_model.h"
+#include "viewcells/bsp/subdivision.h"
+#include "viewcells/core/vec3.h"
+#include "viewcells/scene/scene.h"
+
+namespace viewcells {
+
+/// A partition of the view space, the input of merging.
+struct CellPartition {
+  std::vector<double> weight;                   ///< per cell: integral of the viewpoint density
+  std::vector<double> volume;                   ///< per cell
+  std::vector<Box3> bounds;                     ///< per cell (the pixel term's points)
+  std::vector<std::vector<uint32_t>> pvs;       ///< per cell: sorted object ids
+  std::vector<std::pair<uint32_t, uint32_t>> neighbours;  ///< cells sharing a face, first < second
+
+  size_t size() const { return weight.size(); }
+};
+
+/// The leaves of `s` as a partition, in the order of s.leaves(); `leaf_pvs` is per node
+/// (subdivision_io.h: leaf_pvs). Needs the leaf cells (s.cells) for the neighbours.
+CellPartition partition_from_subdivision(const Subdivision& s, const std::vector<std::vector<uint32_t>>& leaf_pvs);
+
+struct MergeNode {
+  int32_t child[2] = {-1, -1};  ///< -1 for an elementary cell
+  int32_t parent = -1;          ///< -1 for a root
+  double weight = 0, volume = 0;
+  Box3 bounds;
+  double pvs_cost = 0;     ///< r(PVS) of the (merged) cell
+  uint32_t pvs_size = 0;   ///< objects in its PVS
+};
+
+struct MergeStats {
+  uint64_t evaluations = 0;  ///< delta(x, y) computed
+  uint64_t stale = 0;        ///< queue entries skipped because a side had merged already
+  double seconds = 0;
+};
+
+struct MergeHistory {
+  uint32_t leaf_count = 0;
+  std::vector<MergeNode> nodes;  ///< leaves first, then one per merge
+  /// c(S) after each merge: cost_after[k] holds for leaf_count - k - 1 cells.
+  std::vector<double> cost_after;
+  double initial_cost = 0;       ///< c(S) of the elementary cells
+  double total_weight = 0;
+  MergeStats stats;
+
+  size_t merges() const { return nodes.size() - leaf_count; }
+  /// Smallest number of cells the merges reach (1 unless the neighbour graph is disconnected).
+  size_t min_cells() const { return leaf_count - merges(); }
+  /// c(S) with `cells` cells (min_cells() <= cells <= leaf_count).
+  double cost_with(size_t cells) const;
+  /// The cells (MHT node ids) after the first k merges, sorted.
+  std::vector<int32_t> cut_after(size_t k) const;
+  /// The elementary cells (leaf ids) under node n, sorted.
+  std::vector<uint32_t> leaves_under(int32_t n) const;
+};
+
+struct MergeConfig {
+  uint32_t min_cells = 1;  ///< stop merging at this many cells
+  bool show_progress = true;
+};
+
+/// Merges greedily down to config.min_cells cells (or as far as the neighbour graph allows).
+/// Deterministic: ties go to the pair with the smaller node ids.
+MergeHistory merge_cells(const Scene& scene, const CellPartition& partition, const CostModel& model,
+                         const MergeConfig& config = {});
+
+/// A set of view cells cut from the merge history.
+struct ViewCellSet {
+  std::vector<int32_t> cells;  ///< MHT node ids, sorted
+  double cost = 0;             ///< c(S) of the set
+  uint64_t pvs_entries = 0;    ///< sum of the cells' PVS sizes
+  uint64_t pvs_bytes = 0;      ///< approx_pvs_bytes of the set
+  std::string rule;            ///< how it was chosen, in words
+};
+
+/// Approximate PVS storage of a cell: a 32-bit id per object plus a 4-byte count.
+inline uint64_t approx_pvs_bytes(uint32_t pvs_size) { return 4ull * pvs_size + 4; }
+
+/// Exactly `count` cells (min_cells() <= count <= leaf_count, else Error).
+ViewCellSet extract_by_count(const MergeHistory& h, size_t count);
+/// The most cells whose approximate PVS storage fits in `bytes`, walking the history back
+/// from its coarsest cut (paper 5.1: stop when the budget is reached). Error if not even the
+/// coarsest cut fits.
+ViewCellSet extract_by_memory(const MergeHistory& h, uint64_t bytes);
+/// The fewest cells whose cost is at most `ratio` times the cost of the elementary cells
+/// (ratio >= 1).
+ViewCellSet extract_by_cost_ratio(const MergeHistory& h, double ratio);
+
+}  // namespace viewcells

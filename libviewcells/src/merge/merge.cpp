@@ -1,0 +1,324 @@
+// View space merging (view-cell-construction paper, section 4.3) and extraction (section 5.1).
+//
+// The neighbour graph is a Boost.Graph adjacency list over merge-history node ids: merging x
+// and y adds node z with the union of their neighbours and clears x and y. The queue holds
+// (delta, x, y); an entry whose x or y has merged since is stale and skipped when popped, so
+// the queue is never rescanned. delta needs only the intersection of the two PVSs when the
+// object costs do not depend on the cell (c = 0): r(x + y) = r(x) + r(y) - r(x n y).
+#include "viewcells/merge/merge.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <boost/graph/adjacency_list.hpp>
+#include <chrono>
+#include <queue>
+
+#include "viewcells/bsp/adjacency.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/progress.h"
+
+namespace viewcells {
+
+CellPartition partition_from_subdivision(const Subdivision& s, const std::vector<std::vector<uint32_t>>& leaf_pvs) {
+  const std::vector<int32_t> leaves = s.leaves();
+  if (s.cells.size() != s.nodes.size()) throw Error("the subdivision's cells are missing (rebuild them first)");
+  if (leaf_pvs.size() != s.nodes.size()) throw Error("leaf PVSs do not match the subdivision");
+  CellPartition p;
+  std::vector<int32_t> index(s.nodes.size(), -1);
+  for (size_t i = 0; i < leaves.size(); ++i) {
+    const int32_t n = leaves[i];
+    index[n] = static_cast<int32_t>(i);
+    p.weight.push_back(s.nodes[n].weight);
+    p.volume.push_back(s.nodes[n].volume);
+    p.bounds.push_back(s.cells[n].bounds());
+    p.pvs.push_back(leaf_pvs[n]);
+  }
+  for (const LeafAdjacency& a : leaf_adjacency(s)) {
+    const uint32_t x = index[a.a], y = index[a.b];
+    p.neighbours.emplace_back(std::min(x, y), std::max(x, y));
+  }
+  std::sort(p.neighbours.begin(), p.neighbours.end());
+  return p;
+}
+
+double MergeHistory::cost_with(size_t cells) const {
+  VC_CHECK(cells >= min_cells() && cells <= leaf_count);
+  const size_t k = leaf_count - cells;
+  return k == 0 ? initial_cost : cost_after[k - 1];
+}
+
+std::vector<int32_t> MergeHistory::cut_after(size_t k) const {
+  VC_CHECK(k <= merges());
+  const int32_t created = static_cast<int32_t>(leaf_count + k);  // nodes below this exist
+  std::vector<int32_t> cut;
+  for (int32_t n = 0; n < created; ++n)
+    if (nodes[n].parent < 0 || nodes[n].parent >= created) cut.push_back(n);
+  return cut;
+}
+
+std::vector<uint32_t> MergeHistory::leaves_under(int32_t n) const {
+  std::vector<uint32_t> out;
+  std::vector<int32_t> stack = {n};
+  while (!stack.empty()) {
+    const int32_t m = stack.back();
+    stack.pop_back();
+    if (nodes[m].child[0] < 0) {
+      out.push_back(static_cast<uint32_t>(m));
+    } else {
+      stack.push_back(nodes[m].child[0]);
+      stack.push_back(nodes[m].child[1]);
+    }
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+namespace {
+
+using Graph = boost::adjacency_list<boost::setS, boost::vecS, boost::undirectedS>;
+
+struct Entry {
+  double delta;
+  int32_t x, y;  // x < y
+};
+struct Later {  // min-heap on delta; ties: smaller ids first
+  bool operator()(const Entry& p, const Entry& q) const {
+    if (p.delta != q.delta) return p.delta > q.delta;
+    return p.x != q.x ? p.x > q.x : p.y > q.y;
+  }
+};
+
+class Merger {
+ public:
+  Merger(const Scene& scene, const CellPartition& p, const CostModel& model)
+      : scene_(scene), p_(p), model_(model), r_(per_object_costs(scene, model)) {}
+
+  MergeHistory run(const MergeConfig& config) {
+    const auto start = std::chrono::steady_clock::now();
+    const size_t L = p_.size();
+    MergeHistory h;
+    h.leaf_count = static_cast<uint32_t>(L);
+    h.nodes.resize(L);
+    pvs_.resize(2 * L);
+    Graph graph(2 * L);
+    for (size_t i = 0; i < L; ++i) {
+      MergeNode& n = h.nodes[i];
+      n.weight = p_.weight[i];
+      n.volume = p_.volume[i];
+      n.bounds = p_.bounds[i];
+      pvs_[i] = p_.pvs[i];
+      n.pvs_cost = pvs_cost(pvs_[i], n.bounds);
+      n.pvs_size = static_cast<uint32_t>(pvs_[i].size());
+      h.total_weight += n.weight;
+    }
+    if (!(h.total_weight > 0)) throw Error("the cells to merge have no weight");
+    W_ = h.total_weight;
+    for (size_t i = 0; i < L; ++i) h.initial_cost += h.nodes[i].weight / W_ * h.nodes[i].pvs_cost;
+    for (const auto& [a, b] : p_.neighbours)
+      if (a != b) boost::add_edge(a, b, graph);
+
+    // Every neighbouring pair, evaluated in parallel (each is independent).
+    std::vector<Entry> entries;
+    entries.reserve(p_.neighbours.size());
+    for (const auto& [a, b] : p_.neighbours)
+      if (a != b) entries.push_back({0.0, static_cast<int32_t>(a), static_cast<int32_t>(b)});
+    entries.erase(std::unique(entries.begin(), entries.end(),
+                              [](const Entry& u, const Entry& v) { return u.x == v.x && u.y == v.y; }),
+                  entries.end());
+    evaluate(h, entries);
+    std::priority_queue<Entry, std::vector<Entry>, Later> queue(Later{}, std::move(entries));
+
+    const size_t target = std::max<size_t>(1, config.min_cells);
+    size_t alive = L;
+    double cost = h.initial_cost;
+    Progress progress("merging", L > target ? L - target : 0);
+    std::vector<Entry> fresh;
+    while (alive > target && !queue.empty()) {
+      const Entry e = queue.top();
+      queue.pop();
+      if (h.nodes[e.x].parent >= 0 || h.nodes[e.y].parent >= 0) {
+        ++h.stats.stale;
+        continue;
+      }
+      const int32_t z = static_cast<int32_t>(h.nodes.size());
+      MergeNode node;
+      node.child[0] = e.x;
+      node.child[1] = e.y;
+      node.weight = h.nodes[e.x].weight + h.nodes[e.y].weight;
+      node.volume = h.nodes[e.x].volume + h.nodes[e.y].volume;
+      node.bounds = h.nodes[e.x].bounds;
+      node.bounds.extend(h.nodes[e.y].bounds);
+      pvs_[z] = unite(pvs_[e.x], pvs_[e.y]);
+      node.pvs_cost = pvs_cost(pvs_[z], node.bounds);
+      node.pvs_size = static_cast<uint32_t>(pvs_[z].size());
+      // The recorded cost uses the merged cell's actual r(PVS), not the queued estimate.
+      cost += (node.weight * node.pvs_cost - h.nodes[e.x].weight * h.nodes[e.x].pvs_cost -
+               h.nodes[e.y].weight * h.nodes[e.y].pvs_cost) / W_;
+      h.nodes.push_back(node);
+      h.nodes[e.x].parent = z;
+      h.nodes[e.y].parent = z;
+      h.cost_after.push_back(cost);
+      --alive;
+
+      // z inherits the neighbours of x and y.
+      std::vector<int32_t> around;
+      for (int32_t side : {e.x, e.y})
+        for (auto [it, end] = boost::adjacent_vertices(side, graph); it != end; ++it)
+          if (static_cast<int32_t>(*it) != e.x && static_cast<int32_t>(*it) != e.y)
+            around.push_back(static_cast<int32_t>(*it));
+      std::sort(around.begin(), around.end());
+      around.erase(std::unique(around.begin(), around.end()), around.end());
+      boost::clear_vertex(e.x, graph);
+      boost::clear_vertex(e.y, graph);
+      pvs_[e.x] = {};
+      pvs_[e.y] = {};
+      fresh.clear();
+      for (int32_t n : around) {
+        boost::add_edge(n, z, graph);
+        fresh.push_back({0.0, n, z});
+      }
+      evaluate(h, fresh);
+      for (const Entry& f : fresh) queue.push(f);
+      if (config.show_progress) progress.advance(1);
+    }
+    if (config.show_progress) progress.finish();
+    h.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return h;
+  }
+
+ private:
+  /// r(PVS) of a cell with bounding box `bounds`.
+  double pvs_cost(const std::vector<uint32_t>& pvs, const Box3& bounds) const {
+    double c = 0;
+    if (!model_.pixel_term()) {
+      for (uint32_t o : pvs) c += r_[o];
+      return c;
+    }
+    const std::vector<Vec3> points = pixel_estimation_points(bounds);
+    for (uint32_t o : pvs) c += cell_object_cost(scene_.objects[o], r_[o], points, model_);
+    return c;
+  }
+
+  static std::vector<uint32_t> unite(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+    std::vector<uint32_t> u;
+    u.reserve(a.size() + b.size());
+    std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(u));
+    return u;
+  }
+
+  /// delta(x, y) for every entry.
+  void evaluate(MergeHistory& h, std::vector<Entry>& entries) {
+    const size_t grain = entries.size() > 64 ? 16 : entries.size() + 1;  // small sets: no tasks
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, entries.size(), grain), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i < r.end(); ++i) entries[i].delta = delta(h, entries[i].x, entries[i].y);
+    });
+    h.stats.evaluations += entries.size();
+  }
+
+  double delta(const MergeHistory& h, int32_t x, int32_t y) const {
+    const MergeNode &nx = h.nodes[x], &ny = h.nodes[y];
+    const std::vector<uint32_t>&a = pvs_[x], &b = pvs_[y];
+    double merged;
+    if (!model_.pixel_term()) {
+      // r(x + y) = r(x) + r(y) - r(x n y): only the common objects need visiting.
+      double common = 0;
+      auto i = a.begin(), j = b.begin();
+      while (i != a.end() && j != b.end()) {
+        if (*i < *j) {
+          ++i;
+        } else if (*j < *i) {
+          ++j;
+        } else {
+          common += r_[*i];
+          ++i, ++j;
+        }
+      }
+      merged = nx.pvs_cost + ny.pvs_cost - common;
+    } else {
+      Box3 bounds = nx.bounds;
+      bounds.extend(ny.bounds);
+      merged = pvs_cost(unite(a, b), bounds);
+    }
+    return ((nx.weight + ny.weight) * merged - nx.weight * nx.pvs_cost - ny.weight * ny.pvs_cost) / W_;
+  }
+
+  const Scene& scene_;
+  const CellPartition& p_;
+  const CostModel& model_;
+  const std::vector<double> r_;
+  double W_ = 1;
+  std::vector<std::vector<uint32_t>> pvs_;  ///< per MHT node, while it is a current cell
+};
+
+ViewCellSet make_set(const MergeHistory& h, size_t k, std::string rule) {
+  ViewCellSet set;
+  set.cells = h.cut_after(k);
+  set.cost = h.cost_with(h.leaf_count - k);
+  for (int32_t c : set.cells) {
+    set.pvs_entries += h.nodes[c].pvs_size;
+    set.pvs_bytes += approx_pvs_bytes(h.nodes[c].pvs_size);
+  }
+  set.rule = std::move(rule);
+  return set;
+}
+
+}  // namespace
+
+MergeHistory merge_cells(const Scene& scene, const CellPartition& partition, const CostModel& model,
+                         const MergeConfig& config) {
+  const size_t L = partition.size();
+  if (L == 0) throw Error("nothing to merge: the partition has no cells");
+  if (partition.volume.size() != L || partition.bounds.size() != L || partition.pvs.size() != L)
+    throw Error("the partition's per-cell arrays differ in length");
+  for (size_t i = 0; i < L; ++i) {
+    if (!(partition.weight[i] >= 0) || !std::isfinite(partition.weight[i]))
+      throw Error("cell " + std::to_string(i) + " has an invalid weight");
+    for (size_t k = 0; k < partition.pvs[i].size(); ++k)
+      if (partition.pvs[i][k] >= scene.objects.size() || (k && partition.pvs[i][k] <= partition.pvs[i][k - 1]))
+        throw Error("the PVS of cell " + std::to_string(i) + " is not a sorted list of the scene's objects");
+  }
+  for (const auto& [a, b] : partition.neighbours)
+    if (a >= L || b >= L) throw Error("a neighbour pair names a cell that does not exist");
+  model.validate();
+  return Merger(scene, partition, model).run(config);
+}
+
+ViewCellSet extract_by_count(const MergeHistory& h, size_t count) {
+  if (count < h.min_cells() || count > h.leaf_count)
+    throw Error("cannot extract " + std::to_string(count) + " cells: the merge history holds " +
+                std::to_string(h.min_cells()) + " to " + std::to_string(h.leaf_count));
+  return make_set(h, h.leaf_count - count, "exactly " + std::to_string(count) + " cells");
+}
+
+ViewCellSet extract_by_memory(const MergeHistory& h, uint64_t bytes) {
+  // Start from the coarsest cut and undo merges, the last first, while the budget allows.
+  size_t k = h.merges();
+  uint64_t used = 0;
+  for (int32_t c : h.cut_after(k)) used += approx_pvs_bytes(h.nodes[c].pvs_size);
+  if (used > bytes)
+    throw Error("a PVS budget of " + std::to_string(bytes) + " bytes is too small: the coarsest " +
+                std::to_string(h.min_cells()) + " cell(s) need " + std::to_string(used));
+  while (k > 0) {
+    const MergeNode& m = h.nodes[h.leaf_count + k - 1];
+    const uint64_t next = used - approx_pvs_bytes(m.pvs_size) + approx_pvs_bytes(h.nodes[m.child[0]].pvs_size) +
+                          approx_pvs_bytes(h.nodes[m.child[1]].pvs_size);
+    if (next > bytes) break;
+    used = next;
+    --k;
+  }
+  ViewCellSet set = make_set(h, k, "most cells within " + std::to_string(bytes) + " bytes of PVS");
+  VC_CHECK(set.pvs_bytes == used);
+  return set;
+}
+
+ViewCellSet extract_by_cost_ratio(const MergeHistory& h, double ratio) {
+  if (!(ratio >= 1.0) || !std::isfinite(ratio)) throw Error("the cost ratio must be a number >= 1");
+  const double limit = ratio * h.initial_cost;
+  size_t k = 0;  // the most merges whose cost stays within the limit
+  for (size_t j = 1; j <= h.merges(); ++j)
+    if (h.cost_after[j - 1] <= limit) k = j;
+  return make_set(h, k, "fewest cells within " + std::to_string(ratio) + " x the cost of the elementary cells");
+}
+
+}  // namespace viewcells
