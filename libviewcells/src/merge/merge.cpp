@@ -42,6 +42,68 @@ CellPartition partition_from_subdivision(const Subdivision& s, const std::vector
   return p;
 }
 
+CellPartition grid_partition(const SegmentSet& segs, int nx, int ny, int nz) {
+  if (nx < 1 || ny < 1 || nz < 1) throw Error("a grid needs at least one cell along each axis");
+  const Box3 box = segs.view_box;
+  if (!(box.volume() > 0)) throw Error("the segments' view box has no volume");
+  const int n[3] = {nx, ny, nz};
+  const Vec3 e = box.extent();
+  auto cell_box = [&](int i, int j, int k) {
+    const int c[3] = {i, j, k};
+    Box3 b;
+    for (int a = 0; a < 3; ++a) {
+      b.lo[a] = box.lo[a] + e[a] * c[a] / n[a];
+      b.hi[a] = c[a] + 1 == n[a] ? box.hi[a] : box.lo[a] + e[a] * (c[a] + 1) / n[a];
+    }
+    return b;
+  };
+  auto index = [&](int i, int j, int k) { return static_cast<uint32_t>((k * ny + j) * nx + i); };
+  CellPartition p;
+  const size_t cells = static_cast<size_t>(nx) * ny * nz;
+  p.weight.resize(cells);
+  p.volume.resize(cells);
+  p.bounds.resize(cells);
+  p.pvs.resize(cells);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const uint32_t c = index(i, j, k);
+        p.bounds[c] = cell_box(i, j, k);
+        p.volume[c] = p.weight[c] = p.bounds[c].volume();
+        if (i + 1 < nx) p.neighbours.emplace_back(c, index(i + 1, j, k));
+        if (j + 1 < ny) p.neighbours.emplace_back(c, index(i, j + 1, k));
+        if (k + 1 < nz) p.neighbours.emplace_back(c, index(i, j, k + 1));
+      }
+  std::sort(p.neighbours.begin(), p.neighbours.end());
+  // Each segment goes to the cells its bounding box overlaps in which it has positive length.
+  const double tol = 1e-12 * box.diagonal();
+  for (size_t s = 0; s < segs.size(); ++s) {
+    const Vec3 a = segs.a(s), b = segs.b(s);
+    int lo[3], hi[3];
+    for (int ax = 0; ax < 3; ++ax) {
+      auto cell_of = [&](double x) {
+        return std::clamp(static_cast<int>(std::floor((x - box.lo[ax]) / e[ax] * n[ax])), 0, n[ax] - 1);
+      };
+      lo[ax] = cell_of(std::min(a[ax], b[ax]));
+      hi[ax] = cell_of(std::max(a[ax], b[ax]));
+    }
+    for (int k = lo[2]; k <= hi[2]; ++k)
+      for (int j = lo[1]; j <= hi[1]; ++j)
+        for (int i = lo[0]; i <= hi[0]; ++i) {
+          double t0, t1;
+          if (!clip_line_to_box(p.bounds[index(i, j, k)], a, b - a, t0, t1)) continue;
+          if ((std::min(t1, 1.0) - std::max(t0, 0.0)) * length(b - a) <= tol) continue;
+          for (uint32_t o : {segs.object_a[s], segs.object_b[s]})
+            if (o != kNoObject) p.pvs[index(i, j, k)].push_back(o);
+        }
+  }
+  for (auto& v : p.pvs) {
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+  }
+  return p;
+}
+
 double MergeHistory::cost_with(size_t cells) const {
   VC_CHECK(cells >= min_cells() && cells <= leaf_count);
   const size_t k = leaf_count - cells;

@@ -15,6 +15,7 @@
 #include "viewcells/bsp/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/core/vec3.h"
+#include "viewcells/sampling/segments.h"
 #include "viewcells/scene/scene.h"
 
 namespace viewcells {
@@ -33,6 +34,11 @@ struct CellPartition {
 /// The leaves of `s` as a partition, in the order of s.leaves(); `leaf_pvs` is per node
 /// (subdivision_io.h: leaf_pvs). Needs the leaf cells (s.cells) for the neighbours.
 CellPartition partition_from_subdivision(const Subdivision& s, const std::vector<std::vector<uint32_t>>& leaf_pvs);
+
+/// A uniform nx x ny x nz grid over segments.view_box as a partition (the simplest kD
+/// partition: a baseline, and a test that merging takes any partition). A cell's PVS is the
+/// objects of the segments with positive length inside it; neighbours share a face.
+CellPartition grid_partition(const SegmentSet& segments, int nx, int ny, int nz);
 
 struct MergeNode {
   int32_t child[2] = {-1, -1};  ///< -1 for an elementary cell

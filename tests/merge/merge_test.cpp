@@ -1,0 +1,260 @@
+// Merging, the merge history tree and extraction (view-cell-construction paper, 4.3 and 5.1).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/parallel.h"
+#include "viewcells/merge/merge.h"
+#include "viewcells/raycast/ray_caster.h"
+#include "viewcells/sampling/sampler.h"
+#include "viewcells/scene/generators.h"
+
+namespace viewcells {
+namespace {
+
+SegmentSet sample(const Scene& scene, uint64_t samples) {
+  const auto caster = make_embree_caster(scene);
+  SamplerConfig config;
+  config.samples = samples;
+  config.show_progress = false;
+  return sample_segments(scene, *caster, config).segments;
+}
+
+struct Fixture {
+  Scene scene;
+  SegmentSet segs;
+  Subdivision sub;
+  CellPartition partition;
+};
+
+Fixture office(uint32_t cells, int size = 2, uint64_t samples = 30000) {
+  Fixture f;
+  f.scene = generate_scene({GeneratorKind::kOffice, 1, size});
+  f.segs = sample(f.scene, samples);
+  SubdivisionConfig config;
+  config.max_cells = cells;
+  config.show_progress = false;
+  f.sub = subdivide(f.scene, f.segs, CostModel{}, config);
+  f.partition = partition_from_subdivision(f.sub, leaf_pvs(f.sub, f.segs));
+  return f;
+}
+
+MergeHistory merge(const Fixture& f, const CostModel& model = {}) {
+  MergeConfig config;
+  config.show_progress = false;
+  return merge_cells(f.scene, f.partition, model, config);
+}
+
+/// The PVS of MHT node n: the union of its elementary cells' PVSs.
+std::vector<uint32_t> union_pvs(const MergeHistory& h, const CellPartition& p, int32_t n) {
+  std::vector<uint32_t> u;
+  for (uint32_t leaf : h.leaves_under(n)) u.insert(u.end(), p.pvs[leaf].begin(), p.pvs[leaf].end());
+  std::sort(u.begin(), u.end());
+  u.erase(std::unique(u.begin(), u.end()), u.end());
+  return u;
+}
+
+/// c(S) of a set of MHT nodes, recomputed from scratch (uniform density, c = 0).
+double cost_from_scratch(const Scene& scene, const MergeHistory& h, const CellPartition& p,
+                         const std::vector<int32_t>& cells) {
+  const std::vector<double> r = per_object_costs(scene, CostModel{});
+  double total_weight = 0;
+  for (double w : p.weight) total_weight += w;
+  double c = 0;
+  for (int32_t n : cells) {
+    double weight = 0, pvs = 0;
+    for (uint32_t leaf : h.leaves_under(n)) weight += p.weight[leaf];
+    for (uint32_t o : union_pvs(h, p, n)) pvs += r[o];
+    c += weight / total_weight * pvs;
+  }
+  return c;
+}
+
+/// The cells tile the view space: their elementary cells are every leaf exactly once.
+void expect_tiling(const MergeHistory& h, const CellPartition& p, const std::vector<int32_t>& cells) {
+  std::vector<int> seen(h.leaf_count, 0);
+  double volume = 0;
+  for (int32_t n : cells) {
+    for (uint32_t leaf : h.leaves_under(n)) ++seen[leaf];
+    volume += h.nodes[n].volume;
+  }
+  for (uint32_t l = 0; l < h.leaf_count; ++l) ASSERT_EQ(seen[l], 1) << "leaf " << l;
+  double total = 0;
+  for (double v : p.volume) total += v;
+  EXPECT_NEAR(volume / total, 1.0, 1e-9);
+}
+
+TEST(Merge, HistoryIsMonotoneAndMatchesRecomputedCosts) {
+  const Fixture f = office(120);
+  const MergeHistory h = merge(f);
+  ASSERT_EQ(h.leaf_count, 120u);
+  ASSERT_EQ(h.merges(), 119u) << "the BSP's neighbour graph is connected";
+  EXPECT_EQ(h.min_cells(), 1u);
+  EXPECT_NEAR(h.initial_cost, f.sub.cost(), 1e-9 * h.initial_cost) << "leaves cost what the subdivision said";
+  double previous = h.initial_cost;
+  for (size_t k = 0; k < h.merges(); ++k) {
+    EXPECT_GE(h.cost_after[k], previous - 1e-12 * h.initial_cost) << "merge " << k;
+    previous = h.cost_after[k];
+  }
+  for (size_t k : {0ul, 1ul, 30ul, 90ul, 118ul, 119ul}) {
+    const std::vector<int32_t> cut = h.cut_after(k);
+    ASSERT_EQ(cut.size(), h.leaf_count - k);
+    expect_tiling(h, f.partition, cut);
+    const double expected = cost_from_scratch(f.scene, h, f.partition, cut);
+    EXPECT_NEAR(h.cost_with(cut.size()), expected, 1e-9 * expected) << k << " merges";
+    for (int32_t n : cut) EXPECT_EQ(h.nodes[n].pvs_size, union_pvs(h, f.partition, n).size());
+  }
+  // The root sees everything any cell sees; its cost is the single cell's.
+  const int32_t root = static_cast<int32_t>(h.nodes.size() - 1);
+  EXPECT_EQ(h.nodes[root].parent, -1);
+  EXPECT_NEAR(h.cost_after.back(), f.sub.initial_cost, 1e-9 * f.sub.initial_cost);
+}
+
+/// Every merge is the cheapest one among the neighbouring pairs of the cells at that point
+/// (checked against all pairs, with neighbours recomputed from the elementary cells).
+TEST(Merge, EachMergeIsTheCheapestNeighbouringPair) {
+  const Fixture f = office(40, 1, 15000);
+  const MergeHistory h = merge(f);
+  const std::vector<double> r = per_object_costs(f.scene, CostModel{});
+  double W = 0;
+  for (double w : f.partition.weight) W += w;
+  for (size_t k = 0; k < h.merges(); ++k) {
+    const std::vector<int32_t> cut = h.cut_after(k);
+    std::vector<int32_t> owner(h.leaf_count);
+    for (int32_t n : cut)
+      for (uint32_t leaf : h.leaves_under(n)) owner[leaf] = n;
+    auto weight = [&](int32_t n) { return h.nodes[n].weight; };
+    auto rcost = [&](const std::vector<uint32_t>& pvs) {
+      double c = 0;
+      for (uint32_t o : pvs) c += r[o];
+      return c;
+    };
+    double best = INFINITY;
+    for (const auto& [a, b] : f.partition.neighbours) {
+      const int32_t x = owner[a], y = owner[b];
+      if (x == y) continue;
+      std::vector<uint32_t> u = union_pvs(h, f.partition, x);
+      const std::vector<uint32_t> py = union_pvs(h, f.partition, y);
+      u.insert(u.end(), py.begin(), py.end());
+      std::sort(u.begin(), u.end());
+      u.erase(std::unique(u.begin(), u.end()), u.end());
+      const double delta = ((weight(x) + weight(y)) * rcost(u) - weight(x) * rcost(union_pvs(h, f.partition, x)) -
+                            weight(y) * rcost(py)) / W;
+      best = std::min(best, delta);
+    }
+    const double done = h.cost_after[k] - h.cost_with(h.leaf_count - k);
+    EXPECT_NEAR(done, best, 1e-9 * h.initial_cost) << "merge " << k;
+  }
+}
+
+TEST(Merge, ExtractionByCountMemoryAndCostRatio) {
+  const Fixture f = office(150);
+  const MergeHistory h = merge(f);
+  for (size_t n : {1ul, 2ul, 17ul, 100ul, 150ul}) {
+    const ViewCellSet set = extract_by_count(h, n);
+    ASSERT_EQ(set.cells.size(), n);
+    expect_tiling(h, f.partition, set.cells);
+    EXPECT_DOUBLE_EQ(set.cost, h.cost_with(n));
+  }
+  EXPECT_THROW(extract_by_count(h, 0), Error);
+  EXPECT_THROW(extract_by_count(h, 151), Error);
+
+  // Memory: never over the budget, and growing with it.
+  const uint64_t finest = extract_by_count(h, 150).pvs_bytes, coarsest = extract_by_count(h, 1).pvs_bytes;
+  size_t previous_cells = 0;
+  for (uint64_t budget = coarsest; budget <= finest + 1000; budget += (finest - coarsest) / 13 + 1) {
+    const ViewCellSet set = extract_by_memory(h, budget);
+    EXPECT_LE(set.pvs_bytes, budget);
+    uint64_t bytes = 0;
+    for (int32_t c : set.cells) bytes += approx_pvs_bytes(static_cast<uint32_t>(union_pvs(h, f.partition, c).size()));
+    EXPECT_EQ(bytes, set.pvs_bytes);
+    EXPECT_GE(set.cells.size(), previous_cells);
+    previous_cells = set.cells.size();
+    expect_tiling(h, f.partition, set.cells);
+  }
+  EXPECT_EQ(previous_cells, 150u) << "a budget above the finest set's needs takes every cell";
+  EXPECT_THROW(extract_by_memory(h, coarsest - 1), Error);
+
+  // Cost ratio: within the ratio, and one cell fewer would not be.
+  for (double ratio : {1.0, 1.05, 1.5, 3.0, 100.0}) {
+    const ViewCellSet set = extract_by_cost_ratio(h, ratio);
+    EXPECT_LE(set.cost, ratio * h.initial_cost);
+    if (set.cells.size() > h.min_cells()) EXPECT_GT(h.cost_with(set.cells.size() - 1), ratio * h.initial_cost);
+    expect_tiling(h, f.partition, set.cells);
+  }
+  EXPECT_EQ(extract_by_cost_ratio(h, 1e9).cells.size(), 1u);
+  EXPECT_THROW(extract_by_cost_ratio(h, 0.5), Error);
+}
+
+TEST(Merge, MergesAGridPartition) {
+  Fixture f;
+  f.scene = generate_scene({GeneratorKind::kOffice, 1, 2});
+  f.segs = sample(f.scene, 30000);
+  f.partition = grid_partition(f.segs, 6, 5, 3);
+  ASSERT_EQ(f.partition.size(), 90u);
+  EXPECT_EQ(f.partition.neighbours.size(), 5u * 5 * 3 + 6 * 4 * 3 + 6 * 5 * 2);
+  // A grid cell's PVS: the objects of the segments with length inside it (checked for one).
+  const MergeHistory h = merge(f);
+  EXPECT_EQ(h.merges(), 89u);
+  for (size_t k : {0ul, 45ul, 89ul}) {
+    const std::vector<int32_t> cut = h.cut_after(k);
+    expect_tiling(h, f.partition, cut);
+    const double expected = cost_from_scratch(f.scene, h, f.partition, cut);
+    EXPECT_NEAR(h.cost_with(cut.size()), expected, 1e-9 * expected);
+  }
+  // The grid is coarse where AV-S adapts: at equal cell count AV-S + merging costs less.
+  const Fixture ours = office(90);
+  const MergeHistory ho = merge(ours);
+  EXPECT_LT(ho.cost_with(30), h.cost_with(30));
+}
+
+TEST(Merge, IdenticalForOneAndTwoThreads) {
+  const Fixture f = office(80);
+  MergeHistory one;
+  {
+    ThreadLimit limit(1);
+    one = merge(f);
+  }
+  const MergeHistory two = merge(f);
+  ASSERT_EQ(one.nodes.size(), two.nodes.size());
+  for (size_t n = 0; n < one.nodes.size(); ++n) {
+    EXPECT_EQ(one.nodes[n].child[0], two.nodes[n].child[0]);
+    EXPECT_EQ(one.nodes[n].child[1], two.nodes[n].child[1]);
+  }
+  EXPECT_EQ(one.cost_after, two.cost_after);
+}
+
+TEST(Merge, PixelTermMergesWithCellCosts) {
+  const Fixture f = office(60);
+  CostModel pixel{100, 1, 0.01};
+  const MergeHistory h = merge(f, pixel);
+  EXPECT_EQ(h.merges(), 59u);
+  // A merged cell's cost is the model's for its bounds and the union of its PVS.
+  const std::vector<double> base = per_object_costs(f.scene, pixel);
+  for (size_t n = h.leaf_count; n < h.nodes.size(); n += 7) {
+    const std::vector<Vec3> points = pixel_estimation_points(h.nodes[n].bounds);
+    double c = 0;
+    for (uint32_t o : union_pvs(h, f.partition, static_cast<int32_t>(n)))
+      c += cell_object_cost(f.scene.objects[o], base[o], points, pixel);
+    EXPECT_NEAR(h.nodes[n].pvs_cost, c, 1e-9 * c);
+  }
+  EXPECT_GT(h.cost_after.back(), h.initial_cost);
+}
+
+TEST(Merge, BadInput) {
+  const Fixture f = office(10, 1, 5000);
+  CellPartition p = f.partition;
+  p.pvs[3] = {5, 2};
+  EXPECT_THROW(merge_cells(f.scene, p, CostModel{}), Error);
+  p = f.partition;
+  p.neighbours.push_back({0, 99});
+  EXPECT_THROW(merge_cells(f.scene, p, CostModel{}), Error);
+  EXPECT_THROW(merge_cells(f.scene, CellPartition{}, CostModel{}), Error);
+  EXPECT_THROW(grid_partition(f.segs, 0, 1, 1), Error);
+}
+
+}  // namespace
+}  // namespace viewcells
