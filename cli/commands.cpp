@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -17,6 +18,8 @@
 #include "viewcells/core/progress.h"
 #include "viewcells/io/binary_file.h"
 #include "viewcells/io/scene_io.h"
+#include "viewcells/merge/merge.h"
+#include "viewcells/pvs/pvs.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
 #include "viewcells/scene/generators.h"
@@ -347,6 +350,7 @@ struct BuildArgs {
   uint32_t max_cells = 1000;
   bool no_ga = false;
   bool ga = false;
+  bool no_merge = false;
   uint32_t ga_candidates = 150;
   uint32_t axis_candidates = 200;
   double min_reduction = 1e-6;
@@ -381,14 +385,14 @@ HeightBandDensity parse_density_band(const std::string& text) {
 }
 
 void write_views(const Subdivision& s, const Scene* scene, const std::string& mesh, const std::string& png,
-                 double slice_z, int width, const Common& c) {
+                 double slice_z, int width, const Common& c, const CellView* view = nullptr) {
   if (!mesh.empty()) {
-    write_cells_ply(mesh, s);
+    write_cells_ply(mesh, s, view);
     c.log("viewcells: cells -> " + mesh + " (coloured by render cost)");
   }
   if (!png.empty()) {
     const double z = std::isnan(slice_z) ? 0.5 * (s.view_box.lo.z + s.view_box.hi.z) : slice_z;
-    write_slice_png(png, s, z, width, scene);
+    write_slice_png(png, s, z, width, scene, view);
     c.log("viewcells: slice at z = " + fmt(z, 3) + " -> " + png);
   }
 }
@@ -423,12 +427,22 @@ int run_build(const SampleArgs& a, const BuildArgs& b, const Common& c) {
   c.log("viewcells: " + std::to_string(sub.leaf_count()) + " cells in " + fmt(sub.stats.seconds, 2) +
         " s, render cost " + fmt(sub.initial_cost, 1) + " -> " + fmt(sub.cost(), 1) + " (" + sub.stats.stop_reason + ")");
 
-  Stopwatch sw;
   SubdivisionFile file;
   file.leaf_pvs = leaf_pvs(sub, s.result.segments);
+  if (!b.no_merge) {
+    MergeConfig mc;
+    mc.show_progress = !c.quiet;
+    c.log("viewcells: merging " + std::to_string(sub.leaf_count()) + " cells into a merge history");
+    file.history = merge_cells(s.scene, partition_from_subdivision(sub, file.leaf_pvs), model, mc);
+    c.log("viewcells: merged in " + fmt(file.history->stats.seconds, 2) + " s (" +
+          std::to_string(file.history->stats.evaluations) + " pair costs, " +
+          std::to_string(file.history->stats.stale) + " stale queue entries skipped)");
+  }
+  Stopwatch sw;
   file.cost_model = model;
   file.scene_fingerprint = s.scene.fingerprint();
   file.object_count = static_cast<uint32_t>(s.scene.object_count());
+  for (const ObjectInfo& o : s.scene.objects) file.object_names.push_back(o.name);
   if (!b.output.empty()) {
     file.subdivision = sub;
     file.subdivision.segments.clear();
@@ -471,6 +485,20 @@ int run_build(const SampleArgs& a, const BuildArgs& b, const Common& c) {
                            {"geometry_candidates_evaluated", sub.stats.geometry_candidates},
                            {"stop_reason", sub.stats.stop_reason}};
   report["final_cost"] = sub.cost();
+  if (file.history) {
+    const MergeHistory& h = *file.history;
+    json merged = json::array();
+    for (size_t cells = 1; cells <= h.leaf_count; cells *= 2)
+      if (cells >= h.min_cells()) merged.push_back({{"cells", cells}, {"cost", h.cost_with(cells)}});
+    report["merge"] = {{"cells_from", h.leaf_count},
+                       {"cells_to", h.min_cells()},
+                       {"cost_at_power_of_two_cells", merged},
+                       {"pair_costs_evaluated", h.stats.evaluations},
+                       {"stale_entries_skipped", h.stats.stale}};
+    report["timings"]["merge_seconds"] = h.stats.seconds;
+  }
+  report["effects"]["merging"] = b.no_merge ? json{{"enabled", false}, {"reason", "--no-merge"}}
+                                            : json{{"enabled", true}, {"reason", "default: the merge history is built"}};
   report["timings"]["subdivision_seconds"] = sub.stats.seconds;
   report["timings"]["write_seconds"] = write_s;
   report["timings"]["export_seconds"] = views_s;
@@ -505,13 +533,223 @@ int run_export(const ExportArgs& e, const Common& c) {
   return 0;
 }
 
+// ---------------------------------------------------------------- extract, compress, query
+
+/// "123", "64K", "2M", "1G" (powers of 1024) -> bytes.
+uint64_t parse_bytes(const std::string& text) {
+  size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  std::string unit = text.substr(used);
+  double scale = 1;
+  if (unit == "K" || unit == "k" || unit == "KB") scale = 1024.0;
+  else if (unit == "M" || unit == "MB") scale = 1024.0 * 1024;
+  else if (unit == "G" || unit == "GB") scale = 1024.0 * 1024 * 1024;
+  else if (!unit.empty() && unit != "B") used = 0;
+  if (used == 0 || !(v >= 0) || !std::isfinite(v * scale) || v * scale > 1e18)
+    throw Error("--memory needs a size in bytes, e.g. 65536, 64K, 2M or 1G (got '" + text + "')");
+  return static_cast<uint64_t>(v * scale);
+}
+
+struct CutArgs {
+  uint32_t count = 0;
+  std::string memory;
+  double cost_ratio = 0;
+};
+
+void add_cut_options(CLI::App* app, CutArgs& a) {
+  app->add_option("--count", a.count, "Exactly this many view cells")->check(CLI::PositiveNumber);
+  app->add_option("--memory", a.memory,
+                  "The most view cells whose approximate PVS storage fits this budget (bytes; K, M, G allowed)");
+  app->add_option("--cost-ratio", a.cost_ratio,
+                  "The fewest view cells whose render cost is within this ratio (>= 1) of the elementary cells'");
+}
+
+/// The view cells a cut rule asks for; `fallback_all` takes every elementary cell when no rule
+/// is given (compress), else a rule is required (extract).
+ViewCellSet choose_cells(const MergeHistory& h, const CutArgs& a, bool fallback_all) {
+  const int rules = (a.count > 0) + !a.memory.empty() + (a.cost_ratio != 0);
+  if (rules > 1) throw Error("give only one of --count, --memory and --cost-ratio");
+  if (a.count > 0) return extract_by_count(h, a.count);
+  if (!a.memory.empty()) return extract_by_memory(h, parse_bytes(a.memory));
+  if (a.cost_ratio != 0) return extract_by_cost_ratio(h, a.cost_ratio);
+  if (!fallback_all) throw Error("say which cells: --count N, --memory BYTES or --cost-ratio R");
+  return extract_by_count(h, h.leaf_count);
+}
+
+SubdivisionFile read_merged(const std::string& path) {
+  SubdivisionFile file = read_subdivision(path);
+  if (!file.history)
+    throw Error(path, 0, "no merge history in this file (it was built with --no-merge, or by an older version)");
+  return file;
+}
+
+struct ExtractArgs {
+  std::string input, output, mesh, png, scene;
+  CutArgs cut;
+  double slice_z = NAN;
+  int width = 1024;
+};
+
+int run_extract(const ExtractArgs& e, const Common& c) {
+  SubdivisionFile file = read_merged(e.input);
+  const MergeHistory& h = *file.history;
+  const ViewCellSet set = choose_cells(h, e.cut, false);
+  const std::vector<int32_t> leaves = file.subdivision.leaves();
+  c.log("viewcells: " + std::to_string(set.cells.size()) + " view cells (" + set.rule + "), render cost " +
+        fmt(set.cost, 1) + " (elementary cells: " + fmt(h.initial_cost, 1) + "), approximate PVS " +
+        std::to_string(set.pvs_bytes) + " bytes");
+  json cells = json::array();
+  for (size_t i = 0; i < set.cells.size(); ++i) {
+    const MergeNode& n = h.nodes[set.cells[i]];
+    json bsp_leaves = json::array();
+    for (uint32_t l : h.leaves_under(set.cells[i])) bsp_leaves.push_back(leaves[l]);
+    cells.push_back({{"id", i},
+                     {"merge_node", set.cells[i]},
+                     {"bsp_leaves", bsp_leaves},
+                     {"volume", n.volume},
+                     {"bounds", {{"min", {n.bounds.lo.x, n.bounds.lo.y, n.bounds.lo.z}},
+                                 {"max", {n.bounds.hi.x, n.bounds.hi.y, n.bounds.hi.z}}}},
+                     {"pvs_size", n.pvs_size},
+                     {"pvs_cost", n.pvs_cost}});
+  }
+  json out = {{"command", "extract"},
+              {"input", e.input},
+              {"rule", set.rule},
+              {"cells", set.cells.size()},
+              {"cost", set.cost},
+              {"cost_of_elementary_cells", h.initial_cost},
+              {"cost_ratio", set.cost / h.initial_cost},
+              {"pvs_entries", set.pvs_entries},
+              {"approximate_pvs_bytes", set.pvs_bytes},
+              {"view_cells", cells}};
+  if (!e.output.empty()) {
+    write_json(e.output, out);
+    c.log("viewcells: view cells -> " + e.output);
+  }
+  if (!e.mesh.empty() || !e.png.empty()) {
+    rebuild_cells(file.subdivision);
+    const CellView view = merged_cell_view(file.subdivision, h, set.cells);
+    std::unique_ptr<Scene> scene;
+    if (!e.scene.empty()) scene = std::make_unique<Scene>(load_scene(e.scene));
+    write_views(file.subdivision, scene.get(), e.mesh, e.png, e.slice_z, e.width, c, &view);
+  }
+  if (e.output.empty() && e.mesh.empty() && e.png.empty()) std::cout << out.dump(2) << '\n';
+  return 0;
+}
+
+struct CompressArgs {
+  std::string input, output, flat, report;
+  CutArgs cut;
+};
+
+int run_compress(const CompressArgs& a, const Common& c) {
+  SubdivisionFile file = read_merged(a.input);
+  const MergeHistory& h = *file.history;
+  const ViewCellSet set = choose_cells(h, a.cut, true);
+  Stopwatch sw;
+  PvsFile pf = make_pvs_file(file.subdivision, file.leaf_pvs, h, set.cells);
+  pf.object_count = file.object_count;
+  pf.object_names = file.object_names;
+  pf.scene_fingerprint = file.scene_fingerprint;
+  pf.rule = set.rule;
+  const double compress_s = sw.seconds();
+  // Sizes before (every cell lists its whole PVS) and after (each node keeps its part).
+  std::vector<std::vector<uint32_t>> flat(pf.pvs.cell_count);
+  uint64_t before = 0;
+  for (uint32_t i = 0; i < pf.pvs.cell_count; ++i) {
+    flat[i] = pf.pvs.cell_pvs(i);
+    before += flat[i].size();
+  }
+  const uint64_t after = pf.pvs.stored_entries();
+  const uint64_t varint_before = varint_bytes(flat), varint_after = varint_bytes(pf.pvs.stored);
+  write_pvs(a.output, pf);
+  // Check what was written: read back, every cell's PVS must come back exactly.
+  const PvsFile back = read_pvs(a.output);
+  for (uint32_t i = 0; i < back.pvs.cell_count; ++i)
+    if (back.pvs.cell_pvs(i) != flat[i]) throw Error(a.output, 0, "read-back check failed for cell " + std::to_string(i));
+  const uint64_t file_bytes = std::filesystem::file_size(a.output);
+  c.log("viewcells: " + std::to_string(pf.pvs.cell_count) + " view cells (" + set.rule + "): " +
+        std::to_string(before) + " PVS entries -> " + std::to_string(after) + " kept in " +
+        std::to_string(pf.pvs.node_count()) + " hierarchy nodes (" + fmt(before ? double(after) / before : 1.0, 3) +
+        "); " + a.output + ": " + std::to_string(file_bytes) + " bytes");
+  json report = {{"command", "compress"},
+                 {"input", a.input},
+                 {"output", a.output},
+                 {"rule", set.rule},
+                 {"cells", pf.pvs.cell_count},
+                 {"objects", pf.object_count},
+                 {"hierarchy_nodes", pf.pvs.node_count()},
+                 {"entries_before", before},
+                 {"entries_after", after},
+                 {"entry_ratio", before ? double(after) / before : 1.0},
+                 {"raw_bytes_before", 4 * before},
+                 {"raw_bytes_after", 4 * after},
+                 {"varint_bytes_before", varint_before},
+                 {"varint_bytes_after", varint_after},
+                 {"file_bytes", file_bytes},
+                 {"seconds", compress_s}};
+  if (!a.flat.empty()) {
+    const uint64_t rle = write_flat_rows(a.flat, pf);
+    const uint64_t rows = static_cast<uint64_t>(pf.pvs.cell_count) * ((pf.object_count + 7) / 8);
+    report["flat"] = {{"file", a.flat}, {"bit_row_bytes", rows}, {"run_length_bytes", rle},
+                      {"file_bytes", std::filesystem::file_size(a.flat)}};
+    c.log("viewcells: flat rows -> " + a.flat + ": " + std::to_string(rows) + " bytes of bit rows, " +
+          std::to_string(rle) + " run-length coded (Quake style)");
+  }
+  if (!a.report.empty()) {
+    write_json(a.report, report);
+    c.log("viewcells: report -> " + a.report);
+  }
+  return 0;
+}
+
+struct QueryArgs {
+  std::string input;
+  std::vector<double> point;
+  bool json_out = false;
+};
+
+int run_query(const QueryArgs& q, const Common&) {
+  const PvsFile f = read_pvs(q.input);
+  if (q.point.size() != 3) throw Error("query needs a point: X Y Z");
+  const Vec3 p{q.point[0], q.point[1], q.point[2]};
+  if (!is_finite(p)) throw Error("query point has non-finite coordinates");
+  const int32_t cell = f.locate(p);
+  if (cell < 0)
+    throw Error("(" + fmt(p.x, 3) + ", " + fmt(p.y, 3) + ", " + fmt(p.z, 3) + ") is outside the view space");
+  const std::vector<uint32_t> pvs = f.pvs.cell_pvs(static_cast<uint32_t>(cell));
+  auto name = [&](uint32_t o) { return f.object_names.empty() ? std::string() : f.object_names[o]; };
+  if (q.json_out) {
+    json objects = json::array();
+    for (uint32_t o : pvs) objects.push_back({{"id", o}, {"name", name(o)}});
+    std::cout << json{{"point", {p.x, p.y, p.z}},
+                      {"cell", cell},
+                      {"cells", f.pvs.cell_count},
+                      {"merge_node", f.cell_mht_node[cell]},
+                      {"pvs", objects}}
+                     .dump(2)
+              << '\n';
+    return 0;
+  }
+  std::cout << "cell " << cell << " of " << f.pvs.cell_count << " (" << f.rule << "): " << pvs.size() << " of "
+            << f.object_count << " objects visible\n";
+  for (uint32_t o : pvs) std::cout << "  " << o << (f.object_names.empty() ? "" : "  " + name(o)) << '\n';
+  return 0;
+}
+
 }  // namespace
 
 int run(int argc, char** argv) {
   CLI::App app{
       "viewcells: builds view cells for visibility preprocessing from the visibility of the scene itself.\n"
       "Pipeline: generate or load a scene -> sample visibility segments -> subdivide the view space\n"
-      "into cells (build) -> (merge, extract, compress PVS: coming)."};
+      "into cells and merge them into a hierarchy (build) -> cut view cells from it (extract) ->\n"
+      "write their compressed PVS (compress) -> look a viewpoint up (query)."};
   app.require_subcommand(1);
   app.fallthrough();
   Common common;
@@ -572,6 +810,7 @@ int run(int argc, char** argv) {
       ->capture_default_str();
   bc->add_option("--density-band", bld.density_band,
                  "Viewpoint density zlo,zhi[,outside]: weight 1 between the heights, outside (default 0.1) elsewhere");
+  bc->add_flag("--no-merge", bld.no_merge, "Keep the AV-S cells: no merge history (extract and compress need one)");
   bc->add_option("-o,--output", bld.output, "Hierarchy file to write (.vcells)");
   bc->add_option("--report", bld.report, "JSON report: settings, effects and why, costs, candidates, timings");
   bc->add_option("--mesh", bld.mesh, "Also write the cells as a PLY coloured by render cost");
@@ -587,6 +826,32 @@ int run(int argc, char** argv) {
   ex->add_option("--slice-z", exp.slice_z, "Height of the slice (default: middle of the view space)");
   ex->add_option("--slice-width", exp.width, "Slice image width in pixels")->capture_default_str();
   ex->add_option("--scene", exp.scene, "Draw this scene's cross-section into the slice");
+
+  ExtractArgs ext;
+  auto* xt = app.add_subcommand("extract", "Cut view cells from the merge history of a built hierarchy");
+  xt->add_option("cells", ext.input, "Hierarchy file (.vcells, built with merging)")->required();
+  add_cut_options(xt, ext.cut);
+  xt->add_option("-o,--output", ext.output, "JSON file of the view cells (default: printed)");
+  xt->add_option("--mesh", ext.mesh, "PLY of the BSP leaves coloured by their view cell's render cost");
+  xt->add_option("--slice-png", ext.png, "PNG of a horizontal slice, borders between view cells");
+  xt->add_option("--slice-z", ext.slice_z, "Height of the slice (default: middle of the view space)");
+  xt->add_option("--slice-width", ext.width, "Slice image width in pixels")->capture_default_str();
+  xt->add_option("--scene", ext.scene, "Draw this scene's cross-section into the slice");
+
+  CompressArgs cmp;
+  auto* cp = app.add_subcommand("compress",
+                                "Write the view cells' PVSs, compressed through the hierarchy, as a .pvs file");
+  cp->add_option("cells", cmp.input, "Hierarchy file (.vcells, built with merging)")->required();
+  add_cut_options(cp, cmp.cut);
+  cp->add_option("-o,--output", cmp.output, "The .pvs file to write")->required();
+  cp->add_option("--flat", cmp.flat, "Also write Quake-style run-length coded bit rows, to compare sizes");
+  cp->add_option("--report", cmp.report, "JSON report: entries and bytes before and after");
+
+  QueryArgs qry;
+  auto* qy = app.add_subcommand("query", "Print the view cell containing a point and its PVS");
+  qy->add_option("pvs", qry.input, "A .pvs file (from compress)")->required();
+  qy->add_option("point", qry.point, "X Y Z")->required()->expected(3);
+  qy->add_flag("--json", qry.json_out, "Print JSON");
 
   try {
     app.parse(argc, argv);
@@ -605,6 +870,9 @@ int run(int argc, char** argv) {
       return run_build(bsmp, bld, common);
     }
     if (*ex) return run_export(exp, common);
+    if (*xt) return run_extract(ext, common);
+    if (*cp) return run_compress(cmp, common);
+    if (*qy) return run_query(qry, common);
   } catch (const Error& e) {
     std::cerr << "viewcells: error: " << e.what() << '\n';
     return 1;

@@ -27,7 +27,7 @@ json_get() { python3 -c "import json,sys; d=json.load(open('$1')); print(eval('d
 
 # --help explains every subcommand.
 expect_ok "$VC" --help
-for sub in generate info sample build export; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
+for sub in generate info sample build export extract compress query; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
 expect_ok "$VC" sample --help
 grep -q -- "--measure-raw" out.txt && ok || bad "sample --help lacks --measure-raw"
 
@@ -117,6 +117,52 @@ expect_ok "$VC" export pixel.vcells --mesh pixel.ply -q
 expect_error "--screen" "$VC" build office.obj --samples 1000 --cost-c 1 --screen 640-480
 expect_error "field of view" "$VC" build office.obj --samples 1000 --cost-c 1 --fov 200
 expect_error "must be finite and non-negative" "$VC" build office.obj --samples 1000 --cost-c -1
+# Merging (default), extraction, compression and queries.
+python3 -c "
+import json; r=json.load(open('build.json')); m=r['merge']
+assert r['effects']['merging']['enabled'] is True
+assert m['cells_from'] == 64 and m['cells_to'] == 1
+c=[p['cost'] for p in m['cost_at_power_of_two_cells']]
+assert all(b <= a for a, b in zip(c, c[1:])), 'merged cost must fall with more cells'
+" && ok || bad "build report: merge"
+expect_ok "$VC" extract office.vcells --count 10 -o ten.json --mesh ten.ply --slice-png ten.png --slice-z 1.5 -q
+python3 -c "
+import json; r=json.load(open('ten.json'))
+assert r['cells'] == 10 and len(r['view_cells']) == 10
+leaves = sorted(l for c in r['view_cells'] for l in c['bsp_leaves'])
+assert len(leaves) == 64 and len(set(leaves)) == 64, 'the cells tile the 64 leaves'
+" && ok || bad "extract --count"
+[ -s ten.ply ] && [ -s ten.png ] && ok || bad "extract views"
+expect_ok "$VC" extract office.vcells --memory 1K -o mem.json -q
+python3 -c "
+import json; r=json.load(open('mem.json')); assert r['approximate_pvs_bytes'] <= 1024, r['approximate_pvs_bytes']
+" && ok || bad "extract --memory"
+expect_ok "$VC" extract office.vcells --cost-ratio 1.5 -o ratio.json -q
+python3 -c "
+import json; r=json.load(open('ratio.json')); assert r['cost_ratio'] <= 1.5
+" && ok || bad "extract --cost-ratio"
+expect_error "only one of" "$VC" extract office.vcells --count 3 --cost-ratio 2
+expect_error "say which cells" "$VC" extract office.vcells
+expect_error "cannot extract 65 cells" "$VC" extract office.vcells --count 65
+expect_error "--memory needs a size" "$VC" extract office.vcells --memory lots
+expect_error "too small" "$VC" extract office.vcells --memory 10
+expect_ok "$VC" compress office.vcells --count 16 -o office.pvs --flat office.vflt --report compress.json -q
+python3 -c "
+import json; r=json.load(open('compress.json'))
+assert r['cells'] == 16 and r['entries_after'] < r['entries_before'], r
+assert r['flat']['run_length_bytes'] > 0
+" && ok || bad "compress report"
+expect_ok "$VC" query office.pvs 2 2 1.5
+grep -q "^cell [0-9]* of 16" out.txt && grep -q "facade" out.txt && ok || bad "query output: $(head -3 out.txt)"
+expect_ok "$VC" query office.pvs 2 2 1.5 --json
+python3 -c "
+import json; r=json.load(open('out.txt')); assert r['cells'] == 16 and len(r['pvs']) > 0
+" && ok || bad "query --json"
+expect_error "outside the view space" "$VC" query office.pvs 1e6 0 0
+head -c 60 office.pvs > cut.pvs
+expect_error "cut.pvs" "$VC" query cut.pvs 2 2 1.5
+expect_ok "$VC" build office.obj --samples 5000 --max-cells 8 --no-merge -o nomerge.vcells -q
+expect_error "no merge history" "$VC" extract nomerge.vcells --count 2
 head -c 100 office.vcells > cut.vcells
 expect_error "cut.vcells" "$VC" export cut.vcells --mesh x.ply
 expect_error "nothing to export" "$VC" export office.vcells

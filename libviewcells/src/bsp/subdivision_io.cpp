@@ -28,8 +28,80 @@ std::vector<std::vector<uint32_t>> leaf_pvs(const Subdivision& s, const SegmentS
 
 namespace {
 constexpr char kMagic[5] = "VCEL";
-// 1: first layout; 2: adds the pixel term's screen (width, height, field of view) after c.
-constexpr uint32_t kVersion = 2;
+// 1: first layout; 2: adds the pixel term's screen (width, height, field of view) after c;
+// 3: adds the merge history and the object names at the end.
+constexpr uint32_t kVersion = 3;
+
+void put_history(ByteWriter& w, const std::optional<MergeHistory>& h) {
+  w.put<uint8_t>(h ? 1 : 0);
+  if (!h) return;
+  w.put<uint32_t>(h->leaf_count);
+  w.put<uint64_t>(h->nodes.size());
+  for (const MergeNode& n : h->nodes) {
+    w.put<int32_t>(n.child[0]);
+    w.put<int32_t>(n.child[1]);
+    w.put<int32_t>(n.parent);
+    w.put(n.weight);
+    w.put(n.volume);
+    w.put(n.bounds.lo);
+    w.put(n.bounds.hi);
+    w.put(n.pvs_cost);
+    w.put<uint32_t>(n.pvs_size);
+  }
+  w.put(h->initial_cost);
+  w.put(h->total_weight);
+  for (double c : h->cost_after) w.put(c);
+}
+
+/// Reads and checks the merge history against the subdivision's leaves and their PVSs.
+std::optional<MergeHistory> get_history(ByteReader& r, const Subdivision& s,
+                                        const std::vector<std::vector<uint32_t>>& leaf_pvs, uint64_t max_items) {
+  if (r.get<uint8_t>() == 0) return std::nullopt;
+  MergeHistory h;
+  h.leaf_count = r.get<uint32_t>();
+  const std::vector<int32_t> leaves = s.leaves();
+  if (h.leaf_count != leaves.size()) r.fail("the merge history does not match the subdivision's leaves");
+  const uint64_t nodes = r.get<uint64_t>();
+  if (nodes < h.leaf_count || nodes > 2ull * h.leaf_count - 1 || nodes > max_items) r.fail("invalid merge node count");
+  h.nodes.resize(nodes);
+  for (MergeNode& n : h.nodes) {
+    n.child[0] = r.get<int32_t>();
+    n.child[1] = r.get<int32_t>();
+    n.parent = r.get<int32_t>();
+    n.weight = r.get<double>();
+    n.volume = r.get<double>();
+    n.bounds.lo = r.get<Vec3>();
+    n.bounds.hi = r.get<Vec3>();
+    n.pvs_cost = r.get<double>();
+    n.pvs_size = r.get<uint32_t>();
+    if (!(n.weight >= 0) || !(n.volume > 0) || !(n.pvs_cost >= 0) || !std::isfinite(n.pvs_cost) ||
+        !is_finite(n.bounds.lo) || !is_finite(n.bounds.hi))
+      r.fail("invalid merge node");
+  }
+  h.initial_cost = r.get<double>();
+  h.total_weight = r.get<double>();
+  h.cost_after.resize(nodes - h.leaf_count);
+  for (double& c : h.cost_after) {
+    c = r.get<double>();
+    if (!std::isfinite(c)) r.fail("invalid cost in the merge history");
+  }
+  // Structure: leaves first; merge k is node L + k, made of two earlier nodes.
+  const int32_t L = static_cast<int32_t>(h.leaf_count);
+  for (int32_t i = 0; i < static_cast<int32_t>(nodes); ++i) {
+    const MergeNode& n = h.nodes[i];
+    const bool leaf = i < L;
+    if (leaf != (n.child[0] < 0) || leaf != (n.child[1] < 0)) r.fail("merge node " + std::to_string(i) + " is malformed");
+    if (n.parent != -1 && (n.parent <= i || n.parent >= static_cast<int32_t>(nodes) ||
+                           (h.nodes[n.parent].child[0] != i && h.nodes[n.parent].child[1] != i)))
+      r.fail("merge node " + std::to_string(i) + " has a wrong parent");
+    if (!leaf)
+      for (int32_t c : n.child)
+        if (c >= i || h.nodes[c].parent != i) r.fail("merge node " + std::to_string(i) + " has a wrong child");
+    if (leaf && n.pvs_size != leaf_pvs[leaves[i]].size()) r.fail("merge leaf " + std::to_string(i) + " has another PVS");
+  }
+  return h;
+}
+
 }  // namespace
 
 void write_subdivision(const std::string& path, const SubdivisionFile& f) {
@@ -70,6 +142,11 @@ void write_subdivision(const std::string& path, const SubdivisionFile& f) {
     w.put(r.cost_after);
   }
   for (size_t n = 0; n < s.nodes.size(); ++n) w.put_array(n < f.leaf_pvs.size() ? f.leaf_pvs[n] : std::vector<uint32_t>{});
+  put_history(w, f.history);
+  if (!f.object_names.empty() && f.object_names.size() != f.object_count)
+    throw Error(path, 0, "object names do not match the object count");
+  w.put<uint64_t>(f.object_names.size());
+  for (const std::string& n : f.object_names) w.put_string(n);
   write_container(path, kMagic, kVersion, w.data());
 }
 
@@ -131,7 +208,7 @@ SubdivisionFile read_subdivision(const std::string& path) {
   }
   f.leaf_pvs.resize(nodes);
   for (auto& pvs : f.leaf_pvs) r.get_array(pvs, max_items);
-  if (!r.at_end()) r.fail("trailing bytes");
+  const size_t history_at = r.position();
   // Structure: split k splits an existing leaf into nodes 2k+1 and 2k+2 on plane 6 + k.
   const int32_t n_nodes = static_cast<int32_t>(nodes);
   if (s.nodes[0].parent != -1) r.fail("the root has a parent");
@@ -155,6 +232,14 @@ SubdivisionFile read_subdivision(const std::string& path) {
   }
   if (planes != 6 + splits) r.fail("plane count does not match the split count");
   if (!(s.nodes[0].weight > 0)) r.fail("the view space has zero weight");
+  if (version >= 3) {
+    r.seek(history_at);
+    f.history = get_history(r, s, f.leaf_pvs, max_items);
+    const uint64_t names = r.get<uint64_t>();
+    if (names != 0 && names != f.object_count) r.fail("object names do not match the object count");
+    for (uint64_t i = 0; i < names; ++i) f.object_names.push_back(r.get_string());
+  }
+  if (!r.at_end()) r.fail("trailing bytes");
   return f;
 }
 
@@ -184,17 +269,37 @@ void cost_colour(double t, unsigned char rgb[3]) {
   rgb[2] = static_cast<unsigned char>(255 * b);
 }
 
-double max_leaf_cost(const Subdivision& s) {
+double max_leaf_value(const Subdivision& s, const CellView* view) {
   double m = 0;
-  for (int32_t l : s.leaves()) m = std::max(m, s.nodes[l].pvs_cost);
+  for (int32_t l : s.leaves()) m = std::max(m, view ? view->value[l] : s.nodes[l].pvs_cost);
   return m > 0 ? m : 1.0;
+}
+
+void check_view(const Subdivision& s, const CellView* view) {
+  if (view && (view->value.size() != s.nodes.size() || view->group.size() != s.nodes.size()))
+    throw Error("cell view does not match the subdivision");
 }
 
 }  // namespace
 
-void write_cells_ply(const std::string& path, const Subdivision& s, double shrink) {
+CellView merged_cell_view(const Subdivision& s, const MergeHistory& h, const std::vector<int32_t>& cells) {
   const std::vector<int32_t> leaves = s.leaves();
-  const double max_cost = max_leaf_cost(s);
+  if (leaves.size() != h.leaf_count) throw Error("the merge history does not match the subdivision");
+  CellView view;
+  view.value.assign(s.nodes.size(), 0.0);
+  view.group.assign(s.nodes.size(), -1);
+  for (int32_t c : cells)
+    for (uint32_t leaf : h.leaves_under(c)) {
+      view.value[leaves[leaf]] = h.nodes[c].pvs_cost;
+      view.group[leaves[leaf]] = c;
+    }
+  return view;
+}
+
+void write_cells_ply(const std::string& path, const Subdivision& s, const CellView* view, double shrink) {
+  check_view(s, view);
+  const std::vector<int32_t> leaves = s.leaves();
+  const double max_cost = max_leaf_value(s, view);
   std::string body;
   size_t nv = 0, nf = 0;
   std::string faces;
@@ -202,7 +307,7 @@ void write_cells_ply(const std::string& path, const Subdivision& s, double shrin
     const ConvexPolyhedron& cell = s.cells[l];
     if (cell.empty()) throw Error(path, 0, "cell geometry missing (rebuild_cells first)");
     unsigned char rgb[3];
-    cost_colour(s.nodes[l].pvs_cost / max_cost, rgb);
+    cost_colour((view ? view->value[l] : s.nodes[l].pvs_cost) / max_cost, rgb);
     const Vec3 c = cell.centroid();
     const size_t base = nv;
     for (const Vec3& p : cell.vertices()) {
@@ -230,7 +335,9 @@ void write_cells_ply(const std::string& path, const Subdivision& s, double shrin
   write_text_file(path, header + body + faces);
 }
 
-void write_slice_png(const std::string& path, const Subdivision& s, double height, int width, const Scene* scene) {
+void write_slice_png(const std::string& path, const Subdivision& s, double height, int width, const Scene* scene,
+                     const CellView* view) {
+  check_view(s, view);
   const Box3& b = s.view_box;
   if (!(height >= b.lo.z && height <= b.hi.z))
     throw Error("slice height " + std::to_string(height) + " is outside the view space (" + std::to_string(b.lo.z) +
@@ -238,20 +345,23 @@ void write_slice_png(const std::string& path, const Subdivision& s, double heigh
   if (width < 16 || width > 16384) throw Error("slice width must be between 16 and 16384 pixels");
   const double scale = width / (b.hi.x - b.lo.x);
   const int h = std::max(16, static_cast<int>(std::ceil((b.hi.y - b.lo.y) * scale)));
-  const double max_cost = max_leaf_cost(s);
+  const double max_cost = max_leaf_value(s, view);
   std::vector<int32_t> leaf(static_cast<size_t>(width) * h);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < width; ++x)
       leaf[static_cast<size_t>(y) * width + x] =
           s.locate({b.lo.x + (x + 0.5) / scale, b.hi.y - (y + 0.5) / scale, height});
+  // Borders are drawn where the cell changes: the leaf, or the group of the view.
+  auto cell_of = [&](int32_t l) { return view && l >= 0 ? view->group[l] : l; };
   std::vector<unsigned char> rgb(static_cast<size_t>(width) * h * 3);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < width; ++x) {
       const size_t i = static_cast<size_t>(y) * width + x;
       unsigned char* px = &rgb[3 * i];
       const int32_t l = leaf[i];
-      cost_colour(l >= 0 ? s.nodes[l].pvs_cost / max_cost : 0.0, px);
-      const bool border = (x + 1 < width && leaf[i + 1] != l) || (y + 1 < h && leaf[i + width] != l);
+      cost_colour(l >= 0 ? (view ? view->value[l] : s.nodes[l].pvs_cost) / max_cost : 0.0, px);
+      const int32_t c = cell_of(l);
+      const bool border = (x + 1 < width && cell_of(leaf[i + 1]) != c) || (y + 1 < h && cell_of(leaf[i + width]) != c);
       if (border)
         for (int c = 0; c < 3; ++c) px[c] = static_cast<unsigned char>(px[c] / 3);
     }

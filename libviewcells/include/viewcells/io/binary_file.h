@@ -76,6 +76,12 @@ class ByteReader {
     return s;
   }
   bool at_end() const { return pos_ == data_.size(); }
+  size_t position() const { return pos_; }
+  /// Back to an earlier position (to read a part once what it depends on is validated).
+  void seek(size_t pos) {
+    if (pos > data_.size()) fail("seek past the end");
+    pos_ = pos;
+  }
   [[noreturn]] void fail(const std::string& what) const {
     throw Error(file_, 0, "corrupt file: " + what);
   }

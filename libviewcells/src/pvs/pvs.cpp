@@ -1,0 +1,342 @@
+#include "viewcells/pvs/pvs.h"
+
+#include <algorithm>
+#include <iterator>
+#include <map>
+
+#include "viewcells/core/error.h"
+#include "viewcells/io/binary_file.h"
+
+namespace viewcells {
+
+std::vector<uint32_t> PvsHierarchy::cell_pvs(uint32_t cell) const {
+  VC_CHECK(cell < cell_count);
+  std::vector<uint32_t> out;
+  // What the nodes of a path keep is disjoint, so the union is a concatenation.
+  for (int32_t n = static_cast<int32_t>(cell); n >= 0; n = parent[n]) out.insert(out.end(), stored[n].begin(), stored[n].end());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+uint64_t PvsHierarchy::stored_entries() const {
+  uint64_t n = 0;
+  for (const auto& s : stored) n += s.size();
+  return n;
+}
+
+PvsHierarchy compress_pvs(const MergeHistory& h, const std::vector<int32_t>& cells,
+                          const std::vector<std::vector<uint32_t>>& cell_pvs) {
+  if (cells.size() != cell_pvs.size()) throw Error("compress_pvs: one PVS per cell is needed");
+  // Nodes: the cells first, then every merge node above them, children before parents.
+  std::map<int32_t, int32_t> index;  // MHT node -> hierarchy node
+  for (size_t i = 0; i < cells.size(); ++i) {
+    if (cells[i] < 0 || cells[i] >= static_cast<int32_t>(h.nodes.size())) throw Error("compress_pvs: no such cell");
+    if (!index.emplace(cells[i], static_cast<int32_t>(i)).second) throw Error("compress_pvs: a cell is listed twice");
+  }
+  std::vector<int32_t> above;
+  for (int32_t c : cells)
+    for (int32_t n = h.nodes[c].parent; n >= 0; n = h.nodes[n].parent) {
+      if (index.count(n) && index[n] < static_cast<int32_t>(cells.size()))
+        throw Error("compress_pvs: the cells overlap (one lies inside another)");
+      above.push_back(n);
+    }
+  std::sort(above.begin(), above.end());
+  above.erase(std::unique(above.begin(), above.end()), above.end());
+  for (int32_t n : above) index.emplace(n, static_cast<int32_t>(index.size()));
+
+  PvsHierarchy out;
+  out.cell_count = static_cast<uint32_t>(cells.size());
+  const size_t total = cells.size() + above.size();
+  out.parent.assign(total, -1);
+  std::vector<std::vector<uint32_t>> full(total);
+  for (size_t i = 0; i < cells.size(); ++i) {
+    full[i] = cell_pvs[i];
+    if (!std::is_sorted(full[i].begin(), full[i].end())) throw Error("compress_pvs: PVSs must be sorted");
+  }
+  for (int32_t n : above) {  // increasing MHT ids: children are done before their parent
+    const int32_t me = index[n];
+    const auto c0 = index.find(h.nodes[n].child[0]), c1 = index.find(h.nodes[n].child[1]);
+    if (c0 == index.end() || c1 == index.end())
+      throw Error("compress_pvs: the cells do not cover the merge node " + std::to_string(n) + " (not a cut)");
+    std::set_intersection(full[c0->second].begin(), full[c0->second].end(), full[c1->second].begin(),
+                          full[c1->second].end(), std::back_inserter(full[me]));
+    out.parent[c0->second] = me;
+    out.parent[c1->second] = me;
+  }
+  out.stored.resize(total);
+  for (size_t n = 0; n < total; ++n) {
+    if (out.parent[n] < 0) {
+      out.stored[n] = full[n];
+      continue;
+    }
+    const auto& up = full[out.parent[n]];
+    std::set_difference(full[n].begin(), full[n].end(), up.begin(), up.end(), std::back_inserter(out.stored[n]));
+  }
+  return out;
+}
+
+namespace {
+
+void put_varint(std::string& out, uint32_t v) {
+  while (v >= 0x80) {
+    out.push_back(static_cast<char>((v & 0x7f) | 0x80));
+    v >>= 7;
+  }
+  out.push_back(static_cast<char>(v));
+}
+
+std::string encode_list(const std::vector<uint32_t>& ids) {
+  std::string out;
+  put_varint(out, static_cast<uint32_t>(ids.size()));
+  uint32_t previous = 0;
+  for (size_t i = 0; i < ids.size(); ++i) {
+    put_varint(out, i ? ids[i] - previous - 1 : ids[i]);
+    previous = ids[i];
+  }
+  return out;
+}
+
+uint32_t get_varint(ByteReader& r) {
+  uint32_t v = 0;
+  for (int shift = 0; shift < 35; shift += 7) {
+    const uint8_t b = r.get<uint8_t>();
+    v |= static_cast<uint32_t>(b & 0x7f) << shift;
+    if (!(b & 0x80)) return v;
+  }
+  r.fail("malformed varint");
+}
+
+std::vector<uint32_t> decode_list(ByteReader& r, uint32_t object_count) {
+  const uint32_t n = get_varint(r);
+  if (n > object_count) r.fail("a list holds more entries than there are objects");
+  std::vector<uint32_t> ids(n);
+  uint64_t previous = 0;
+  for (uint32_t i = 0; i < n; ++i) {
+    const uint64_t id = (i ? previous + 1 : 0) + get_varint(r);
+    if (id >= object_count) r.fail("object id " + std::to_string(id) + " out of range");
+    ids[i] = static_cast<uint32_t>(id);
+    previous = id;
+  }
+  return ids;
+}
+
+constexpr char kMagic[5] = "VPVS";
+constexpr uint32_t kVersion = 1;
+constexpr char kFlatMagic[5] = "VFLT";
+
+}  // namespace
+
+uint64_t varint_bytes(const std::vector<std::vector<uint32_t>>& lists) {
+  uint64_t n = 0;
+  for (const auto& l : lists) n += encode_list(l).size();
+  return n;
+}
+
+std::string rle_row(const std::vector<uint32_t>& pvs, uint32_t object_count) {
+  std::string bits((object_count + 7) / 8, '\0');
+  for (uint32_t o : pvs) {
+    VC_CHECK(o < object_count);
+    bits[o >> 3] = static_cast<char>(bits[o >> 3] | (1 << (o & 7)));
+  }
+  std::string out;
+  for (size_t i = 0; i < bits.size();) {
+    if (bits[i]) {
+      out.push_back(bits[i++]);
+      continue;
+    }
+    size_t run = 0;
+    while (i < bits.size() && !bits[i] && run < 255) ++i, ++run;
+    out.push_back('\0');
+    out.push_back(static_cast<char>(run));
+  }
+  return out;
+}
+
+std::vector<uint32_t> unrle_row(const std::string& row, uint32_t object_count) {
+  const size_t bytes = (object_count + 7) / 8;
+  std::vector<uint32_t> out;
+  size_t at = 0;
+  for (size_t i = 0; i < row.size(); ++i) {
+    const uint8_t b = static_cast<uint8_t>(row[i]);
+    if (b == 0) {
+      if (i + 1 >= row.size() || row[i + 1] == 0) throw Error("malformed run-length row");
+      at += static_cast<uint8_t>(row[++i]);
+      continue;
+    }
+    if (at >= bytes) throw Error("run-length row longer than its objects");
+    for (int k = 0; k < 8; ++k)
+      if (b & (1 << k)) out.push_back(static_cast<uint32_t>(8 * at + k));
+    ++at;
+  }
+  if (at != bytes) throw Error("run-length row of the wrong length");
+  if (!out.empty() && out.back() >= object_count) throw Error("run-length row names objects that do not exist");
+  return out;
+}
+
+int32_t PvsFile::locate(const Vec3& p) const {
+  const int32_t leaf = bsp.locate(p);
+  return leaf < 0 ? -1 : leaf_cell[leaf];
+}
+
+PvsFile make_pvs_file(const Subdivision& s, const std::vector<std::vector<uint32_t>>& leaf_pvs,
+                      const MergeHistory& h, const std::vector<int32_t>& cells) {
+  const std::vector<int32_t> leaves = s.leaves();
+  if (leaves.size() != h.leaf_count) throw Error("the merge history does not match the subdivision");
+  PvsFile f;
+  f.bsp.view_box = s.view_box;
+  f.bsp.planes = s.planes;
+  f.bsp.nodes = s.nodes;
+  f.bsp.splits = s.splits;
+  f.leaf_cell.assign(s.nodes.size(), -1);
+  std::vector<std::vector<uint32_t>> cell_pvs(cells.size());
+  for (size_t i = 0; i < cells.size(); ++i) {
+    auto& pvs = cell_pvs[i];
+    for (uint32_t leaf : h.leaves_under(cells[i])) {
+      if (f.leaf_cell[leaves[leaf]] != -1) throw Error("the view cells overlap");
+      f.leaf_cell[leaves[leaf]] = static_cast<int32_t>(i);
+      pvs.insert(pvs.end(), leaf_pvs[leaves[leaf]].begin(), leaf_pvs[leaves[leaf]].end());
+    }
+    std::sort(pvs.begin(), pvs.end());
+    pvs.erase(std::unique(pvs.begin(), pvs.end()), pvs.end());
+    f.cell_mht_node.push_back(static_cast<uint32_t>(cells[i]));
+  }
+  for (int32_t leaf : leaves)
+    if (f.leaf_cell[leaf] < 0) throw Error("the view cells do not cover the view space");
+  f.pvs = compress_pvs(h, cells, cell_pvs);
+  return f;
+}
+
+void write_pvs(const std::string& path, const PvsFile& f) {
+  ByteWriter w;
+  w.put<uint64_t>(f.scene_fingerprint);
+  w.put<uint32_t>(f.object_count);
+  w.put<uint64_t>(f.object_names.size());
+  for (const std::string& n : f.object_names) w.put_string(n);
+  w.put_string(f.rule);
+  // Point location.
+  const Subdivision& s = f.bsp;
+  w.put(s.view_box.lo);
+  w.put(s.view_box.hi);
+  w.put<uint64_t>(s.planes.size());
+  for (const Plane& p : s.planes) {
+    w.put<int32_t>(p.axis);
+    w.put(p.normal);
+    w.put(p.offset);
+    for (const Vec3& q : p.points) w.put(q);
+  }
+  w.put<uint64_t>(s.nodes.size());
+  for (size_t n = 0; n < s.nodes.size(); ++n) {
+    w.put<int32_t>(s.nodes[n].plane);
+    w.put<int32_t>(s.nodes[n].child[0]);
+    w.put<int32_t>(s.nodes[n].child[1]);
+    w.put<int32_t>(f.leaf_cell[n]);
+  }
+  // The hierarchy: cells first, parents, then the kept lists.
+  w.put<uint32_t>(f.pvs.cell_count);
+  w.put_array(f.pvs.parent);
+  w.put_array(f.cell_mht_node);
+  std::string lists;
+  for (const auto& l : f.pvs.stored) lists += encode_list(l);
+  w.put_string(lists);
+  write_container(path, kMagic, kVersion, w.data());
+}
+
+PvsFile read_pvs(const std::string& path) {
+  uint32_t version = 0;
+  const std::string payload = read_container(path, kMagic, kVersion, version);
+  ByteReader r(payload, path);
+  PvsFile f;
+  const uint64_t max_items = payload.size();
+  f.scene_fingerprint = r.get<uint64_t>();
+  f.object_count = r.get<uint32_t>();
+  const uint64_t names = r.get<uint64_t>();
+  if (names != 0 && names != f.object_count) r.fail("object names do not match the object count");
+  for (uint64_t i = 0; i < names; ++i) f.object_names.push_back(r.get_string());
+  f.rule = r.get_string();
+  Subdivision& s = f.bsp;
+  s.view_box.lo = r.get<Vec3>();
+  s.view_box.hi = r.get<Vec3>();
+  if (!(s.view_box.volume() > 0) || !is_finite(s.view_box.lo) || !is_finite(s.view_box.hi)) r.fail("invalid view box");
+  const uint64_t planes = r.get<uint64_t>();
+  if (planes < 6 || planes > max_items) r.fail("invalid plane count");
+  s.planes.resize(planes);
+  for (Plane& p : s.planes) {
+    p.axis = r.get<int32_t>();
+    p.normal = r.get<Vec3>();
+    p.offset = r.get<double>();
+    for (Vec3& q : p.points) q = r.get<Vec3>();
+    if (p.axis < -1 || p.axis > 2 || !is_finite(p.normal) || !std::isfinite(p.offset)) r.fail("invalid plane");
+  }
+  const uint64_t nodes = r.get<uint64_t>();
+  if (nodes == 0 || nodes > max_items || nodes % 2 == 0) r.fail("invalid node count");
+  s.nodes.resize(nodes);
+  f.leaf_cell.resize(nodes);
+  for (size_t n = 0; n < nodes; ++n) {
+    BspNode& b = s.nodes[n];
+    b.plane = r.get<int32_t>();
+    b.child[0] = r.get<int32_t>();
+    b.child[1] = r.get<int32_t>();
+    f.leaf_cell[n] = r.get<int32_t>();
+  }
+  f.pvs.cell_count = r.get<uint32_t>();
+  r.get_array(f.pvs.parent, max_items);
+  r.get_array(f.cell_mht_node, max_items);
+  const std::string lists = r.get_string();
+  if (!r.at_end()) r.fail("trailing bytes");
+  // The BSP: every inner node has a plane and two later children, each child one parent.
+  const size_t total = f.pvs.parent.size();
+  if (f.pvs.cell_count == 0 || f.pvs.cell_count > total || f.cell_mht_node.size() != f.pvs.cell_count)
+    r.fail("invalid view cell count");
+  std::vector<int> parents(nodes, 0);
+  for (size_t n = 0; n < nodes; ++n) {
+    const BspNode& b = s.nodes[n];
+    if (b.plane < 0) {
+      if (b.child[0] != -1 || b.child[1] != -1) r.fail("BSP leaf " + std::to_string(n) + " has children");
+      if (f.leaf_cell[n] < 0 || f.leaf_cell[n] >= static_cast<int32_t>(f.pvs.cell_count))
+        r.fail("BSP leaf " + std::to_string(n) + " has no view cell");
+      continue;
+    }
+    if (b.plane >= static_cast<int32_t>(planes) || f.leaf_cell[n] != -1) r.fail("BSP node " + std::to_string(n) + " is invalid");
+    for (int32_t c : b.child) {
+      if (c <= static_cast<int32_t>(n) || c >= static_cast<int32_t>(nodes)) r.fail("BSP node " + std::to_string(n) + " has a bad child");
+      ++parents[c];
+    }
+  }
+  for (size_t n = 1; n < nodes; ++n)
+    if (parents[n] != 1) r.fail("BSP node " + std::to_string(n) + " is not in the tree once");
+  // The hierarchy: parents come later; lists decode to sorted ids within the object count.
+  for (size_t n = 0; n < total; ++n) {
+    const int32_t p = f.pvs.parent[n];
+    if (p != -1 && (p <= static_cast<int32_t>(n) || p >= static_cast<int32_t>(total)))
+      r.fail("hierarchy node " + std::to_string(n) + " has a bad parent");
+  }
+  ByteReader lr(lists, path);
+  f.pvs.stored.resize(total);
+  for (auto& l : f.pvs.stored) l = decode_list(lr, f.object_count);
+  if (!lr.at_end()) r.fail("trailing bytes after the PVS lists");
+  for (uint32_t c = 0; c < f.pvs.cell_count; ++c) {
+    // Kept lists along a path are disjoint by construction; a repeat means corruption.
+    const std::vector<uint32_t> pvs = f.pvs.cell_pvs(c);
+    if (std::adjacent_find(pvs.begin(), pvs.end()) != pvs.end()) r.fail("cell " + std::to_string(c) + " repeats an object");
+  }
+  return f;
+}
+
+uint64_t write_flat_rows(const std::string& path, const PvsFile& f) {
+  ByteWriter w;
+  w.put<uint32_t>(f.pvs.cell_count);
+  w.put<uint32_t>(f.object_count);
+  std::string rows;
+  std::vector<uint64_t> offsets;
+  for (uint32_t c = 0; c < f.pvs.cell_count; ++c) {
+    offsets.push_back(rows.size());
+    rows += rle_row(f.pvs.cell_pvs(c), f.object_count);
+  }
+  offsets.push_back(rows.size());
+  w.put_array(offsets);
+  w.put_string(rows);
+  write_container(path, kFlatMagic, 1, w.data());
+  return rows.size();
+}
+
+}  // namespace viewcells

@@ -1,0 +1,186 @@
+// PVS compression through the merge history, the .pvs file, and Quake-style flat rows.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <fstream>
+
+#include "support/test_scenes.h"
+#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/rng.h"
+#include "viewcells/merge/merge.h"
+#include "viewcells/pvs/pvs.h"
+#include "viewcells/raycast/ray_caster.h"
+#include "viewcells/sampling/sampler.h"
+#include "viewcells/scene/generators.h"
+
+namespace viewcells {
+namespace {
+
+struct Built {
+  Scene scene;
+  SegmentSet segs;
+  SubdivisionFile file;
+};
+
+Built build(GeneratorKind kind, int size, uint64_t samples, uint32_t cells) {
+  Built b;
+  b.scene = generate_scene({kind, 1, size});
+  const auto caster = make_embree_caster(b.scene);
+  SamplerConfig sc;
+  sc.samples = samples;
+  sc.show_progress = false;
+  b.segs = sample_segments(b.scene, *caster, sc).segments;
+  SubdivisionConfig config;
+  config.max_cells = cells;
+  config.show_progress = false;
+  Subdivision s = subdivide(b.scene, b.segs, CostModel{}, config);
+  b.file.leaf_pvs = leaf_pvs(s, b.segs);
+  MergeConfig mc;
+  mc.show_progress = false;
+  b.file.history = merge_cells(b.scene, partition_from_subdivision(s, b.file.leaf_pvs), CostModel{}, mc);
+  b.file.object_count = static_cast<uint32_t>(b.scene.object_count());
+  b.file.scene_fingerprint = b.scene.fingerprint();
+  for (const ObjectInfo& o : b.scene.objects) b.file.object_names.push_back(o.name);
+  b.file.subdivision = std::move(s);
+  return b;
+}
+
+/// The PVS of MHT node n from the leaves' PVSs.
+std::vector<uint32_t> expected_pvs(const Built& b, int32_t n) {
+  const std::vector<int32_t> leaves = b.file.subdivision.leaves();
+  std::vector<uint32_t> u;
+  for (uint32_t l : b.file.history->leaves_under(n))
+    u.insert(u.end(), b.file.leaf_pvs[leaves[l]].begin(), b.file.leaf_pvs[leaves[l]].end());
+  std::sort(u.begin(), u.end());
+  u.erase(std::unique(u.begin(), u.end()), u.end());
+  return u;
+}
+
+TEST(Pvs, CompressionIsLosslessAndSmaller) {
+  const Built b = build(GeneratorKind::kOffice, 2, 30000, 200);
+  const MergeHistory& h = *b.file.history;
+  for (size_t count : {200ul, 64ul, 7ul, 1ul}) {
+    const std::vector<int32_t> cells = extract_by_count(h, count).cells;
+    const PvsFile f = make_pvs_file(b.file.subdivision, b.file.leaf_pvs, h, cells);
+    ASSERT_EQ(f.pvs.cell_count, count);
+    uint64_t before = 0;
+    for (uint32_t i = 0; i < count; ++i) {
+      EXPECT_EQ(f.pvs.cell_pvs(i), expected_pvs(b, cells[i])) << "cell " << i;
+      before += expected_pvs(b, cells[i]).size();
+    }
+    // Each node keeps what all cells below it share, so nothing is stored twice on a path.
+    for (size_t n = 0; n < f.pvs.node_count(); ++n)
+      for (int32_t p = f.pvs.parent[n]; p >= 0; p = f.pvs.parent[p])
+        for (uint32_t o : f.pvs.stored[n])
+          EXPECT_FALSE(std::binary_search(f.pvs.stored[p].begin(), f.pvs.stored[p].end(), o));
+    EXPECT_LE(f.pvs.stored_entries(), before);
+    if (count >= 64) EXPECT_LT(f.pvs.stored_entries(), 0.7 * before) << "siblings share most of their PVS";
+  }
+}
+
+TEST(Pvs, FileRoundTripAndPointLocation) {
+  Built b = build(GeneratorKind::kRotatedOffice, 1, 20000, 120);
+  const MergeHistory& h = *b.file.history;
+  const std::vector<int32_t> cells = extract_by_count(h, 30).cells;
+  PvsFile f = make_pvs_file(b.file.subdivision, b.file.leaf_pvs, h, cells);
+  f.object_count = b.file.object_count;
+  f.object_names = b.file.object_names;
+  f.rule = "30 cells";
+  const std::string path = test::temp_path("level.pvs");
+  write_pvs(path, f);
+  const PvsFile back = read_pvs(path);
+  EXPECT_EQ(back.object_names, f.object_names);
+  EXPECT_EQ(back.rule, "30 cells");
+  ASSERT_EQ(back.pvs.cell_count, 30u);
+  for (uint32_t i = 0; i < 30; ++i) EXPECT_EQ(back.pvs.cell_pvs(i), f.pvs.cell_pvs(i));
+  // A point's cell is the view cell holding its BSP leaf.
+  const Subdivision& s = b.file.subdivision;
+  Rng rng(9);
+  for (int k = 0; k < 300; ++k) {
+    const Vec3 p{rng.uniform(s.view_box.lo.x, s.view_box.hi.x), rng.uniform(s.view_box.lo.y, s.view_box.hi.y),
+                 rng.uniform(s.view_box.lo.z, s.view_box.hi.z)};
+    const int32_t leaf = s.locate(p);
+    const int32_t cell = back.locate(p);
+    ASSERT_GE(cell, 0);
+    const std::vector<uint32_t> under = h.leaves_under(cells[cell]);
+    const std::vector<int32_t> leaves = s.leaves();
+    const auto it = std::find(leaves.begin(), leaves.end(), leaf);
+    ASSERT_NE(it, leaves.end());
+    EXPECT_TRUE(std::binary_search(under.begin(), under.end(), static_cast<uint32_t>(it - leaves.begin())));
+  }
+  EXPECT_EQ(back.locate({1e9, 0, 0}), -1);
+
+  // Truncated, bit-flipped and structurally altered files are rejected with the file's name.
+  std::ifstream in(path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string cut = test::temp_path("cut.pvs");
+  test::write_file(cut, bytes.substr(0, bytes.size() - 10));
+  try {
+    read_pvs(cut);
+    FAIL() << "a truncated file was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("cut.pvs"), std::string::npos) << e.what();
+  }
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] ^= 0x10;
+  test::write_file(cut, flipped);
+  EXPECT_THROW(read_pvs(cut), Error);
+  PvsFile bad = f;
+  bad.pvs.parent[0] = 0;  // a cell that is its own parent
+  write_pvs(cut, bad);
+  EXPECT_THROW(read_pvs(cut), Error);
+  bad = f;
+  bad.pvs.stored[0].push_back(f.object_count + 5);  // an object that does not exist
+  write_pvs(cut, bad);
+  EXPECT_THROW(read_pvs(cut), Error);
+  bad = f;
+  bad.leaf_cell[s.leaves()[0]] = 99;
+  write_pvs(cut, bad);
+  EXPECT_THROW(read_pvs(cut), Error);
+}
+
+TEST(Pvs, QuakeStyleRowsRoundTrip) {
+  Rng rng(3);
+  for (uint32_t objects : {1u, 7u, 8u, 9u, 300u, 5000u}) {
+    for (int trial = 0; trial < 20; ++trial) {
+      std::vector<uint32_t> pvs;
+      const double density = rng.uniform() * rng.uniform();
+      for (uint32_t o = 0; o < objects; ++o)
+        if (rng.uniform() < density) pvs.push_back(o);
+      const std::string row = rle_row(pvs, objects);
+      EXPECT_EQ(unrle_row(row, objects), pvs);
+      EXPECT_LE(row.size(), 2 * ((objects + 7) / 8) + 2);
+    }
+  }
+  // Empty rows of many objects shrink to a few bytes: runs of up to 255 zero bytes.
+  EXPECT_EQ(rle_row({}, 8 * 600).size(), 6u);
+  EXPECT_THROW(unrle_row(std::string("\0", 1), 80), Error);
+  EXPECT_THROW(unrle_row(std::string("\x01\x01", 2), 8), Error);
+}
+
+TEST(Pvs, HierarchyFileKeepsTheMergeHistory) {
+  const Built b = build(GeneratorKind::kOffice, 1, 15000, 80);
+  const std::string path = test::temp_path("merged.vcells");
+  write_subdivision(path, b.file);
+  const SubdivisionFile back = read_subdivision(path);
+  ASSERT_TRUE(back.history.has_value());
+  const MergeHistory &h = *b.file.history, &r = *back.history;
+  ASSERT_EQ(r.nodes.size(), h.nodes.size());
+  EXPECT_EQ(r.cost_after, h.cost_after);
+  EXPECT_EQ(r.initial_cost, h.initial_cost);
+  for (size_t n = 0; n < h.nodes.size(); ++n) {
+    EXPECT_EQ(r.nodes[n].parent, h.nodes[n].parent);
+    EXPECT_EQ(r.nodes[n].pvs_size, h.nodes[n].pvs_size);
+  }
+  EXPECT_EQ(back.object_names, b.file.object_names);
+  EXPECT_EQ(extract_by_count(r, 10).cells, extract_by_count(h, 10).cells);
+  // An altered history (a merge of nodes that do not exist yet) is rejected.
+  SubdivisionFile bad = b.file;
+  bad.history->nodes[h.leaf_count].child[0] = static_cast<int32_t>(h.nodes.size() - 1);
+  write_subdivision(path, bad);
+  EXPECT_THROW(read_subdivision(path), Error);
+}
+
+}  // namespace
+}  // namespace viewcells
