@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs dependencies, builds, and runs the pipeline on the built-in default scene (a
-# generated two-storey office): visibility sampling and view space subdivision into 2000 cells,
-# with a coloured cell mesh and a slice image. Outputs go to out/demo/. Later stages extend it.
+# generated two-storey office): visibility sampling, view space subdivision into 2000 cells and
+# merging, 100 view cells cut from the merge history, their PVSs compressed into a .pvs file,
+# and a viewpoint looked up in it. Coloured cell mesh and slice images. Outputs: out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -13,6 +14,12 @@ mkdir -p "$out"
 "$vc" info "$out/office.obj" --json "$out/office-info.json"
 "$vc" build "$out/office.obj" --samples 1000000 --seed 1 --max-cells 2000 -o "$out/office.vcells" \
   --report "$out/build-report.json" --mesh "$out/cells.ply" --slice-png "$out/slice.png" --slice-z 1.5
+"$vc" extract "$out/office.vcells" --count 100 -o "$out/view-cells.json" \
+  --slice-png "$out/view-cells.png" --slice-z 1.5 --scene "$out/office.obj"
+"$vc" compress "$out/office.vcells" --count 100 -o "$out/office.pvs" --flat "$out/office.vflt" \
+  --report "$out/compress-report.json"
+"$vc" query "$out/office.pvs" 3 12 1.5 | head -n 8
 echo
-echo "demo: scene $out/office.obj; cells $out/office.vcells (look at $out/slice.png and $out/cells.ply);"
-echo "      what was enabled and why, costs and timings: $out/build-report.json"
+echo "demo: scene $out/office.obj; hierarchy $out/office.vcells (look at $out/slice.png, $out/cells.ply);"
+echo "      100 view cells $out/view-cells.json ($out/view-cells.png); PVS $out/office.pvs;"
+echo "      what was enabled and why, costs and timings: $out/build-report.json, $out/compress-report.json"
