@@ -4,16 +4,11 @@
 # Five runs per configuration by default; the table shows medians. Rewrites the sampling section of
 # BENCHMARKS.md. Usage: scripts/bench-sampling.sh [CITY_SIZE] [RUNS]
 set -euo pipefail
-cd "$(dirname "$0")/.."
 size="${1:-23}"
 runs="${2:-5}"
-bash scripts/install-deps.sh >/dev/null
-bash scripts/build.sh build-release Release -DVIEWCELLS_BUILD_TESTS=OFF -DVIEWCELLS_BUILD_BENCH=ON
-vc=build-release/cli/viewcells
-dir=out/bench
-mkdir -p "$dir"
-scene="$dir/city$size.obj"
-[ -f "$scene" ] || "$vc" generate city --size "$size" --seed 1 -o "$scene"
+bench_cmake_args="-DVIEWCELLS_BUILD_BENCH=ON"
+source "$(dirname "$0")/bench-setup.sh"
+scene=$(bench_scene city "$size")
 # The street band: the whole footprint, from the ground to 30 m (where people and cars are).
 bounds=$("$vc" info "$scene" --json "$dir/info.json" >/dev/null && python3 -c "
 import json; b=json.load(open('$dir/info.json'))['bounds']; print(','.join(str(v) for v in b['min'][:2]+[0.0]+b['max'][:2]+[30.0]))")

@@ -4,16 +4,10 @@
 # The stagnation stop is switched off (--min-reduction 0) so that every run reaches CELLS.
 # Rewrites the subdivision section of BENCHMARKS.md. Usage: scripts/bench-subdivision.sh [SIZE] [CELLS]
 set -euo pipefail
-cd "$(dirname "$0")/.."
 size="${1:-23}"
 cells="${2:-50000}"
-bash scripts/install-deps.sh >/dev/null
-bash scripts/build.sh build-release Release -DVIEWCELLS_BUILD_TESTS=OFF
-vc=build-release/cli/viewcells
-dir=out/bench
-mkdir -p "$dir"
-scene="$dir/city$size.obj"
-[ -f "$scene" ] || "$vc" generate city --size "$size" --seed 1 -o "$scene"
+source "$(dirname "$0")/bench-setup.sh"
+scene=$(bench_scene city "$size")
 for n in 500000 1000000 1500000 2000000; do
   "$vc" build "$scene" --segments "$n" --max-cells "$cells" --min-reduction 0 --seed 1 -q --report "$dir/build-$n.json"
 done

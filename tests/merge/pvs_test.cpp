@@ -110,6 +110,11 @@ TEST(Pvs, FileRoundTripAndPointLocation) {
     EXPECT_TRUE(std::binary_search(under.begin(), under.end(), static_cast<uint32_t>(it - leaves.begin())));
   }
   EXPECT_EQ(back.locate({1e9, 0, 0}), -1);
+  // The copy of the BSP keeps only what separates view cells: fewer leaves than the BSP has,
+  // at least one per view cell.
+  const auto bsp_leaves = std::count_if(back.leaf_cell.begin(), back.leaf_cell.end(), [](int32_t c) { return c >= 0; });
+  EXPECT_LT(bsp_leaves, static_cast<long>(s.leaf_count()));
+  EXPECT_GE(bsp_leaves, 30);
 
   // Truncated, bit-flipped and structurally altered files are rejected with the file's name.
   std::ifstream in(path, std::ios::binary);
@@ -135,7 +140,7 @@ TEST(Pvs, FileRoundTripAndPointLocation) {
   write_pvs(cut, bad);
   EXPECT_THROW(read_pvs(cut), Error);
   bad = f;
-  bad.leaf_cell[s.leaves()[0]] = 99;
+  *std::find_if(bad.leaf_cell.begin(), bad.leaf_cell.end(), [](int32_t c) { return c >= 0; }) = 99;
   write_pvs(cut, bad);
   EXPECT_THROW(read_pvs(cut), Error);
 }

@@ -183,17 +183,13 @@ PvsFile make_pvs_file(const Subdivision& s, const std::vector<std::vector<uint32
   const std::vector<int32_t> leaves = s.leaves();
   if (leaves.size() != h.leaf_count) throw Error("the merge history does not match the subdivision");
   PvsFile f;
-  f.bsp.view_box = s.view_box;
-  f.bsp.planes = s.planes;
-  f.bsp.nodes = s.nodes;
-  f.bsp.splits = s.splits;
-  f.leaf_cell.assign(s.nodes.size(), -1);
+  std::vector<int32_t> leaf_cell(s.nodes.size(), -1);
   std::vector<std::vector<uint32_t>> cell_pvs(cells.size());
   for (size_t i = 0; i < cells.size(); ++i) {
     auto& pvs = cell_pvs[i];
     for (uint32_t leaf : h.leaves_under(cells[i])) {
-      if (f.leaf_cell[leaves[leaf]] != -1) throw Error("the view cells overlap");
-      f.leaf_cell[leaves[leaf]] = static_cast<int32_t>(i);
+      if (leaf_cell[leaves[leaf]] != -1) throw Error("the view cells overlap");
+      leaf_cell[leaves[leaf]] = static_cast<int32_t>(i);
       pvs.insert(pvs.end(), leaf_pvs[leaves[leaf]].begin(), leaf_pvs[leaves[leaf]].end());
     }
     std::sort(pvs.begin(), pvs.end());
@@ -201,8 +197,49 @@ PvsFile make_pvs_file(const Subdivision& s, const std::vector<std::vector<uint32
     f.cell_mht_node.push_back(static_cast<uint32_t>(cells[i]));
   }
   for (int32_t leaf : leaves)
-    if (f.leaf_cell[leaf] < 0) throw Error("the view cells do not cover the view space");
+    if (leaf_cell[leaf] < 0) throw Error("the view cells do not cover the view space");
   f.pvs = compress_pvs(h, cells, cell_pvs);
+
+  // Point location needs only the BSP's subtrees that straddle view cells: a subtree whose
+  // leaves all lie in one cell becomes one leaf. Children have larger ids than their parent,
+  // so a backward pass sees children first.
+  std::vector<int32_t> uniform(s.nodes.size(), -1);  // the subtree's single cell, or -1
+  for (size_t n = s.nodes.size(); n-- > 0;) {
+    const BspNode& b = s.nodes[n];
+    if (b.plane < 0) {
+      uniform[n] = leaf_cell[n];
+    } else if (uniform[b.child[0]] >= 0 && uniform[b.child[0]] == uniform[b.child[1]]) {
+      uniform[n] = uniform[b.child[0]];
+    }
+  }
+  f.bsp.view_box = s.view_box;
+  f.bsp.planes.assign(s.planes.begin(), s.planes.begin() + 6);  // the box faces stay
+  std::vector<int32_t> plane_id(s.planes.size(), -1);
+  // Preorder copy: a parent gets its index before its children, as in the original.
+  std::vector<std::pair<int32_t, int32_t>> stack = {{0, -1}};  // (old node, new parent's slot)
+  while (!stack.empty()) {
+    const auto [old, slot] = stack.back();
+    stack.pop_back();
+    const int32_t me = static_cast<int32_t>(f.bsp.nodes.size());
+    if (slot >= 0) f.bsp.nodes[slot / 2].child[slot % 2] = me;
+    BspNode node;
+    node.parent = slot >= 0 ? slot / 2 : -1;
+    if (uniform[old] >= 0) {
+      f.bsp.nodes.push_back(node);
+      f.leaf_cell.push_back(uniform[old]);
+      continue;
+    }
+    const int32_t p = s.nodes[old].plane;
+    if (plane_id[p] < 0) {
+      plane_id[p] = static_cast<int32_t>(f.bsp.planes.size());
+      f.bsp.planes.push_back(s.planes[p]);
+    }
+    node.plane = plane_id[p];
+    f.bsp.nodes.push_back(node);
+    f.leaf_cell.push_back(-1);
+    stack.push_back({s.nodes[old].child[1], 2 * me + 1});
+    stack.push_back({s.nodes[old].child[0], 2 * me});
+  }
   return f;
 }
 
