@@ -79,6 +79,28 @@ int32_t Subdivision::locate(const Vec3& p) const {
   return n;
 }
 
+SplitStrategy parse_split_strategy(const std::string& name) {
+  if (name == "av-s") return SplitStrategy::kCost;
+  if (name == "kd-casm") return SplitStrategy::kKdCycling;
+  if (name == "kd-lasm") return SplitStrategy::kKdLongest;
+  if (name == "kd-vt") return SplitStrategy::kKdVisibility;
+  if (name == "kd-vt-star") return SplitStrategy::kKdVisibilityDepthFirst;
+  if (name == "bsp") return SplitStrategy::kPolygonBsp;
+  throw Error("unknown subdivision method '" + name + "' (expected av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star or bsp)");
+}
+
+const char* to_string(SplitStrategy s) {
+  switch (s) {
+    case SplitStrategy::kCost: return "av-s";
+    case SplitStrategy::kKdCycling: return "kd-casm";
+    case SplitStrategy::kKdLongest: return "kd-lasm";
+    case SplitStrategy::kKdVisibility: return "kd-vt";
+    case SplitStrategy::kKdVisibilityDepthFirst: return "kd-vt-star";
+    case SplitStrategy::kPolygonBsp: return "bsp";
+  }
+  return "?";
+}
+
 bool use_geometry_aligned(const Scene& scene, const SubdivisionConfig& config, std::string& reason) {
   const double share = scene.non_axis_aligned_share();
   const std::string pct = std::to_string(static_cast<int>(std::round(100 * share))) + "%";
@@ -93,6 +115,38 @@ bool use_geometry_aligned(const Scene& scene, const SubdivisionConfig& config, s
   }
   reason = "disabled: only " + pct + " of the surface area is not axis-aligned (axis-aligned candidates cover it)";
   return false;
+}
+
+namespace {
+
+}  // namespace
+
+void Subdivision::leaves_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
+                                    std::vector<std::tuple<int32_t, double, double>>& stack) const {
+  stack.clear();
+  stack.emplace_back(0, 0.0, 1.0);
+  while (!stack.empty()) {
+    const auto [n, t0, t1] = stack.back();
+    stack.pop_back();
+    const BspNode& node = nodes[n];
+    if (node.plane < 0) {
+      out.push_back(n);
+      continue;
+    }
+    const Plane& plane = planes[node.plane];
+    const Vec3 p0 = a * (1.0 - t0) + b * t0, p1 = a * (1.0 - t1) + b * t1;
+    const int s0 = plane.side(p0), s1 = plane.side(p1);
+    if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) {  // as Builder::apply_split
+      const double d0 = plane.distance(p0), d1 = plane.distance(p1);
+      const double t = std::clamp(t0 + (t1 - t0) * (d0 / (d0 - d1)), t0, t1);
+      stack.emplace_back(node.child[s0 < 0 ? 0 : 1], t0, t);
+      stack.emplace_back(node.child[s0 < 0 ? 1 : 0], t, t1);
+      continue;
+    }
+    const bool in_plane = s0 == 0 && s1 == 0;
+    if (in_plane || s0 < 0 || s1 < 0) stack.emplace_back(node.child[0], t0, t1);
+    if (in_plane || s0 > 0 || s1 > 0) stack.emplace_back(node.child[1], t0, t1);
+  }
 }
 
 namespace {
@@ -162,7 +216,11 @@ class Builder {
   void run() {
     const auto start = std::chrono::steady_clock::now();
     out_.view_box = segs_.view_box;
-    out_.stats.geometry_aligned = use_geometry_aligned(scene_, config_, out_.stats.geometry_aligned_reason);
+    if (config_.strategy == SplitStrategy::kCost) {
+      out_.stats.geometry_aligned = use_geometry_aligned(scene_, config_, out_.stats.geometry_aligned_reason);
+    } else {
+      out_.stats.geometry_aligned_reason = std::string("not used by ") + to_string(config_.strategy);
+    }
     ga_ = out_.stats.geometry_aligned;
     if (!(total_volume_ > 0)) throw Error("the view space box has zero volume");
     const Box3& b = out_.view_box;
@@ -174,8 +232,21 @@ class Builder {
     ConvexPolyhedron root = ConvexPolyhedron::box(b, 0);
     std::vector<SegRef> refs(segs_.size());
     for (uint32_t i = 0; i < segs_.size(); ++i) refs[i] = {i, 0.0, 1.0};
+    if (config_.strategy == SplitStrategy::kPolygonBsp) {
+      // The polygons that reach into the view space.
+      std::vector<uint32_t> inside;
+      for (uint32_t t = 0; t < scene_.triangles.size(); ++t) {
+        Box3 tb;
+        for (uint32_t v : scene_.triangles[t]) tb.extend(scene_.vertices[v]);
+        if (tb.lo.x <= b.hi.x && tb.hi.x >= b.lo.x && tb.lo.y <= b.hi.y && tb.hi.y >= b.lo.y && tb.lo.z <= b.hi.z &&
+            tb.hi.z >= b.lo.z)
+          inside.push_back(t);
+      }
+      tris_.push_back(std::move(inside));
+    }
     add_node(-1, std::move(root), std::move(refs));
     total_weight_ = out_.nodes[0].weight;
+    pvs_budget_ = config_.pvs_budget_share * out_.nodes[0].pvs_cost;
     if (!(total_weight_ > 0)) throw Error("the viewpoint density is zero everywhere in the view space");
     out_.initial_cost = node_cost(0);
     double cost = out_.initial_cost;
@@ -195,14 +266,16 @@ class Builder {
     out_.stats.stop_reason = "reached the maximum number of cells";
     while (out_.leaf_count() < config_.max_cells) {
       if (queue.empty()) {
-        out_.stats.stop_reason = "no cell can be split further (no candidate reduces the cost)";
+        out_.stats.stop_reason = config_.strategy == SplitStrategy::kCost
+                                     ? "no cell can be split further (no candidate reduces the cost)"
+                                     : "no cell is left to split under the method's own termination rule";
         break;
       }
       const int32_t node = queue.top().second;
       queue.pop();
       const Candidate cand = best_[node];
       stagnant = cand.reduction < config_.min_reduction * out_.initial_cost ? stagnant + 1 : 0;
-      if (stagnant >= config_.stagnation_steps) {
+      if (config_.strategy == SplitStrategy::kCost && stagnant >= config_.stagnation_steps) {
         out_.stats.stop_reason = "the cost reduction stayed below the threshold for " +
                                  std::to_string(config_.stagnation_steps) + " successive splits";
         break;
@@ -234,7 +307,13 @@ class Builder {
 
  private:
   double node_cost(int32_t n) const { return out_.nodes[n].weight / total_weight_ * out_.nodes[n].pvs_cost; }
-  double priority(int32_t n) const { return best_[n].reduction + 0.01 * node_cost(n); }
+  double priority(int32_t n) const {
+    switch (config_.strategy) {
+      case SplitStrategy::kCost: return best_[n].reduction + 0.01 * node_cost(n);
+      case SplitStrategy::kKdVisibilityDepthFirst: return n;  // newest first: depth-first
+      default: return -static_cast<double>(n);                // oldest first: breadth-first
+    }
+  }
 
   double pvs_cost(const ConvexPolyhedron& cell, const std::vector<SegRef>& refs) {
     if (model_.pixel_term()) {
@@ -277,6 +356,7 @@ class Builder {
     node.volume = cell.volume();
     node.weight = config_.density.weight(cell);
     node.pvs_cost = pvs_cost(cell, refs);
+    depth_.push_back(parent < 0 ? 0 : depth_[parent] + 1);
     out_.nodes.push_back(node);
     out_.cells.push_back(std::move(cell));
     refs_.push_back(std::move(refs));
@@ -307,6 +387,24 @@ class Builder {
     }
     refs_[node].clear();
     refs_[node].shrink_to_fit();
+    if (config_.strategy == SplitStrategy::kPolygonBsp) {
+      // Polygons go to the sides their vertices are on (both when cut); those lying in the
+      // plane are used up.
+      std::vector<uint32_t> tri_side[2];
+      for (uint32_t t : tris_[node]) {
+        bool neg = false, pos = false;
+        for (uint32_t v : scene_.triangles[t]) {
+          const int side = plane.side(scene_.vertices[v]);
+          neg |= side < 0;
+          pos |= side > 0;
+        }
+        if (neg) tri_side[0].push_back(t);
+        if (pos) tri_side[1].push_back(t);
+      }
+      tris_[node] = {};
+      tris_.push_back(std::move(tri_side[0]));
+      tris_.push_back(std::move(tri_side[1]));
+    }
     out_.cells[node] = ConvexPolyhedron();
     out_.nodes[node].plane = plane_id;
     const int32_t a = add_node(node, std::move(halves->first), std::move(side[0]));
@@ -325,6 +423,11 @@ class Builder {
 
   Evaluation evaluate(int32_t node) {
     Evaluation ev;
+    switch (config_.strategy) {
+      case SplitStrategy::kCost: break;
+      case SplitStrategy::kPolygonBsp: ev.best = best_polygon_candidate(node, ev); return ev;
+      default: ev.best = kd_candidate(node); ++ev.axis; return ev;
+    }
     const std::vector<SegRef>& refs = refs_[node];
     if (refs.empty() || out_.nodes[node].pvs_cost == 0) return ev;
     RawVector<double> storage;
@@ -340,6 +443,67 @@ class Builder {
     for (const Candidate& c : results)  // in a fixed order: ties keep the earlier kind/axis
       if (c.valid && (!ev.best.valid || c.reduction > ev.best.reduction)) ev.best = c;
     return ev;
+  }
+
+  /// The kd baselines: the spatial median of the cycling or the longest axis; KD-VT and KD-VT*
+  /// leave cells under the PVS budget or at the maximum depth whole.
+  Candidate kd_candidate(int32_t node) const {
+    const SplitStrategy st = config_.strategy;
+    if ((st == SplitStrategy::kKdVisibility || st == SplitStrategy::kKdVisibilityDepthFirst) &&
+        (out_.nodes[node].pvs_cost <= pvs_budget_ || depth_[node] >= config_.max_depth))
+      return {};
+    const Box3 b = out_.cells[node].bounds();
+    const Vec3 e = b.extent();
+    int axis = depth_[node] % 3;
+    if (st != SplitStrategy::kKdCycling) axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+    const double at = 0.5 * (b.lo[axis] + b.hi[axis]);
+    if (!(at > b.lo[axis] && at < b.hi[axis])) return {};  // too thin to split in floating point
+    return {true, Plane::axis_aligned(axis, at), 0.0};
+  }
+
+  /// The BSP baseline: among (a random subset of) the planes of the polygons in the cell, the
+  /// one that cuts the fewest polygons and balances the sides best (score 8 * cut + |front -
+  /// back|, a classic cell-and-portal heuristic). Sides are counted in floating point here;
+  /// the split itself uses exact predicates.
+  Candidate best_polygon_candidate(int32_t node, Evaluation& ev) {
+    const std::vector<uint32_t>& tris = tris_[node];
+    if (tris.empty()) return {};
+    std::vector<uint32_t> pick = tris;
+    if (pick.size() > config_.polygon_candidates) {
+      Rng rng(config_.seed, (static_cast<uint64_t>(node) << 2) | 3);
+      for (size_t i = 0; i < config_.polygon_candidates; ++i) std::swap(pick[i], pick[i + rng.below(pick.size() - i)]);
+      pick.resize(config_.polygon_candidates);
+    }
+    const ConvexPolyhedron& cell = out_.cells[node];
+    const double volume = out_.nodes[node].volume;
+    const double eps = 1e-9 * out_.view_box.diagonal();
+    Candidate best;
+    double best_score = INFINITY;
+    for (uint32_t t : pick) {
+      const auto& tri = scene_.triangles[t];
+      const Plane plane = Plane::through(scene_.vertices[tri[0]], scene_.vertices[tri[1]], scene_.vertices[tri[2]]);
+      const double vl = cell.volume_below(plane);
+      if (!(vl > 1e-9 * volume && volume - vl > 1e-9 * volume)) continue;  // does not cut the cell
+      size_t front = 0, back = 0, cut = 0;
+      for (uint32_t u : tris) {
+        bool neg = false, pos = false;
+        for (uint32_t v : scene_.triangles[u]) {
+          const double d = plane.distance(scene_.vertices[v]);
+          neg |= d < -eps;
+          pos |= d > eps;
+        }
+        cut += neg && pos;
+        front += pos && !neg;
+        back += neg && !pos;
+      }
+      const double score = 8.0 * cut + std::abs(static_cast<double>(front) - static_cast<double>(back));
+      if (score < best_score) {
+        best_score = score;
+        best = {true, plane, 0.0};
+      }
+    }
+    __atomic_add_fetch(&ev.geometry, pick.size(), __ATOMIC_RELAXED);
+    return best;
   }
 
   /// The sweep: r(PVS) of both sides at every candidate position of one axis in O(n log n).
@@ -514,6 +678,9 @@ class Builder {
   double total_weight_ = 0;
   bool ga_ = false;
   std::vector<std::vector<SegRef>> refs_;
+  std::vector<uint32_t> depth_;              ///< per node
+  std::vector<std::vector<uint32_t>> tris_;  ///< BSP baseline: per node, the polygons in it
+  double pvs_budget_ = 0;
   std::vector<Candidate> best_;
   std::atomic<uint64_t> axis_evaluated_{0}, geometry_evaluated_{0};
   tbb::enumerable_thread_specific<Marks> marks_;

@@ -8,6 +8,7 @@
 /// Deterministic: the same inputs and seed give the same tree for any number of threads.
 #include <cstdint>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "viewcells/bsp/cost_model.h"
@@ -36,7 +37,32 @@ struct HeightBandDensity {
   ConvexPolyhedron band_part(const ConvexPolyhedron& cell) const;
 };
 
+/// How cells are chosen and split. kCost is AV-S; the others are the baselines of the
+/// paper's section 6.3, built in the same BSP so that one evaluator compares them all.
+enum class SplitStrategy {
+  kCost,       ///< AV-S: the split that lowers c(S) the most, best cell first (paper 4.2)
+  kKdCycling,  ///< KD-CASM: breadth-first kd-tree, spatial median, axes x, y, z in turn
+  kKdLongest,  ///< KD-LASM: breadth-first kd-tree, spatial median of the longest axis
+  /// KD-VT: KD-LASM, but a cell whose sampled r(PVS) is at most the PVS budget, or at the
+  /// maximum depth, is not split.
+  kKdVisibility,
+  kKdVisibilityDepthFirst,  ///< KD-VT*: KD-VT depth-first (Saona-Vazquez et al., Nirenstein et al.)
+  /// BSP: planes of the scene's polygons inside the cell only, chosen as cell-and-portal
+  /// builders do (few polygons cut, balanced sides), breadth-first; a cell without polygons
+  /// is not split (empty space stays whole).
+  kPolygonBsp,
+};
+/// "av-s", "kd-casm", "kd-lasm", "kd-vt", "kd-vt-star", "bsp" (Error otherwise).
+SplitStrategy parse_split_strategy(const std::string& name);
+const char* to_string(SplitStrategy s);
+
 struct SubdivisionConfig {
+  SplitStrategy strategy = SplitStrategy::kCost;
+  /// KD-VT, KD-VT*: cells whose sampled r(PVS) is at most this share of the whole view
+  /// space's r(PVS) are not split.
+  double pvs_budget_share = 0.05;
+  uint32_t max_depth = 40;           ///< KD-VT, KD-VT*: deepest level split
+  uint32_t polygon_candidates = 50;  ///< BSP: polygon planes tried per cell at most
   uint32_t max_cells = 1000;           ///< stop at this many leaves
   uint32_t max_axis_candidates = 200;  ///< positions per axis (a random subset of segment ends beyond)
   GeometryAlignedMode geometry_aligned = GeometryAlignedMode::kAuto;
@@ -97,6 +123,10 @@ struct Subdivision {
   int32_t locate(const Vec3& p) const;
   /// The leaves of the subdivision after its first k splits (k <= splits.size()).
   std::vector<int32_t> leaves_after(size_t k) const;
+  /// The leaves the segment a-b (inside the view box) has length in, by the same rule the
+  /// subdivision distributes its own segments with; appended to `out`, `stack` is scratch.
+  void leaves_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
+                         std::vector<std::tuple<int32_t, double, double>>& stack) const;
 };
 
 /// Decides whether geometry-aligned candidates are used, and why.

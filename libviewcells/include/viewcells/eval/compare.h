@@ -1,0 +1,50 @@
+#pragma once
+/// Comparing view cell construction methods (view-cell-construction paper, section 6.3): every
+/// method builds from the same construction samples, and one evaluator scores them all on
+/// independent evaluation samples.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "viewcells/eval/evaluate.h"
+#include "viewcells/raycast/ray_caster.h"
+#include "viewcells/sampling/sampler.h"
+
+namespace viewcells {
+
+struct CompareConfig {
+  /// av-m, av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp
+  std::vector<std::string> methods = {"av-m", "av-s", "kd-casm", "kd-lasm", "kd-vt", "kd-vt-star", "bsp"};
+  uint32_t max_cells = 1000;
+  SamplerConfig construction;  ///< samples for building
+  SamplerConfig evaluation;    ///< independent samples for scoring (own seed, more of them)
+  CostModel model;
+  SubdivisionConfig subdivision;  ///< shared settings (strategy is set per method)
+  uint32_t histogram_cells = 0;   ///< cell count of the histograms (0: max_cells)
+  bool show_progress = true;
+};
+
+struct MethodResult {
+  std::string method;
+  CostCurve evaluated;          ///< c(S) on the evaluation samples along the method's order
+  CostCurve constructed;        ///< the method's own estimate (construction samples)
+  std::vector<CellCost> cells;  ///< evaluated cells at the histogram cell count (if reached)
+  uint32_t leaves = 0;          ///< cells the method produced
+  double build_seconds = 0;     ///< subdivision (and merging), without sampling
+  std::string stop_reason;
+};
+
+struct Comparison {
+  std::vector<MethodResult> methods;
+  SamplingStats construction, evaluation;
+  double evaluation_seconds = 0;
+};
+
+/// Builds every method of config.methods and evaluates it. Throws Error for unknown methods.
+Comparison compare_methods(const Scene& scene, const RayCaster& caster, const CompareConfig& config);
+
+/// Cell counts to report a curve at: every count up to 16, then about 24 per decade, and the
+/// last one; all <= max.
+std::vector<uint32_t> report_cell_counts(uint32_t max);
+
+}  // namespace viewcells

@@ -1,0 +1,50 @@
+#pragma once
+/// The evaluator (view-cell-construction paper, section 6.1): independent evaluation samples
+/// give every cell of a hierarchy a PVS, and c(S) is read off at every cell count along the
+/// method's own refinement order: the split order of a BSP or kd-tree (AV-S and the
+/// baselines), the merge history backwards (AV-M). Construction never sees these samples.
+#include <cstdint>
+#include <vector>
+
+#include "viewcells/bsp/cost_model.h"
+#include "viewcells/bsp/subdivision.h"
+#include "viewcells/merge/merge.h"
+#include "viewcells/sampling/segments.h"
+#include "viewcells/scene/scene.h"
+
+namespace viewcells {
+
+/// Per node of `s` (filled for leaves): the sorted objects seen by the segments of `eval`
+/// that have length in the leaf. Parallel; the result does not depend on the thread count.
+std::vector<std::vector<uint32_t>> evaluation_pvs(const Subdivision& s, const SegmentSet& eval);
+
+/// c(S) against the number of cells.
+struct CostCurve {
+  std::vector<uint32_t> cells;  ///< increasing
+  std::vector<double> cost;
+  /// The cost at `n` cells (Error if the curve has no such point).
+  double at(uint32_t n) const;
+};
+
+/// c(S) after every split of `s`, 1 .. leaf_count cells, with the leaves' evaluation PVSs.
+CostCurve evaluate_subdivision(const Scene& scene, const Subdivision& s,
+                               const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model);
+/// c(S) along the merge history over the leaves of `s`, min_cells .. leaf_count cells.
+CostCurve evaluate_merge_history(const Scene& scene, const Subdivision& s, const MergeHistory& h,
+                                 const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model);
+
+/// One view cell of a set, for render cost histograms over the view space volume.
+struct CellCost {
+  double cost = 0;    ///< evaluated r(PVS)
+  double volume = 0;
+};
+/// The cells of `s` after `cells - 1` splits.
+std::vector<CellCost> subdivision_cells_at(const Scene& scene, const Subdivision& s,
+                                           const std::vector<std::vector<uint32_t>>& leaf_pvs,
+                                           const CostModel& model, uint32_t cells);
+/// The cells of the merge history's cut with `cells` cells.
+std::vector<CellCost> merged_cells_at(const Scene& scene, const Subdivision& s, const MergeHistory& h,
+                                      const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model,
+                                      uint32_t cells);
+
+}  // namespace viewcells

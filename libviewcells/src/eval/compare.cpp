@@ -1,0 +1,112 @@
+#include "viewcells/eval/compare.h"
+
+#include <chrono>
+#include <cmath>
+#include <set>
+
+#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/core/error.h"
+#include "viewcells/merge/merge.h"
+
+namespace viewcells {
+
+std::vector<uint32_t> report_cell_counts(uint32_t max) {
+  std::set<uint32_t> counts;
+  for (uint32_t c = 1; c <= std::min<uint32_t>(16, max); ++c) counts.insert(c);
+  for (double x = 16; x <= max; x *= std::pow(10.0, 1.0 / 24)) counts.insert(static_cast<uint32_t>(std::lround(x)));
+  counts.insert(max);
+  std::vector<uint32_t> out;
+  for (uint32_t c : counts)
+    if (c >= 1 && c <= max) out.push_back(c);
+  return out;
+}
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+}  // namespace
+
+Comparison compare_methods(const Scene& scene, const RayCaster& caster, const CompareConfig& config) {
+  for (const std::string& m : config.methods)
+    if (m != "av-m") parse_split_strategy(m);  // unknown names fail before any work
+  if (config.methods.empty()) throw Error("no methods to compare");
+  if (config.construction.seed == config.evaluation.seed)
+    throw Error("evaluation samples need their own seed (it equals the construction seed)");
+  Comparison out;
+  SamplingResult built = sample_segments(scene, caster, config.construction);
+  out.construction = built.stats;
+  SamplingResult eval = sample_segments(scene, caster, config.evaluation);
+  out.evaluation = eval.stats;
+  const uint32_t hist_cells = config.histogram_cells ? config.histogram_cells : config.max_cells;
+
+  std::optional<Subdivision> av_s;  // shared by av-s and av-m
+  double av_s_seconds = 0;
+  auto build = [&](const std::string& method) {
+    SubdivisionConfig sc = config.subdivision;
+    sc.max_cells = config.max_cells;
+    sc.strategy = parse_split_strategy(method);
+    sc.show_progress = config.show_progress;
+    const auto t = std::chrono::steady_clock::now();
+    Subdivision s = subdivide(scene, built.segments, config.model, sc);
+    return std::make_pair(std::move(s), seconds_since(t));
+  };
+  for (const std::string& method : config.methods) {
+    MethodResult r;
+    r.method = method;
+    const bool merged = method == "av-m";
+    Subdivision local;
+    const Subdivision* s = nullptr;
+    if (merged || method == "av-s") {
+      if (!av_s) {
+        auto [sub, secs] = build("av-s");
+        av_s = std::move(sub);
+        av_s_seconds = secs;
+      }
+      s = &*av_s;
+      r.build_seconds = av_s_seconds;
+    } else {
+      auto [sub, secs] = build(method);
+      local = std::move(sub);
+      s = &local;
+      r.build_seconds = secs;
+    }
+    r.stop_reason = s->stats.stop_reason;
+    const auto t = std::chrono::steady_clock::now();
+    const std::vector<std::vector<uint32_t>> pvs = evaluation_pvs(*s, eval.segments);
+    if (merged) {
+      MergeConfig mc;
+      mc.show_progress = config.show_progress;
+      const auto tm = std::chrono::steady_clock::now();
+      const MergeHistory h = merge_cells(scene, partition_from_subdivision(*s, leaf_pvs(*s, built.segments)), config.model, mc);
+      const double merge_seconds = seconds_since(tm);
+      r.build_seconds += merge_seconds;
+      out.evaluation_seconds -= merge_seconds;  // counted below with the evaluation otherwise
+      r.evaluated = evaluate_merge_history(scene, *s, h, pvs, config.model);
+      for (size_t cells = h.min_cells(); cells <= h.leaf_count; ++cells) {
+        r.constructed.cells.push_back(static_cast<uint32_t>(cells));
+        r.constructed.cost.push_back(h.cost_with(cells));
+      }
+      r.leaves = h.leaf_count;
+      if (hist_cells >= h.min_cells() && hist_cells <= h.leaf_count)
+        r.cells = merged_cells_at(scene, *s, h, pvs, config.model, hist_cells);
+    } else {
+      r.evaluated = evaluate_subdivision(scene, *s, pvs, config.model);
+      r.constructed.cells.push_back(1);
+      r.constructed.cost.push_back(s->initial_cost);
+      for (size_t k = 0; k < s->splits.size(); ++k) {
+        r.constructed.cells.push_back(static_cast<uint32_t>(k + 2));
+        r.constructed.cost.push_back(s->splits[k].cost_after);
+      }
+      r.leaves = static_cast<uint32_t>(s->leaf_count());
+      if (hist_cells <= s->leaf_count()) r.cells = subdivision_cells_at(scene, *s, pvs, config.model, hist_cells);
+    }
+    out.evaluation_seconds += seconds_since(t);
+    out.methods.push_back(std::move(r));
+  }
+  return out;
+}
+
+}  // namespace viewcells

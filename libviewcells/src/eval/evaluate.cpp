@@ -1,0 +1,188 @@
+#include "viewcells/eval/evaluate.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <iterator>
+
+#include "viewcells/core/error.h"
+
+namespace viewcells {
+
+std::vector<std::vector<uint32_t>> evaluation_pvs(const Subdivision& s, const SegmentSet& eval) {
+  if (s.nodes.empty()) throw Error("evaluation needs a subdivision");
+  using Lists = std::vector<std::vector<uint32_t>>;
+  tbb::enumerable_thread_specific<Lists> per_thread([&] { return Lists(s.nodes.size()); });
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, eval.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    Lists& lists = per_thread.local();
+    std::vector<int32_t> leaves;
+    std::vector<std::tuple<int32_t, double, double>> stack;
+    for (size_t i = r.begin(); i < r.end(); ++i) {
+      leaves.clear();
+      s.leaves_of_segment(eval.a(i), eval.b(i), leaves, stack);
+      for (int32_t l : leaves)
+        for (uint32_t o : {eval.object_a[i], eval.object_b[i]})
+          if (o != kNoObject) lists[l].push_back(o);
+    }
+    // Keep the lists short: duplicates are the rule (many segments see the same objects).
+    for (auto& l : lists)
+      if (l.size() > 4096) {
+        std::sort(l.begin(), l.end());
+        l.erase(std::unique(l.begin(), l.end()), l.end());
+      }
+  });
+  Lists out(s.nodes.size());
+  for (Lists& lists : per_thread)
+    for (size_t n = 0; n < lists.size(); ++n) out[n].insert(out[n].end(), lists[n].begin(), lists[n].end());
+  tbb::parallel_for(size_t{0}, out.size(), [&](size_t n) {
+    std::sort(out[n].begin(), out[n].end());
+    out[n].erase(std::unique(out[n].begin(), out[n].end()), out[n].end());
+  });
+  return out;
+}
+
+double CostCurve::at(uint32_t n) const {
+  const auto it = std::lower_bound(cells.begin(), cells.end(), n);
+  if (it == cells.end() || *it != n) throw Error("the cost curve has no point at " + std::to_string(n) + " cells");
+  return cost[it - cells.begin()];
+}
+
+namespace {
+
+/// r(PVS) of a cell with bounds `bounds`.
+double pvs_cost(const Scene& scene, const std::vector<double>& base, const CostModel& model,
+                const std::vector<uint32_t>& pvs, const Box3& bounds) {
+  double c = 0;
+  if (!model.pixel_term()) {
+    for (uint32_t o : pvs) c += base[o];
+    return c;
+  }
+  const std::vector<Vec3> points = pixel_estimation_points(bounds);
+  for (uint32_t o : pvs) c += cell_object_cost(scene.objects[o], base[o], points, model);
+  return c;
+}
+
+std::vector<uint32_t> unite(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+  std::vector<uint32_t> u;
+  u.reserve(a.size() + b.size());
+  std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(u));
+  return u;
+}
+
+/// Evaluated r(PVS) of every node of the BSP (children have larger ids than their parent).
+std::vector<double> bsp_node_costs(const Scene& scene, const Subdivision& s,
+                                   const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
+  if (leaf_pvs.size() != s.nodes.size()) throw Error("evaluation PVSs do not match the subdivision");
+  const std::vector<double> base = per_object_costs(scene, model);
+  const size_t n = s.nodes.size();
+  std::vector<std::vector<uint32_t>> pvs(n);
+  std::vector<Box3> bounds(n);
+  std::vector<double> r(n, 0.0);
+  for (size_t i = n; i-- > 0;) {
+    const BspNode& node = s.nodes[i];
+    if (node.plane < 0) {
+      pvs[i] = leaf_pvs[i];
+      if (model.pixel_term()) {
+        if (s.cells.size() != n || s.cells[i].empty()) throw Error("the pixel term needs the cells' geometry");
+        bounds[i] = s.cells[i].bounds();
+      }
+    } else {
+      pvs[i] = unite(pvs[node.child[0]], pvs[node.child[1]]);
+      bounds[i] = bounds[node.child[0]];
+      bounds[i].extend(bounds[node.child[1]]);
+      pvs[node.child[0]] = {};
+      pvs[node.child[1]] = {};
+    }
+    r[i] = pvs_cost(scene, base, model, pvs[i], bounds[i]);
+  }
+  return r;
+}
+
+/// Evaluated r(PVS) of every node of the merge history (children have smaller ids).
+std::vector<double> mht_node_costs(const Scene& scene, const Subdivision& s, const MergeHistory& h,
+                                   const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
+  const std::vector<int32_t> leaves = s.leaves();
+  if (leaves.size() != h.leaf_count || leaf_pvs.size() != s.nodes.size())
+    throw Error("the merge history does not match the subdivision");
+  const std::vector<double> base = per_object_costs(scene, model);
+  std::vector<std::vector<uint32_t>> pvs(h.nodes.size());
+  std::vector<double> r(h.nodes.size(), 0.0);
+  for (size_t i = 0; i < h.nodes.size(); ++i) {
+    const MergeNode& m = h.nodes[i];
+    if (m.child[0] < 0) {
+      pvs[i] = leaf_pvs[leaves[i]];
+    } else {
+      pvs[i] = unite(pvs[m.child[0]], pvs[m.child[1]]);
+      pvs[m.child[0]] = {};
+      pvs[m.child[1]] = {};
+    }
+    r[i] = pvs_cost(scene, base, model, pvs[i], m.bounds);
+  }
+  return r;
+}
+
+}  // namespace
+
+CostCurve evaluate_subdivision(const Scene& scene, const Subdivision& s,
+                               const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
+  const std::vector<double> r = bsp_node_costs(scene, s, leaf_pvs, model);
+  const double W = s.nodes[0].weight;
+  CostCurve curve;
+  double c = r[0];
+  curve.cells.push_back(1);
+  curve.cost.push_back(c);
+  for (size_t k = 0; k < s.splits.size(); ++k) {
+    const BspNode& n = s.nodes[s.splits[k].node];
+    c += (s.nodes[n.child[0]].weight * r[n.child[0]] + s.nodes[n.child[1]].weight * r[n.child[1]] - n.weight * r[s.splits[k].node]) / W;
+    curve.cells.push_back(static_cast<uint32_t>(k + 2));
+    curve.cost.push_back(c);
+  }
+  return curve;
+}
+
+CostCurve evaluate_merge_history(const Scene& scene, const Subdivision& s, const MergeHistory& h,
+                                 const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
+  const std::vector<double> r = mht_node_costs(scene, s, h, leaf_pvs, model);
+  const double W = h.total_weight;
+  std::vector<double> after(h.merges() + 1);  // after[k]: cost after k merges
+  double c = 0;
+  for (uint32_t i = 0; i < h.leaf_count; ++i) c += h.nodes[i].weight * r[i] / W;
+  after[0] = c;
+  for (size_t k = 0; k < h.merges(); ++k) {
+    const size_t z = h.leaf_count + k;
+    const MergeNode& m = h.nodes[z];
+    c += (m.weight * r[z] - h.nodes[m.child[0]].weight * r[m.child[0]] - h.nodes[m.child[1]].weight * r[m.child[1]]) / W;
+    after[k + 1] = c;
+  }
+  CostCurve curve;
+  for (size_t k = h.merges() + 1; k-- > 0;) {
+    curve.cells.push_back(static_cast<uint32_t>(h.leaf_count - k));
+    curve.cost.push_back(after[k]);
+  }
+  return curve;
+}
+
+std::vector<CellCost> subdivision_cells_at(const Scene& scene, const Subdivision& s,
+                                           const std::vector<std::vector<uint32_t>>& leaf_pvs,
+                                           const CostModel& model, uint32_t cells) {
+  if (cells < 1 || cells > s.leaf_count()) throw Error("the subdivision has no set of " + std::to_string(cells) + " cells");
+  const std::vector<double> r = bsp_node_costs(scene, s, leaf_pvs, model);
+  std::vector<CellCost> out;
+  for (int32_t n : s.leaves_after(cells - 1)) out.push_back({r[n], s.nodes[n].volume});
+  return out;
+}
+
+std::vector<CellCost> merged_cells_at(const Scene& scene, const Subdivision& s, const MergeHistory& h,
+                                      const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model,
+                                      uint32_t cells) {
+  if (cells < h.min_cells() || cells > h.leaf_count)
+    throw Error("the merge history has no set of " + std::to_string(cells) + " cells");
+  const std::vector<double> r = mht_node_costs(scene, s, h, leaf_pvs, model);
+  std::vector<CellCost> out;
+  for (int32_t n : h.cut_after(h.leaf_count - cells)) out.push_back({r[n], h.nodes[n].volume});
+  return out;
+}
+
+}  // namespace viewcells
