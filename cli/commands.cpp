@@ -17,6 +17,8 @@
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/io/binary_file.h"
+#include "viewcells/eval/compare.h"
+#include "viewcells/eval/compare.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/merge/merge.h"
 #include "viewcells/pvs/pvs.h"
@@ -215,11 +217,10 @@ struct Sampled {
   double load_s = 0, bvh_s = 0;
 };
 
-Sampled load_and_sample(const SampleArgs& a, const Common& c, int threads) {
+SamplerConfig sampler_config(const SampleArgs& a, const Common& c) {
   if (a.samples == 0) throw Error("--samples must be positive");
   if (a.segments == 0 && a.segments_given) throw Error("--segments must be positive");
-  Sampled out;
-  SamplerConfig& config = out.config;
+  SamplerConfig config;
   config.samples = a.samples;
   config.target_segments = a.segments;
   config.seed = a.seed;
@@ -227,7 +228,11 @@ Sampled load_and_sample(const SampleArgs& a, const Common& c, int threads) {
   config.max_recasts = a.max_recasts;
   config.show_progress = !c.quiet;
   if (!a.view_box.empty()) config.view_box = parse_box(a.view_box);
+  return config;
+}
 
+/// Loads the scene and builds the ray caster (into out.scene, out.caster).
+void load_for_sampling(const SampleArgs& a, const Common& c, Sampled& out) {
   Stopwatch sw;
   out.scene = load_scene(a.scene, parse_grouping(a.objects));
   out.load_s = sw.seconds();
@@ -238,6 +243,13 @@ Sampled load_and_sample(const SampleArgs& a, const Common& c, int threads) {
   ec.robust = !a.fast;
   out.caster = make_embree_caster(out.scene, ec);
   out.bvh_s = sw.seconds();
+}
+
+Sampled load_and_sample(const SampleArgs& a, const Common& c, int threads) {
+  Sampled out;
+  out.config = sampler_config(a, c);
+  const SamplerConfig& config = out.config;
+  load_for_sampling(a, c, out);
   const EmptySpaceDecision esd = decide_empty_space(out.scene, config.empty_space);
   c.log("viewcells: sampling " +
         (a.segments ? "until " + std::to_string(a.segments) + " segments" : std::to_string(a.samples) + " samples") +
@@ -530,6 +542,127 @@ int run_export(const ExportArgs& e, const Common& c) {
       c.log("viewcells: warning: " + e.scene + " is not the scene these cells were built from");
   }
   write_views(file.subdivision, scene.get(), e.mesh, e.png, e.slice_z, e.width, c);
+  return 0;
+}
+
+// -------------------------------------------------------------------------------- compare
+
+struct CompareArgs {
+  std::string methods = "av-m,av-s,kd-casm,kd-lasm,kd-vt,kd-vt-star,bsp";
+  uint32_t max_cells = 1000;
+  uint64_t eval_samples = 0;
+  uint64_t eval_seed = 0;
+  uint32_t histogram_cells = 0;
+  double cost_a = 100, cost_b = 1;
+  bool no_ga = false;
+  std::string output;
+};
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+bool has_point(const CostCurve& c, uint32_t n) { return std::binary_search(c.cells.begin(), c.cells.end(), n); }
+
+int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
+  ThreadLimit threads(c.threads);
+  CompareConfig config;
+  config.methods = split_list(ca.methods);
+  config.max_cells = ca.max_cells;
+  config.construction = sampler_config(a, c);
+  config.evaluation = config.construction;
+  config.evaluation.target_segments = 0;
+  config.evaluation.samples = ca.eval_samples ? ca.eval_samples : 4 * a.samples;
+  config.evaluation.seed = ca.eval_seed ? ca.eval_seed : a.seed + 1'000'003;
+  config.model.a = ca.cost_a;
+  config.model.b = ca.cost_b;
+  config.model.validate();
+  config.subdivision.seed = a.seed;
+  config.subdivision.geometry_aligned = ca.no_ga ? GeometryAlignedMode::kOff : GeometryAlignedMode::kAuto;
+  config.histogram_cells = ca.histogram_cells;
+  config.show_progress = !c.quiet;
+  for (const std::string& m : config.methods)
+    if (m != "av-m") parse_split_strategy(m);
+  std::filesystem::create_directories(ca.output);
+  Sampled loaded;
+  load_for_sampling(a, c, loaded);
+  c.log("viewcells: comparing " + ca.methods + " up to " + std::to_string(ca.max_cells) + " cells; " +
+        std::to_string(config.construction.samples) + " construction samples (seed " +
+        std::to_string(config.construction.seed) + "), " + std::to_string(config.evaluation.samples) +
+        " evaluation samples (seed " + std::to_string(config.evaluation.seed) + ")");
+  const Comparison cmp = compare_methods(loaded.scene, *loaded.caster, config);
+
+  const MethodResult* avm = nullptr;
+  for (const MethodResult& m : cmp.methods)
+    if (m.method == "av-m") avm = &m;
+  const std::vector<uint32_t> counts = report_cell_counts(ca.max_cells);
+  std::string csv = "method,cells,cost,ratio_to_av_m,constructed_cost\n";
+  json methods = json::array();
+  for (const MethodResult& m : cmp.methods) {
+    for (uint32_t n : counts) {
+      if (!has_point(m.evaluated, n)) continue;
+      const double cost = m.evaluated.at(n);
+      const std::string ratio = avm && has_point(avm->evaluated, n) ? fmt(cost / avm->evaluated.at(n), 6) : "";
+      char line[256];
+      std::snprintf(line, sizeof line, "%s,%u,%.6g,%s,%.6g\n", m.method.c_str(), n, cost, ratio.c_str(),
+                    m.constructed.at(n));
+      csv += line;
+    }
+    const uint32_t last = m.evaluated.cells.back();
+    methods.push_back({{"method", m.method},
+                       {"cells", m.leaves},
+                       {"build_seconds", m.build_seconds},
+                       {"stop_reason", m.stop_reason},
+                       {"evaluated_cost_at_most_cells", m.evaluated.at(last)},
+                       {"constructed_cost_at_most_cells", m.constructed.at(last)}});
+  }
+  write_text_file(ca.output + "/curves.csv", csv);
+  std::string hist = "method,cell,cost,volume\n";
+  for (const MethodResult& m : cmp.methods)
+    for (size_t i = 0; i < m.cells.size(); ++i) {
+      char line[256];
+      std::snprintf(line, sizeof line, "%s,%zu,%.6g,%.6g\n", m.method.c_str(), i, m.cells[i].cost, m.cells[i].volume);
+      hist += line;
+    }
+  write_text_file(ca.output + "/histogram.csv", hist);
+  json summary = {
+      {"command", "compare"},
+      {"scene", scene_summary(loaded.scene)},
+      {"settings",
+       {{"methods", config.methods},
+        {"max_cells", ca.max_cells},
+        {"construction_samples", config.construction.samples},
+        {"construction_seed", config.construction.seed},
+        {"evaluation_samples", config.evaluation.samples},
+        {"evaluation_seed", config.evaluation.seed},
+        {"histogram_cells", ca.histogram_cells ? ca.histogram_cells : ca.max_cells},
+        {"cost_model", {{"a", config.model.a}, {"b", config.model.b}, {"c", 0}}},
+        {"threads", threads.threads()}}},
+      {"effects",
+       {{"empty_space_detection",
+         {{"enabled", cmp.construction.empty_space.enabled}, {"reason", cmp.construction.empty_space.reason}}},
+        {"pixel_cost_term", {{"enabled", false}, {"reason", "c = 0: the comparison uses r(o) = max(a, b t)"}}}}},
+      {"methods", methods},
+      {"timings",
+       {{"load_seconds", loaded.load_s},
+        {"bvh_build_seconds", loaded.bvh_s},
+        {"construction_sampling_seconds", cmp.construction.seconds},
+        {"evaluation_sampling_seconds", cmp.evaluation.seconds},
+        {"evaluation_seconds", cmp.evaluation_seconds}}}};
+  write_json(ca.output + "/summary.json", summary);
+  for (const MethodResult& m : cmp.methods) {
+    const uint32_t last = m.evaluated.cells.back();
+    c.log("viewcells: " + m.method + ": " + std::to_string(m.leaves) + " cells in " + fmt(m.build_seconds, 2) +
+          " s; evaluated cost " + fmt(m.evaluated.at(last), 1) + " at " + std::to_string(last) + " cells" +
+          (avm && has_point(avm->evaluated, last) ? " (" + fmt(m.evaluated.at(last) / avm->evaluated.at(last), 3) + " x AV-M)"
+                                                  : ""));
+  }
+  c.log("viewcells: curves -> " + ca.output + "/curves.csv, histograms -> " + ca.output +
+        "/histogram.csv; plots: bash scripts/plot-compare.sh " + ca.output);
   return 0;
 }
 
@@ -827,6 +960,23 @@ int run(int argc, char** argv) {
   ex->add_option("--slice-width", exp.width, "Slice image width in pixels")->capture_default_str();
   ex->add_option("--scene", exp.scene, "Draw this scene's cross-section into the slice");
 
+  SampleArgs csmp;
+  CompareArgs cmpa;
+  auto* cm = app.add_subcommand("compare",
+                                "Build view cells with several methods from the same samples and score them all on "
+                                "independent evaluation samples (paper, section 6)");
+  add_sampling_options(cm, csmp);
+  cm->add_option("--methods", cmpa.methods, "Comma-separated: av-m, av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp")
+      ->capture_default_str();
+  cm->add_option("--max-cells", cmpa.max_cells, "Cells per method at most")->capture_default_str()->check(CLI::PositiveNumber);
+  cm->add_option("--eval-samples", cmpa.eval_samples, "Evaluation samples (default: 4 x --samples)");
+  cm->add_option("--eval-seed", cmpa.eval_seed, "Evaluation seed (default: --seed + 1000003)");
+  cm->add_option("--histogram-cells", cmpa.histogram_cells, "Cell count of the cost histograms (default: --max-cells)");
+  cm->add_option("--cost-a", cmpa.cost_a, "Render cost model: minimum cost of an object")->capture_default_str();
+  cm->add_option("--cost-b", cmpa.cost_b, "Render cost model: cost per triangle")->capture_default_str();
+  cm->add_flag("--no-ga", cmpa.no_ga, "AV-S/AV-M without geometry-aligned candidates");
+  cm->add_option("-o,--output", cmpa.output, "Directory for curves.csv, histogram.csv, summary.json")->required();
+
   ExtractArgs ext;
   auto* xt = app.add_subcommand("extract", "Cut view cells from the merge history of a built hierarchy");
   xt->add_option("cells", ext.input, "Hierarchy file (.vcells, built with merging)")->required();
@@ -871,6 +1021,10 @@ int run(int argc, char** argv) {
     }
     if (*ex) return run_export(exp, common);
     if (*xt) return run_extract(ext, common);
+    if (*cm) {
+      csmp.segments_given = cm->count("--segments") > 0;
+      return run_compare(csmp, cmpa, common);
+    }
     if (*cp) return run_compress(cmp, common);
     if (*qy) return run_query(qry, common);
   } catch (const Error& e) {

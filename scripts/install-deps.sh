@@ -15,6 +15,7 @@ packages=(
   libzstd-dev            # compressed binary files
   libpng-dev             # slice images
   libgtest-dev libgmock-dev libbenchmark-dev   # tests and micro-benchmarks
+  gnuplot-nox                                  # plots of comparisons and studies (scripts/plot-*.sh)
 )
 
 missing=()

@@ -27,7 +27,7 @@ json_get() { python3 -c "import json,sys; d=json.load(open('$1')); print(eval('d
 
 # --help explains every subcommand.
 expect_ok "$VC" --help
-for sub in generate info sample build export extract compress query; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
+for sub in generate info sample build export extract compress query compare; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
 expect_ok "$VC" sample --help
 grep -q -- "--measure-raw" out.txt && ok || bad "sample --help lacks --measure-raw"
 
@@ -163,6 +163,23 @@ head -c 60 office.pvs > cut.pvs
 expect_error "cut.pvs" "$VC" query cut.pvs 2 2 1.5
 expect_ok "$VC" build office.obj --samples 5000 --max-cells 8 --no-merge -o nomerge.vcells -q
 expect_error "no merge history" "$VC" extract nomerge.vcells --count 2
+# compare: every method from the same samples, scored on independent ones.
+expect_ok "$VC" compare office.obj --samples 20000 --max-cells 40 -o cmp -q
+python3 -c "
+import csv, json
+rows = list(csv.DictReader(open('cmp/curves.csv')))
+methods = {r['method'] for r in rows}
+assert methods == {'av-m','av-s','kd-casm','kd-lasm','kd-vt','kd-vt-star','bsp'}, methods
+s = json.load(open('cmp/summary.json'))
+assert s['settings']['evaluation_samples'] == 80000 and s['settings']['evaluation_seed'] != s['settings']['construction_seed']
+avm = {int(r['cells']): float(r['cost']) for r in rows if r['method'] == 'av-m'}
+kd = {int(r['cells']): float(r['cost']) for r in rows if r['method'] == 'kd-casm'}
+assert avm[40] < kd[40], (avm[40], kd[40])
+assert all(float(r['ratio_to_av_m']) == 1.0 for r in rows if r['method'] == 'av-m')
+" && ok || bad "compare outputs"
+[ -s cmp/histogram.csv ] && ok || bad "compare histogram"
+expect_error "unknown subdivision method 'kd-foo'" "$VC" compare office.obj --samples 1000 --methods av-m,kd-foo -o cmp2
+[ ! -e cmp2 ] && ok || bad "a refused compare created its output directory"
 head -c 100 office.vcells > cut.vcells
 expect_error "cut.vcells" "$VC" export cut.vcells --mesh x.ply
 expect_error "nothing to export" "$VC" export office.vcells
