@@ -555,6 +555,8 @@ struct CompareArgs {
   uint32_t histogram_cells = 0;
   double cost_a = 100, cost_b = 1;
   bool no_ga = false;
+  uint32_t axis_candidates = 200;
+  uint32_t ga_candidates = 150;
   std::string output;
 };
 
@@ -583,6 +585,8 @@ int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
   config.model.validate();
   config.subdivision.seed = a.seed;
   config.subdivision.geometry_aligned = ca.no_ga ? GeometryAlignedMode::kOff : GeometryAlignedMode::kAuto;
+  config.subdivision.max_axis_candidates = ca.axis_candidates;
+  config.subdivision.ga_candidates = ca.ga_candidates;
   config.histogram_cells = ca.histogram_cells;
   config.show_progress = !c.quiet;
   for (const std::string& m : config.methods)
@@ -617,6 +621,9 @@ int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
                        {"cells", m.leaves},
                        {"build_seconds", m.build_seconds},
                        {"stop_reason", m.stop_reason},
+                       {"geometry_aligned", m.geometry_aligned},
+                       {"axis_candidates_evaluated", m.axis_candidates},
+                       {"geometry_candidates_evaluated", m.geometry_candidates},
                        {"evaluated_cost_at_most_cells", m.evaluated.at(last)},
                        {"constructed_cost_at_most_cells", m.constructed.at(last)}});
   }
@@ -641,6 +648,10 @@ int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
         {"evaluation_seed", config.evaluation.seed},
         {"histogram_cells", ca.histogram_cells ? ca.histogram_cells : ca.max_cells},
         {"cost_model", {{"a", config.model.a}, {"b", config.model.b}, {"c", 0}}},
+        {"axis_candidates", ca.axis_candidates},
+        {"ga_candidates", ca.ga_candidates},
+        {"geometry_aligned", ca.no_ga ? "off" : "auto"},
+        {"robust_ray_casting", !a.fast},
         {"threads", threads.threads()}}},
       {"effects",
        {{"empty_space_detection",
@@ -975,6 +986,10 @@ int run(int argc, char** argv) {
   cm->add_option("--cost-a", cmpa.cost_a, "Render cost model: minimum cost of an object")->capture_default_str();
   cm->add_option("--cost-b", cmpa.cost_b, "Render cost model: cost per triangle")->capture_default_str();
   cm->add_flag("--no-ga", cmpa.no_ga, "AV-S/AV-M without geometry-aligned candidates");
+  cm->add_option("--axis-candidates", cmpa.axis_candidates, "AV-S/AV-M: axis-aligned positions per axis and cell")
+      ->capture_default_str()->check(CLI::PositiveNumber);
+  cm->add_option("--ga-candidates", cmpa.ga_candidates, "AV-S/AV-M: geometry-aligned planes per cell")
+      ->capture_default_str()->check(CLI::PositiveNumber);
   cm->add_option("-o,--output", cmpa.output, "Directory for curves.csv, histogram.csv, summary.json")->required();
 
   ExtractArgs ext;

@@ -74,6 +74,9 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
       r.build_seconds = secs;
     }
     r.stop_reason = s->stats.stop_reason;
+    r.geometry_aligned = s->stats.geometry_aligned_reason;
+    r.axis_candidates = s->stats.axis_candidates;
+    r.geometry_candidates = s->stats.geometry_candidates;
     const auto t = std::chrono::steady_clock::now();
     const std::vector<std::vector<uint32_t>> pvs = evaluation_pvs(*s, eval.segments);
     if (merged) {

@@ -32,6 +32,8 @@ struct MethodResult {
   uint32_t leaves = 0;          ///< cells the method produced
   double build_seconds = 0;     ///< subdivision (and merging), without sampling
   std::string stop_reason;
+  std::string geometry_aligned;  ///< whether geometry-aligned candidates were used, and why
+  uint64_t axis_candidates = 0, geometry_candidates = 0;  ///< candidate planes evaluated
 };
 
 struct Comparison {
