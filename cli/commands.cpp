@@ -495,6 +495,7 @@ int run_build(const SampleArgs& a, const BuildArgs& b, const Common& c) {
                            {"cost_at_power_of_two_cells", curve},
                            {"axis_candidates_evaluated", sub.stats.axis_candidates},
                            {"geometry_candidates_evaluated", sub.stats.geometry_candidates},
+                           {"sliver_splits_refused", sub.stats.slivers_refused},
                            {"stop_reason", sub.stats.stop_reason}};
   report["final_cost"] = sub.cost();
   if (file.history) {
@@ -607,7 +608,12 @@ int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
   std::string csv = "method,cells,cost,ratio_to_av_m,constructed_cost\n";
   json methods = json::array();
   for (const MethodResult& m : cmp.methods) {
-    for (uint32_t n : counts) {
+    // The report's counts, and where the method stopped (a method may stop short of them).
+    std::vector<uint32_t> at = counts;
+    at.push_back(m.evaluated.cells.back());
+    std::sort(at.begin(), at.end());
+    at.erase(std::unique(at.begin(), at.end()), at.end());
+    for (uint32_t n : at) {
       if (!has_point(m.evaluated, n)) continue;
       const double cost = m.evaluated.at(n);
       const std::string ratio = avm && has_point(avm->evaluated, n) ? fmt(cost / avm->evaluated.at(n), 6) : "";

@@ -47,6 +47,7 @@ for name, label in [("office", "office (size 4, two storeys)"), ("rotated-office
                     ("city", f"city (size {size})")]:
     rows = list(csv.DictReader(open(f"{d}/compare-{name}/curves.csv")))
     s = json.load(open(f"{d}/compare-{name}/summary.json"))
+    s["_name"] = name
     curve = {}
     for r in rows:
         curve.setdefault(r["method"], {})[int(r["cells"])] = float(r["cost"])
@@ -86,8 +87,11 @@ for (label, top, gain_top, gmin, gmax, bsp, kdc, kdl, avs, avm, bsp_cells, s) in
     print(f"| AV-M about 20-30% below KD-CASM | {label} | {100 * gain_top:.0f}% below at {top:,} cells ({rng}) |")
 for (label, top, gain_top, gmin, gmax, bsp, kdc, kdl, avs, avm, bsp_cells, s) in claims:
     worst = max((m for m in s["methods"]), key=lambda m: m["evaluated_cost_at_most_cells"])
+    bsp_curve = {int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/compare-{s['_name']}/curves.csv")) if r["method"] == "bsp"}
+    avm_curve = {int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/compare-{s['_name']}/curves.csv")) if r["method"] == "av-m"}
     bsp_text = (f"BSP {bsp / avm:.2f} x AV-M at {top:,} cells" if bsp else
-                f"BSP stops at {bsp_cells:,} cells (no polygons left to split by)")
+                f"BSP stops at {bsp_cells:,} cells (no polygons left to split by), where it costs "
+                f"{bsp_curve[bsp_cells] / avm_curve[bsp_cells]:.2f} x AV-M")
     print(f"| BSP worst: it cannot split empty space | {label} | {bsp_text}; worst at the most cells: "
           f"{names[worst['method']]} |")
 for (label, top, gain_top, gmin, gmax, bsp, kdc, kdl, avs, avm, bsp_cells, s) in claims:

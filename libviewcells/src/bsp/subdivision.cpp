@@ -151,6 +151,9 @@ void Subdivision::leaves_of_segment(const Vec3& a, const Vec3& b, std::vector<in
 
 namespace {
 
+/// Smallest part of a cell a split may cut off, relative to the cell's volume.
+constexpr double kMinPart = 1e-9;
+
 struct SegRef {
   uint32_t id;
   double t0, t1;
@@ -301,6 +304,7 @@ class Builder {
       for (const SegRef& s : refs_[n]) ids.push_back(s.id);
     }
     out_.stats.axis_candidates = axis_evaluated_;
+    out_.stats.slivers_refused = slivers_refused_;
     out_.stats.geometry_candidates = geometry_evaluated_;
     out_.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
@@ -367,6 +371,14 @@ class Builder {
     const int32_t plane_id = static_cast<int32_t>(out_.planes.size());
     auto halves = out_.cells[node].split(plane, plane_id);
     if (!halves) return false;
+    // A sliver (its volume rounds to nothing or below) helps no one and breaks p(i) >= 0:
+    // the cell stays whole. Candidates are filtered by the same relative size, but they see
+    // estimated volumes; this is the exact check on the cells themselves.
+    const double min_part = kMinPart * out_.nodes[node].volume;
+    if (!(halves->first.volume() > min_part && halves->second.volume() > min_part)) {
+      ++slivers_refused_;
+      return false;
+    }
     out_.planes.push_back(plane);
     std::vector<SegRef> side[2];
     for (const SegRef& s : refs_[node]) {
@@ -596,7 +608,7 @@ class Builder {
     for (size_t j = 0; j < k; ++j) {
       const Plane plane = Plane::axis_aligned(axis, positions[j]);
       const double vl = box ? volume * (positions[j] - lo_b) / (hi_b - lo_b) : cell.volume_below(plane);
-      if (!(vl > 0 && volume - vl > 0)) continue;
+      if (!(vl > kMinPart * volume && volume - vl > kMinPart * volume)) continue;
       const double wl = box ? box_weight_below(positions[j]) : density.weight_below(cell, part, plane);
       const double wr = weight - wl;
       const double reduction = own - (wl * left[j] + wr * right[j]) / total_weight_;
@@ -651,7 +663,7 @@ class Builder {
       const auto& tri = scene_.triangles[t];
       const Plane plane = Plane::through(scene_.vertices[tri[0]], scene_.vertices[tri[1]], scene_.vertices[tri[2]]);
       const double vl = cell.volume_below(plane), vr = volume - vl;
-      if (!(vl > 1e-12 * volume && vr > 1e-12 * volume)) continue;
+      if (!(vl > kMinPart * volume && vr > kMinPart * volume)) continue;
       neg.reset(r_.size());
       pos.reset(r_.size());
       double cl = 0, cr = 0;
@@ -681,6 +693,7 @@ class Builder {
   std::vector<uint32_t> depth_;              ///< per node
   std::vector<std::vector<uint32_t>> tris_;  ///< BSP baseline: per node, the polygons in it
   double pvs_budget_ = 0;
+  uint64_t slivers_refused_ = 0;
   std::vector<Candidate> best_;
   std::atomic<uint64_t> axis_evaluated_{0}, geometry_evaluated_{0};
   tbb::enumerable_thread_specific<Marks> marks_;

@@ -335,7 +335,8 @@ MergeHistory merge_cells(const Scene& scene, const CellPartition& partition, con
     throw Error("the partition's per-cell arrays differ in length");
   for (size_t i = 0; i < L; ++i) {
     if (!(partition.weight[i] >= 0) || !std::isfinite(partition.weight[i]))
-      throw Error("cell " + std::to_string(i) + " has an invalid weight");
+      throw Error("cell " + std::to_string(i) + " has an invalid weight (" + std::to_string(partition.weight[i]) +
+                  ", volume " + std::to_string(partition.volume[i]) + ")");
     for (size_t k = 0; k < partition.pvs[i].size(); ++k)
       if (partition.pvs[i][k] >= scene.objects.size() || (k && partition.pvs[i][k] <= partition.pvs[i][k - 1]))
         throw Error("the PVS of cell " + std::to_string(i) + " is not a sorted list of the scene's objects");

@@ -99,6 +99,7 @@ struct SplitRecord {
 struct SubdivisionStats {
   uint64_t axis_candidates = 0;      ///< candidate planes evaluated, by kind
   uint64_t geometry_candidates = 0;
+  uint64_t slivers_refused = 0;      ///< chosen splits left undone: a part would be a sliver
   bool geometry_aligned = false;
   std::string geometry_aligned_reason;
   std::string stop_reason;
