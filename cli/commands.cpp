@@ -608,9 +608,9 @@ int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
   std::string csv = "method,cells,cost,ratio_to_av_m,constructed_cost\n";
   json methods = json::array();
   for (const MethodResult& m : cmp.methods) {
-    // The report's counts, and where the method stopped (a method may stop short of them).
+    // The report's counts, and where each method stopped (so that they compare there too).
     std::vector<uint32_t> at = counts;
-    at.push_back(m.evaluated.cells.back());
+    for (const MethodResult& other : cmp.methods) at.push_back(other.evaluated.cells.back());
     std::sort(at.begin(), at.end());
     at.erase(std::unique(at.begin(), at.end()), at.end());
     for (uint32_t n : at) {

@@ -42,7 +42,7 @@ for ax in 50 800; do
     --axis-candidates "$ax" -o "$out/axis-$ax" -q
 done
 # 4. Robust versus fast ray casting.
-build-release/bench/viewcells_leaks "$small_city" "$city" 200000 4000000 "$out/leaks.json" >/dev/null
+build-release/bench/viewcells_leaks "$small_city" "$city" 50000 4000000 "$out/leaks.json" >/dev/null
 
 python3 - "$out" "$cells" "$size" <<'PY' > docs/accuracy-vs-time.md
 import csv, json, sys

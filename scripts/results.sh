@@ -12,7 +12,9 @@ office=$(bench_scene office 4)
 rotated=$(bench_scene rotated-office 4)
 city=$(bench_scene city "$size")
 mkdir -p docs/results
+# RESULTS_REUSE=1 keeps comparisons already in out/bench (to redo only the tables).
 for name in office rotated-office city; do
+  if [ "${RESULTS_REUSE:-0}" = 1 ] && [ -f "$dir/compare-$name/summary.json" ]; then continue; fi
   case "$name" in
     office) scene="$office" ;;
     rotated-office) scene="$rotated" ;;
@@ -55,10 +57,12 @@ for name, label in [("office", "office (size 4, two storeys)"), ("rotated-office
     print(f"## {label}\n")
     print(f"{sc['triangles']:,} triangles, {sc['objects']:,} objects. Empty view space detection: "
           f"{s['effects']['empty_space_detection']['reason']}. Pixel term: off (c = 0).\n")
-    counts = [c for c in [10, 100, 1000, cells] if c <= cells]
+    # Columns at the reported cell counts nearest to 10, 100, 1000 and the most.
+    have = sorted(curve["av-m"])
+    counts = sorted({min(have, key=lambda c: abs(c - want)) for want in [10, 100, 1000, cells] if want <= cells})
     print("| method | cells built | build s | " + " | ".join(f"cost at {c:,}" for c in counts) + " | " +
           " | ".join(f"/ AV-M at {c:,}" for c in counts) + " |")
-    print("| --- | ---: | ---: | " + " | ".join("---:" for _ in counts) * 2 + " |")
+    print("| --- | ---: | ---: | " + " | ".join(["---:"] * (2 * len(counts))) + " |")
     for m in s["methods"]:
         meth = m["method"]
         cost = [curve[meth].get(c) for c in counts]
@@ -83,22 +87,46 @@ print("## Side by side with the paper's claims\n")
 print("| claim (paper, section 6.3) | scene | measured here |")
 print("| --- | --- | --- |")
 for (label, top, gain_top, gmin, gmax, bsp, kdc, kdl, avs, avm, bsp_cells, s) in claims:
-    rng = f"{100 * gmin:.0f}-{100 * gmax:.0f}% over 100-{top:,} cells" if gmin is not None else "-"
-    print(f"| AV-M about 20-30% below KD-CASM | {label} | {100 * gain_top:.0f}% below at {top:,} cells ({rng}) |")
+    rng = f"from {100 * gmin:+.0f}% to {100 * gmax:+.0f}% over 100-{top:,} cells" if gmin is not None else "-"
+    print(f"| AV-M about 20-30% below KD-CASM | {label} | {100 * gain_top:.0f}% below at {top:,} cells (gain {rng}) |")
 for (label, top, gain_top, gmin, gmax, bsp, kdc, kdl, avs, avm, bsp_cells, s) in claims:
     worst = max((m for m in s["methods"]), key=lambda m: m["evaluated_cost_at_most_cells"])
     bsp_curve = {int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/compare-{s['_name']}/curves.csv")) if r["method"] == "bsp"}
     avm_curve = {int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/compare-{s['_name']}/curves.csv")) if r["method"] == "av-m"}
+    below = max(c for c in avm_curve if c <= bsp_cells)  # AV-M with at most as many cells
     bsp_text = (f"BSP {bsp / avm:.2f} x AV-M at {top:,} cells" if bsp else
-                f"BSP stops at {bsp_cells:,} cells (no polygons left to split by), where it costs "
-                f"{bsp_curve[bsp_cells] / avm_curve[bsp_cells]:.2f} x AV-M")
+                f"BSP stops at {bsp_cells:,} cells (no polygons left to split by) with cost "
+                f"{bsp_curve[bsp_cells]:,.0f}, {bsp_curve[bsp_cells] / avm_curve[below]:.2f} x AV-M's with {below:,} cells")
     print(f"| BSP worst: it cannot split empty space | {label} | {bsp_text}; worst at the most cells: "
           f"{names[worst['method']]} |")
 for (label, top, gain_top, gmin, gmax, bsp, kdc, kdl, avs, avm, bsp_cells, s) in claims:
     if kdl:
         print(f"| KD-CASM better than KD-LASM in cities | {label} | KD-CASM / KD-LASM = {kdc / kdl:.3f} at {top:,} cells |")
 for (label, top, gain_top, gmin, gmax, bsp, kdc, kdl, avs, avm, bsp_cells, s) in claims:
-    print(f"| merging (AV-M) gains little over AV-S | {label} | AV-S / AV-M = {avs / avm:.3f} at {top:,} cells |")
+    cv = {}
+    for r in csv.DictReader(open(f"{d}/compare-{s['_name']}/curves.csv")):
+        cv.setdefault(r["method"], {})[int(r["cells"])] = float(r["cost"])
+    pts = [c for c in sorted(cv["av-m"]) if c in cv["av-s"] and c >= 10]
+    worst = max(pts, key=lambda c: cv["av-m"][c] / cv["av-s"][c])
+    best = min(pts, key=lambda c: cv["av-m"][c] / cv["av-s"][c])
+    est = {}
+    for r in csv.DictReader(open(f"{d}/compare-{s['_name']}/curves.csv")):
+        est.setdefault(r["method"], {})[int(r["cells"])] = float(r["constructed_cost"])
+    print(f"| merging (AV-M) gains little over AV-S | {label} | AV-M / AV-S from {cv['av-m'][best] / cv['av-s'][best]:.3f} "
+          f"({best:,} cells) to {cv['av-m'][worst] / cv['av-s'][worst]:.3f} ({worst:,} cells); equal at {top:,}. "
+          f"At {worst:,} cells the construction samples estimated AV-M at {est['av-m'][worst]:,.0f} and AV-S at "
+          f"{est['av-s'][worst]:,.0f} |")
+print("\nReading it. AV-S and AV-M lead in the office and the rotated office by about the paper's "
+      "margin at thousands of cells. In the generated city the kd-trees come close: its street grid is "
+      "axis-aligned and regular, so median splits fall on streets, and its view space is mostly sky "
+      "where every cell sees much of the city. Greedy merging (AV-M) loses to AV-S's own top-down "
+      "order at low cell counts, although by the construction samples it wins there (last rows): "
+      "merging starts from 5,000 leaves of about 200 samples each, whose PVSs are undersampled, and "
+      "the greedy order picks the pairs whose sampled PVSs happen to overlap most, so it overfits the "
+      "construction samples, and independent samples expose it. The paper found merging's gain "
+      "\"very limited\"; here it is a loss below a few hundred cells. Until merging accounts for "
+      "sampling noise, users who want few cells should cut AV-S's order (`build --no-merge`). The polygon BSP stops where no "
+      "polygons are left; on the rotated office its wall-aligned planes do well at the count it stops at.")
 print("\nKD-VT* is depth-first: its curve shows the order in which it refines, which is why the paper "
       "calls it not scalable; its final set, where it stops, is what such tools ship.")
 PY

@@ -7,6 +7,7 @@
 #include "viewcells/core/error.h"
 #include "viewcells/eval/compare.h"
 #include "viewcells/eval/evaluate.h"
+#include "viewcells/merge/merge.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
 #include "viewcells/scene/generators.h"
@@ -42,6 +43,17 @@ TEST(Evaluate, ConstructionSamplesReproduceTheBuildersCosts) {
   EXPECT_NEAR(c.at(1), s.initial_cost, 1e-9 * s.initial_cost);
   for (size_t k = 0; k < s.splits.size(); ++k)
     EXPECT_NEAR(c.at(static_cast<uint32_t>(k + 2)), s.splits[k].cost_after, 1e-9 * s.initial_cost) << k;
+}
+
+TEST(Evaluate, ConstructionSamplesReproduceTheMergeHistorysCosts) {
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 1});
+  const SegmentSet segs = sample(scene, 20000, 1);
+  const Subdivision s = build(scene, segs, "av-s", 80);
+  MergeConfig mc;
+  mc.show_progress = false;
+  const MergeHistory h = merge_cells(scene, partition_from_subdivision(s, leaf_pvs(s, segs)), CostModel{}, mc);
+  const CostCurve c = evaluate_merge_history(scene, s, h, evaluation_pvs(s, segs), CostModel{});
+  for (uint32_t cells = 1; cells <= 80; ++cells) EXPECT_NEAR(c.at(cells), h.cost_with(cells), 1e-9 * h.initial_cost) << cells;
 }
 
 TEST(Evaluate, CostOfAFixedPartitionConvergesWithMoreEvaluationSamples) {

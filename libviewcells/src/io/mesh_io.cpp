@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "viewcells/core/error.h"
+#include "viewcells/io/q3bsp.h"
 #include "viewcells/io/scene_io.h"
 
 namespace viewcells {
@@ -209,8 +210,11 @@ Scene load_scene(const std::string& path, ObjectGrouping grouping) {
     mesh = read_obj(in, path);
   } else if (ext == ".ply" || ext == ".off" || ext == ".stl") {
     mesh = read_with_openmesh(path);
+  } else if (ext == ".bsp") {
+    // Quake 3 maps: the world's opaque surfaces and the sky that closes it, patches at level 4.
+    mesh = q3_world_mesh(read_q3bsp(path), 4, true);
   } else {
-    throw Error(path, 0, "unknown scene format '" + ext + "' (expected .obj, .ply, .off or .stl)");
+    throw Error(path, 0, "unknown scene format '" + ext + "' (expected .obj, .ply, .off, .stl or .bsp)");
   }
   Scene scene = make_scene(std::move(mesh), grouping, path);
   if (scene.triangles.empty())

@@ -1,0 +1,304 @@
+// Quake 3 BSP reader. Layout (little-endian): "IBSP", version, then 17 lumps (18 for version
+// 47) of {offset, length}; the lumps used here are entities 0, shaders 1, planes 2, nodes 3,
+// leafs 4, leafsurfaces 5, models 7, drawverts 10, drawindexes 11, surfaces 13, visibility 16.
+#include "viewcells/io/q3bsp.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "viewcells/core/error.h"
+
+namespace viewcells {
+
+namespace {
+
+constexpr const char* kLumpNames[] = {"entities", "shaders", "planes", "nodes", "leafs", "leafsurfaces",
+                                      "leafbrushes", "models", "brushes", "brushsides", "drawverts",
+                                      "drawindexes", "fogs", "surfaces", "lightmaps", "lightgrid", "visibility"};
+
+class Reader {
+ public:
+  Reader(const std::string& bytes, const std::string& name) : b_(bytes), name_(name) {}
+
+  [[noreturn]] void fail(const std::string& what) const { throw Error(name_, 0, "Quake 3 BSP: " + what); }
+
+  int32_t i32(size_t at) const {
+    if (at + 4 > b_.size()) fail("file ends early");
+    int32_t v;
+    std::memcpy(&v, b_.data() + at, 4);
+    return v;
+  }
+  float f32(size_t at) const {
+    if (at + 4 > b_.size()) fail("file ends early");
+    float v;
+    std::memcpy(&v, b_.data() + at, 4);
+    if (!std::isfinite(v)) fail("non-finite number at byte " + std::to_string(at));
+    return v;
+  }
+
+  /// Lump `l`: its offset and number of records of `size` bytes, bounds-checked.
+  std::pair<size_t, size_t> lump(int l, size_t size) const {
+    const int32_t off = i32(8 + 8 * l), len = i32(12 + 8 * l);
+    if (off < 0 || len < 0 || static_cast<size_t>(off) + static_cast<size_t>(len) > b_.size())
+      fail(std::string("lump '") + kLumpNames[l] + "' lies outside the file (truncated?)");
+    if (len % size != 0)
+      fail(std::string("lump '") + kLumpNames[l] + "' is not a whole number of " + std::to_string(size) + "-byte records");
+    return {static_cast<size_t>(off), static_cast<size_t>(len) / size};
+  }
+  std::string str(size_t at, size_t n) const { return b_.substr(at, n); }
+
+ private:
+  const std::string& b_;
+  std::string name_;
+};
+
+Vec3 bezier(const Vec3 c[9], double u, double v) {
+  auto b = [](double t, int i) { return i == 0 ? (1 - t) * (1 - t) : (i == 1 ? 2 * t * (1 - t) : t * t); };
+  Vec3 p{0, 0, 0};
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < 3; ++i) p = p + c[3 * j + i] * (b(u, i) * b(v, j));
+  return p;
+}
+
+}  // namespace
+
+bool Q3Map::cluster_sees(int32_t a, int32_t b) const {
+  if (a < 0 || b < 0 || a >= cluster_count || b >= cluster_count) return false;
+  return visibility[static_cast<size_t>(a) * cluster_bytes + (b >> 3)] & (1 << (b & 7));
+}
+
+Q3SurfaceKind Q3Map::kind(const Q3Surface& s) const {
+  const Q3Shader& sh = shaders[s.shader];
+  if (s.type == Q3SurfaceType::kFlare || s.type == Q3SurfaceType::kBad) return Q3SurfaceKind::kSkipped;
+  if (sh.surface_flags & (kQ3SurfNodraw | kQ3SurfHint | kQ3SurfSkip)) return Q3SurfaceKind::kSkipped;
+  if (sh.surface_flags & kQ3SurfSky) return Q3SurfaceKind::kSky;
+  if (sh.content_flags &
+      (kQ3ContentsWater | kQ3ContentsFog | kQ3ContentsSlime | kQ3ContentsLava | kQ3ContentsTranslucent))
+    return Q3SurfaceKind::kNonOccluding;
+  return Q3SurfaceKind::kOpaque;
+}
+
+int32_t Q3Map::leaf_at(const Vec3& p) const {
+  int32_t n = 0;
+  for (size_t steps = 0; n >= 0; ++steps) {
+    if (steps > nodes.size()) throw Error(path, 0, "Quake 3 BSP: the node tree has a cycle");
+    const Q3Node& node = nodes[n];
+    const Q3Plane& pl = planes[node.plane];
+    n = node.children[dot(pl.normal, p) - pl.dist >= 0 ? 0 : 1];
+  }
+  return -(n + 1);
+}
+
+Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
+  Reader r(bytes, name);
+  if (bytes.size() < 8 || bytes.compare(0, 4, "IBSP") != 0) r.fail("not a Quake 3 BSP file (no IBSP header)");
+  Q3Map m;
+  m.path = name;
+  m.version = r.i32(4);
+  if (m.version != 46 && m.version != 47)
+    r.fail("version " + std::to_string(m.version) + " is not supported (46 and 47 are)");
+  if (bytes.size() < 8 + 8 * 17) r.fail("header ends early");
+
+  auto [eo, elen] = r.lump(0, 1);
+  m.entities = r.str(eo, elen);
+  while (!m.entities.empty() && m.entities.back() == '\0') m.entities.pop_back();
+
+  auto [so, sn] = r.lump(1, 72);
+  for (size_t i = 0; i < sn; ++i) {
+    Q3Shader s;
+    const std::string raw = r.str(so + 72 * i, 64);
+    s.name = raw.substr(0, raw.find('\0'));
+    s.surface_flags = r.i32(so + 72 * i + 64);
+    s.content_flags = r.i32(so + 72 * i + 68);
+    m.shaders.push_back(std::move(s));
+  }
+  auto [po, pn] = r.lump(2, 16);
+  for (size_t i = 0; i < pn; ++i)
+    m.planes.push_back({{r.f32(po + 16 * i), r.f32(po + 16 * i + 4), r.f32(po + 16 * i + 8)}, r.f32(po + 16 * i + 12)});
+  auto [lo, ln] = r.lump(4, 48);
+  for (size_t i = 0; i < ln; ++i) {
+    const size_t at = lo + 48 * i;
+    Q3Leaf l;
+    l.cluster = r.i32(at);
+    l.area = r.i32(at + 4);
+    l.bounds = {{double(r.i32(at + 8)), double(r.i32(at + 12)), double(r.i32(at + 16))},
+                {double(r.i32(at + 20)), double(r.i32(at + 24)), double(r.i32(at + 28))}};
+    l.first_surface = r.i32(at + 32);
+    l.surface_count = r.i32(at + 36);
+    m.leaves.push_back(l);
+  }
+  auto [no, nn] = r.lump(3, 36);
+  for (size_t i = 0; i < nn; ++i) {
+    const size_t at = no + 36 * i;
+    Q3Node n;
+    n.plane = r.i32(at);
+    n.children[0] = r.i32(at + 4);
+    n.children[1] = r.i32(at + 8);
+    if (n.plane < 0 || static_cast<size_t>(n.plane) >= m.planes.size()) r.fail("node " + std::to_string(i) + " names a missing plane");
+    for (int32_t c : n.children)
+      if ((c >= 0 && (static_cast<size_t>(c) >= nn || static_cast<size_t>(c) <= i)) ||
+          (c < 0 && static_cast<size_t>(-(c + 1)) >= m.leaves.size()))
+        r.fail("node " + std::to_string(i) + " has a child that does not exist");
+    m.nodes.push_back(n);
+  }
+  if (m.nodes.empty()) r.fail("the map has no BSP nodes");
+  auto [lso, lsn] = r.lump(5, 4);
+  for (size_t i = 0; i < lsn; ++i) m.leaf_surfaces.push_back(r.i32(lso + 4 * i));
+  auto [vo, vn] = r.lump(10, 44);
+  for (size_t i = 0; i < vn; ++i) m.vertices.push_back({r.f32(vo + 44 * i), r.f32(vo + 44 * i + 4), r.f32(vo + 44 * i + 8)});
+  auto [io, in] = r.lump(11, 4);
+  for (size_t i = 0; i < in; ++i) m.indices.push_back(r.i32(io + 4 * i));
+  auto [fo, fn] = r.lump(13, 104);
+  for (size_t i = 0; i < fn; ++i) {
+    const size_t at = fo + 104 * i;
+    Q3Surface s;
+    s.shader = r.i32(at);
+    s.type = static_cast<Q3SurfaceType>(r.i32(at + 8));
+    s.first_vertex = r.i32(at + 12);
+    s.vertex_count = r.i32(at + 16);
+    s.first_index = r.i32(at + 20);
+    s.index_count = r.i32(at + 24);
+    s.patch_width = r.i32(at + 96);
+    s.patch_height = r.i32(at + 100);
+    const std::string which = "surface " + std::to_string(i);
+    if (s.shader < 0 || static_cast<size_t>(s.shader) >= m.shaders.size()) r.fail(which + " names a missing shader");
+    if (s.first_vertex < 0 || s.vertex_count < 0 || static_cast<size_t>(s.first_vertex) + s.vertex_count > vn)
+      r.fail(which + " has vertices outside the drawverts lump");
+    if (s.first_index < 0 || s.index_count < 0 || static_cast<size_t>(s.first_index) + s.index_count > in)
+      r.fail(which + " has indices outside the drawindexes lump");
+    if (s.type == Q3SurfaceType::kPlanar || s.type == Q3SurfaceType::kTriangleSoup) {
+      if (s.index_count % 3 != 0) r.fail(which + " has a partial triangle");
+      for (int32_t k = 0; k < s.index_count; ++k) {
+        const int32_t v = m.indices[s.first_index + k];
+        if (v < 0 || v >= s.vertex_count) r.fail(which + " indexes a vertex it does not own");
+      }
+    }
+    if (s.type == Q3SurfaceType::kPatch &&
+        (s.patch_width < 3 || s.patch_height < 3 || s.patch_width % 2 == 0 || s.patch_height % 2 == 0 ||
+         static_cast<int64_t>(s.patch_width) * s.patch_height != s.vertex_count))
+      r.fail(which + " is a patch with a malformed control grid");
+    m.surfaces.push_back(s);
+  }
+  auto [mo, mn] = r.lump(7, 40);
+  if (mn == 0) r.fail("the map has no world model");
+  m.world_first_surface = r.i32(mo + 24);
+  m.world_surface_count = r.i32(mo + 28);
+  if (m.world_first_surface < 0 || m.world_surface_count < 0 ||
+      static_cast<size_t>(m.world_first_surface) + m.world_surface_count > fn)
+    r.fail("the world model's surfaces lie outside the surfaces lump");
+  for (const Q3Leaf& l : m.leaves)
+    if (l.first_surface < 0 || l.surface_count < 0 || static_cast<size_t>(l.first_surface) + l.surface_count > lsn)
+      r.fail("a leaf's surfaces lie outside the leafsurfaces lump");
+  for (int32_t s : m.leaf_surfaces)
+    if (s < 0 || static_cast<size_t>(s) >= fn) r.fail("a leaf names a missing surface");
+
+  auto [viso, vislen] = r.lump(16, 1);
+  if (vislen > 0) {
+    if (vislen < 8) r.fail("the visibility lump ends early");
+    m.cluster_count = r.i32(viso);
+    m.cluster_bytes = r.i32(viso + 4);
+    if (m.cluster_count < 0 || m.cluster_bytes < 0 || m.cluster_bytes < (m.cluster_count + 7) / 8 ||
+        8 + static_cast<int64_t>(m.cluster_count) * m.cluster_bytes > static_cast<int64_t>(vislen))
+      r.fail("the visibility lump does not hold its " + std::to_string(m.cluster_count) + " cluster rows");
+    const std::string rows = r.str(viso + 8, static_cast<size_t>(m.cluster_count) * m.cluster_bytes);
+    m.visibility.assign(rows.begin(), rows.end());
+    for (const Q3Leaf& l : m.leaves)
+      if (l.cluster >= m.cluster_count) r.fail("a leaf names cluster " + std::to_string(l.cluster) + " of " + std::to_string(m.cluster_count));
+  }
+  return m;
+}
+
+Q3Map read_q3bsp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path, 0, "cannot open file");
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return parse_q3bsp(bytes, path);
+}
+
+RawMesh q3_world_mesh(const Q3Map& map, int patch_level, bool with_sky, Q3MeshStats* stats) {
+  if (patch_level < 1 || patch_level > 64) throw Error("patch tessellation level must be between 1 and 64");
+  RawMesh mesh;
+  Q3MeshStats local;
+  Q3MeshStats& st = stats ? *stats : local;
+  st = Q3MeshStats{};
+  for (int32_t si = map.world_first_surface; si < map.world_first_surface + map.world_surface_count; ++si) {
+    const Q3Surface& s = map.surfaces[si];
+    const Q3SurfaceKind kind = map.kind(s);
+    ++st.surfaces[static_cast<int>(kind)];
+    if (kind == Q3SurfaceKind::kSkipped || kind == Q3SurfaceKind::kNonOccluding) continue;
+    if (kind == Q3SurfaceKind::kSky && !with_sky) continue;
+    const uint32_t group = static_cast<uint32_t>(mesh.group_names.size());
+    mesh.group_names.push_back(map.shaders[s.shader].name + "#" + std::to_string(si));
+    auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
+      mesh.triangles.push_back({a, b, c});
+      mesh.triangle_group.push_back(group);
+    };
+    const uint32_t base = static_cast<uint32_t>(mesh.vertices.size());
+    if (s.type == Q3SurfaceType::kPatch) {
+      ++st.patches;
+      const int w = s.patch_width, h = s.patch_height, n = patch_level;
+      for (int py = 0; py + 2 < h; py += 2)
+        for (int px = 0; px + 2 < w; px += 2) {
+          Vec3 c[9];
+          for (int j = 0; j < 3; ++j)
+            for (int i = 0; i < 3; ++i) c[3 * j + i] = map.vertices[s.first_vertex + (py + j) * w + px + i];
+          const uint32_t first = static_cast<uint32_t>(mesh.vertices.size());
+          for (int j = 0; j <= n; ++j)
+            for (int i = 0; i <= n; ++i) mesh.vertices.push_back(bezier(c, double(i) / n, double(j) / n));
+          for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+              const uint32_t a = first + j * (n + 1) + i, b = a + 1, d = a + (n + 1), e = d + 1;
+              // The front of a patch is along du x dv (checked against the maps' vertex normals).
+              add(a, b, d);
+              add(b, e, d);
+            }
+        }
+      continue;
+    }
+    for (int32_t k = 0; k < s.vertex_count; ++k) mesh.vertices.push_back(map.vertices[s.first_vertex + k]);
+    for (int32_t k = 0; k + 2 < s.index_count; k += 3) {
+      const int32_t* idx = &map.indices[s.first_index + k];
+      // Quake 3 winds triangles clockwise seen from the front (checked against the maps'
+      // vertex normals); the scene wants counter-clockwise.
+      add(base + idx[0], base + idx[2], base + idx[1]);
+    }
+  }
+  st.spawn_points = q3_spawn_points(map).size();
+  return mesh;
+}
+
+std::vector<Vec3> q3_spawn_points(const Q3Map& map) {
+  std::vector<Vec3> out;
+  std::string classname, origin;
+  std::istringstream in(map.entities);
+  std::string line;
+  auto flush = [&] {
+    if ((classname == "info_player_deathmatch" || classname == "info_player_start") && !origin.empty()) {
+      Vec3 p;
+      std::istringstream o(origin);
+      if (o >> p.x >> p.y >> p.z) out.push_back(p);
+    }
+    classname.clear();
+    origin.clear();
+  };
+  while (std::getline(in, line)) {
+    const size_t a = line.find('"');
+    if (line.find('}') != std::string::npos && a == std::string::npos) {
+      flush();
+      continue;
+    }
+    if (a == std::string::npos) continue;
+    const size_t b = line.find('"', a + 1), c = line.find('"', b + 1), d = line.find('"', c + 1);
+    if (b == std::string::npos || c == std::string::npos || d == std::string::npos) continue;
+    const std::string key = line.substr(a + 1, b - a - 1), value = line.substr(c + 1, d - c - 1);
+    if (key == "classname") classname = value;
+    if (key == "origin") origin = value;
+  }
+  flush();
+  return out;
+}
+
+}  // namespace viewcells
