@@ -6,6 +6,7 @@
 
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <iostream>
 
 #include "viewcells/core/error.h"
@@ -23,25 +24,55 @@ Vec3 random_direction(Rng& rng) {
   return {r * std::cos(phi), r * std::sin(phi), z};
 }
 
-/// Rays of one kind: "random" (uniform in the bounds), "edge" (aimed at a point of a triangle
-/// edge), "vertex" (aimed at a vertex).
+/// Rays of one kind: "random" (uniform in the bounds), "edge" (aimed at a point of an edge
+/// shared by two triangles, from the side both face), "vertex" (aimed at a vertex, from a
+/// side every triangle around it faces). Such a ray enters the surface there, so it must hit
+/// it: a miss is a leak, not a graze of a silhouette (which may rightly go either way).
 std::vector<Ray> make_rays(const Scene& scene, const std::string& kind, size_t n, uint64_t seed) {
   Rng rng(seed, kind == "random" ? 1 : (kind == "edge" ? 2 : 3));
   const Box3 b = scene.bounds;
   const double reach = 0.25 * b.diagonal();
   std::vector<Ray> rays;
-  while (rays.size() < n) {
-    if (kind == "random") {
+  if (kind == "random") {
+    while (rays.size() < n) {
       const Vec3 o{b.lo.x + rng.uniform() * (b.hi.x - b.lo.x), b.lo.y + rng.uniform() * (b.hi.y - b.lo.y),
                    b.lo.z + rng.uniform() * (b.hi.z - b.lo.z)};
       rays.push_back({o, random_direction(rng)});
-      continue;
     }
-    const auto& tri = scene.triangles[rng.below(scene.triangles.size())];
-    const int e = static_cast<int>(rng.below(3));
-    const Vec3 p = scene.vertices[tri[e]], q = scene.vertices[tri[(e + 1) % 3]];
-    const Vec3 target = kind == "edge" ? p + (q - p) * rng.uniform() : p;
+    return rays;
+  }
+  // Triangles around each edge and each vertex.
+  std::map<std::pair<uint32_t, uint32_t>, std::vector<uint32_t>> edges;
+  std::vector<std::vector<uint32_t>> around(scene.vertices.size());
+  for (uint32_t t = 0; t < scene.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t u = scene.triangles[t][k], v = scene.triangles[t][(k + 1) % 3];
+      edges[{std::min(u, v), std::max(u, v)}].push_back(t);
+      around[u].push_back(t);
+    }
+  std::vector<std::pair<uint32_t, uint32_t>> shared;
+  for (const auto& [e, tris] : edges)
+    if (tris.size() == 2) shared.push_back(e);
+  if (shared.empty()) throw Error("the scene has no edges shared by two triangles");
+  size_t attempts = 0;
+  while (rays.size() < n && attempts++ < 100 * n) {
+    std::vector<uint32_t> faces;
+    Vec3 target;
+    if (kind == "edge") {
+      const auto e = shared[rng.below(shared.size())];
+      faces = edges[e];
+      const Vec3 p = scene.vertices[e.first], q = scene.vertices[e.second];
+      target = p + (q - p) * (0.05 + 0.9 * rng.uniform());
+    } else {
+      const uint32_t v = static_cast<uint32_t>(rng.below(scene.vertices.size()));
+      if (around[v].size() < 3) continue;
+      faces = around[v];
+      target = scene.vertices[v];
+    }
     const Vec3 d = random_direction(rng);
+    bool facing = true;
+    for (uint32_t t : faces) facing = facing && dot(scene.triangle_normal(t), d) < 0;
+    if (!facing) continue;
     rays.push_back({target - d * (reach * (0.05 + rng.uniform())), d});
   }
   return rays;

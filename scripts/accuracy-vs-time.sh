@@ -17,6 +17,13 @@ rotated=$(bench_scene rotated-office 4)
 city=$(bench_scene city "$size")
 small_city=$(bench_scene city 3)
 out="$dir/accuracy"
+# ACCURACY_REUSE=1 keeps runs already in out/bench/accuracy (to redo only the tables and plots).
+run() {  # run NAME ARGS...: viewcells compare ARGS -o $out/NAME, unless reused
+  local name="$1"
+  shift
+  if [ "${ACCURACY_REUSE:-0}" = 1 ] && [ -f "$out/$name/summary.json" ]; then return; fi
+  "$vc" compare "$@" -o "$out/$name" -q
+}
 mkdir -p "$out" docs/accuracy
 
 # 1. Construction samples; the same 8M (office) / 4M (city) evaluation samples for all.
@@ -24,25 +31,24 @@ for scene in office city; do
   path=$office; eval_samples=8000000
   [ "$scene" = city ] && path=$city && eval_samples=4000000
   for n in 50000 200000 1000000 2000000; do
-    "$vc" compare "$path" --methods av-s --samples "$n" --seed 1 --eval-samples "$eval_samples" --eval-seed 99 \
-      --max-cells "$cells" -o "$out/samples-$scene-$n" -q
+    run "samples-$scene-$n" "$path" --methods av-s --samples "$n" --seed 1 --eval-samples "$eval_samples" \
+      --eval-seed 99 --max-cells "$cells"
   done
 done
 # 2. and 3. on the rotated office: geometry-aligned candidates, and the candidate limits.
-"$vc" compare "$rotated" --methods av-s,av-m --samples 1000000 --seed 1 --eval-seed 99 --max-cells "$cells" \
-  --no-ga -o "$out/ga-off" -q
+run ga-off "$rotated" --methods av-s,av-m --samples 1000000 --seed 1 --eval-seed 99 --max-cells "$cells" --no-ga
 for ga in 50 150 400; do
-  "$vc" compare "$rotated" --methods av-s --samples 1000000 --seed 1 --eval-seed 99 --max-cells "$cells" \
-    --ga-candidates "$ga" -o "$out/ga-$ga" -q
+  run "ga-$ga" "$rotated" --methods av-s --samples 1000000 --seed 1 --eval-seed 99 --max-cells "$cells" \
+    --ga-candidates "$ga"
 done
-"$vc" compare "$rotated" --methods av-m --samples 1000000 --seed 1 --eval-seed 99 --max-cells "$cells" \
-  -o "$out/ga-150-avm" -q
+run ga-150-avm "$rotated" --methods av-m --samples 1000000 --seed 1 --eval-seed 99 --max-cells "$cells"
 for ax in 50 800; do
-  "$vc" compare "$rotated" --methods av-s --samples 1000000 --seed 1 --eval-seed 99 --max-cells "$cells" \
-    --axis-candidates "$ax" -o "$out/axis-$ax" -q
+  run "axis-$ax" "$rotated" --methods av-s --samples 1000000 --seed 1 --eval-seed 99 --max-cells "$cells" \
+    --axis-candidates "$ax"
 done
 # 4. Robust versus fast ray casting.
-build-release/bench/viewcells_leaks "$small_city" "$city" 50000 4000000 "$out/leaks.json" >/dev/null
+[ "${ACCURACY_REUSE:-0}" = 1 ] && [ -f "$out/leaks.json" ] ||
+  build-release/bench/viewcells_leaks "$small_city" "$city" 50000 4000000 "$out/leaks.json" >/dev/null
 
 python3 - "$out" "$cells" "$size" <<'PY' > docs/accuracy-vs-time.md
 import csv, json, sys
@@ -53,6 +59,9 @@ def constructed(run, method):
     return {int(r["cells"]): float(r["constructed_cost"]) for r in csv.DictReader(open(f"{d}/{run}/curves.csv")) if r["method"] == method}
 def summary(run):
     return json.load(open(f"{d}/{run}/summary.json"))
+def near(curve, want):
+    """The reported cell count nearest to `want`."""
+    return min(curve, key=lambda c: abs(c - want))
 def method(run, name):
     return next(m for m in summary(run)["methods"] if m["method"] == name)
 print("# Accuracy versus time\n")
@@ -63,7 +72,7 @@ print("## 1. How many construction samples (paper, figure 6)\n")
 print("The subdivision (AV-S) is built from N samples; the evaluator scores every result on the same "
       "8M (office) or 4M (city) evaluation samples. \"Estimated\" is the builder's own cost from its N "
       "samples: low N under-estimates because it misses visibility.\n")
-print(f"| scene | construction samples | sampling s | subdivision s | estimated cost at {cells:,} | evaluated cost at {cells:,} | evaluated at 100 |")
+print(f"| scene | construction samples | sampling s | subdivision s | estimated cost at {cells:,} | evaluated cost at {cells:,} | evaluated at about 100 |")
 print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
 for scene in ["office", "city"]:
     for n in [50000, 200000, 1000000, 2000000]:
@@ -71,13 +80,13 @@ for scene in ["office", "city"]:
         s = summary(run); m = method(run, "av-s"); c = curve(run, "av-s"); e = constructed(run, "av-s")
         last = max(c)
         print(f"| {scene} | {n:,} | {s['timings']['construction_sampling_seconds']:.2f} | {m['build_seconds']:.1f} | "
-              f"{e[last]:,.0f} | {c[last]:,.0f} | {c.get(100, float('nan')):,.0f} |")
+              f"{e[last]:,.0f} | {c[last]:,.0f} | {c[near(c, 100)]:,.0f} ({near(c, 100)}) |")
 print("\n![office](accuracy/samples-office.png) ![city](accuracy/samples-city.png)\n")
 print("## 2. Geometry-aligned candidates (paper, table 1 and figure 11)\n")
 print("The rotated office (30 degrees about the vertical), 1M construction samples, 4M evaluation samples.\n")
 off, on = curve("ga-off", "av-s"), curve("ga-150", "av-s")
 moff, mon = method("ga-off", "av-s"), method("ga-150", "av-s")
-counts = [c for c in [10, 30, 100, 300, 1000, cells] if c in off and c in on]
+counts = sorted({near(off, w) for w in [10, 30, 100, 300, 1000, cells]} & set(on))
 print("| candidates | subdivision s | merge s (AV-M) | " + " | ".join(f"cost at {c:,}" for c in counts) + " |")
 print("| --- | ---: | ---: | " + " | ".join("---:" for _ in counts) + " |")
 avm_off, avm_on = method("ga-off", "av-m"), method("ga-150-avm", "av-m")
@@ -89,17 +98,20 @@ print("| ratio AA / AA+GA | | | " + " | ".join(f"{off[c] / on[c]:.3f}" for c in 
 print(f"\nThe paper measured a 4-15% benefit on its rotated soda building, and called it marginal for "
       f"the time it costs. ![ratio](accuracy/ga-ratio.png)\n")
 print("## 3. Candidate limits\n")
-print("| axis positions per axis | GA planes per cell | subdivision s | axis candidates evaluated | GA candidates evaluated | cost at 100 | cost at " + f"{cells:,}" + " |")
+print("| axis positions per axis | GA planes per cell | subdivision s | axis candidates evaluated | GA candidates evaluated | cost at about 100 | cost at " + f"{cells:,}" + " |")
 print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
 for run, ax, ga in [("axis-50", 50, 150), ("ga-150", 200, 150), ("axis-800", 800, 150), ("ga-50", 200, 50), ("ga-400", 200, 400)]:
     m = method(run, "av-s"); c = curve(run, "av-s"); last = max(c)
     print(f"| {ax} | {ga} | {m['build_seconds']:.1f} | {m['axis_candidates_evaluated']:,} | {m['geometry_candidates_evaluated']:,} | "
-          f"{c[100]:,.0f} | {c[last]:,.0f} |")
+          f"{c[near(c, 100)]:,.0f} | {c[last]:,.0f} |")
 print("\n## 4. Embree robust versus fast mode\n")
 L = json.load(open(f"{d}/leaks.json"))
 print(f"Leaks are rays the watertight brute-force caster sees hitting a surface that Embree misses or "
-      f"sees behind it, on the {L['leak_scene']['triangles']:,}-triangle city of size 3: random rays, rays aimed "
-      f"at a random point of a random triangle edge, and rays aimed at a vertex. Speed is rays per second "
+      f"sees behind it, on the {L['leak_scene']['triangles']:,}-triangle city of size 3: random rays; rays aimed "
+      f"at a point of an edge shared by two triangles, from the side both of them face; and rays aimed at a "
+      f"vertex from a side all triangles around it face. Those rays enter the surface at the edge or vertex, "
+      f"so missing it is a leak (grazing a silhouette, which may rightly go either way, is excluded). Fewer "
+      f"rays than asked means no such direction was found often enough. Speed is rays per second "
       f"of bare Embree on {L['speed']['robust']['rays']:,} random rays in the {L['speed_scene']['triangles']:,}-triangle "
       "city (best of three).\n")
 print("| mode | Mrays/s | random: leaks / hits | edge-aimed: leaks / hits | vertex-aimed: leaks / hits |")
@@ -110,6 +122,12 @@ for mode in ["robust", "fast"]:
           " | ".join(f"{k[x]['leaks']:,} / {k[x]['oracle_hits']:,}" for x in ["random", "edge", "vertex"]) + " |")
 print(f"\nFast mode is {L['speed']['fast']['rays_per_second'] / L['speed']['robust']['rays_per_second']:.2f} x the "
       "speed of robust mode here; `viewcells` uses robust mode unless `--fast` is given.")
+rl = sum(L["leaks"]["robust"][k]["leaks"] for k in ["edge", "vertex"])
+fl = sum(L["leaks"]["fast"][k]["leaks"] for k in ["edge", "vertex"])
+if rl:
+    print(f"Robust mode lets {rl:,} of these rays through where fast mode lets {fl:,}: not watertight either, "
+          "on this scene. Why is not yet explained (the rays are converted to float before Embree sees them, "
+          "which moves the aim point by up to a float step; the oracle works in double).")
 PY
 
 # Plots: evaluated cost against cells per construction sample count; AA / AA+GA ratio.
