@@ -19,6 +19,7 @@
 #include "viewcells/io/binary_file.h"
 #include "viewcells/eval/compare.h"
 #include "viewcells/eval/compare.h"
+#include "viewcells/io/q3bsp.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/merge/merge.h"
 #include "viewcells/pvs/pvs.h"
@@ -149,6 +150,34 @@ int run_info(const InfoArgs& a, const Common& c) {
             << "empty space detect: " << esd.reason << '\n'
             << "non-axis-aligned:   " << fmt(100.0 * scene.non_axis_aligned_share(), 2) << "% of "
             << fmt(scene.surface_area, 1) << " surface area\n";
+  json map_json;
+  const std::filesystem::path ext = std::filesystem::path(a.scene).extension();
+  if (ext == ".bsp" || ext == ".BSP") {
+    // What the Quake 3 map itself holds besides the geometry.
+    const Q3Map map = read_q3bsp(a.scene);
+    Q3MeshStats st;
+    q3_world_mesh(map, 4, true, &st);
+    size_t solid_leaves = 0;
+    for (const Q3Leaf& l : map.leaves) solid_leaves += l.cluster < 0;
+    std::cout << "quake 3 map:        IBSP version " << map.version << ", " << map.shaders.size() << " shaders, "
+              << map.nodes.size() << " nodes, " << map.leaves.size() << " leaves (" << solid_leaves << " solid)\n"
+              << "world surfaces:     " << st.surfaces[0] << " opaque, " << st.surfaces[1] << " sky (kept: they close "
+              << "the map for rays), " << st.surfaces[2] << " water/fog/translucent (left out for now), " << st.surfaces[3]
+              << " nodraw/hint/skip/flare (left out); " << st.patches << " patches tessellated at level 4\n"
+              << "visibility:         "
+              << (map.has_visibility() ? std::to_string(map.cluster_count) + " clusters, rows of " +
+                                             std::to_string(map.cluster_bytes) + " bytes (q3map2's PVS)"
+                                       : std::string("none (the map was not vis-compiled)"))
+              << "\nspawn points:       " << st.spawn_points << '\n';
+    map_json = {{"version", map.version},
+                {"leaves", map.leaves.size()},
+                {"solid_leaves", solid_leaves},
+                {"surfaces", {{"opaque", st.surfaces[0]}, {"sky", st.surfaces[1]}, {"non_occluding", st.surfaces[2]},
+                              {"skipped", st.surfaces[3]}, {"patches", st.patches}}},
+                {"clusters", map.cluster_count},
+                {"cluster_row_bytes", map.cluster_bytes},
+                {"spawn_points", st.spawn_points}};
+  }
   if (a.list) {
     std::cout << "\n#id\ttriangles\tclosed\toriented\tsolid\tname\n";
     for (size_t i = 0; i < scene.objects.size(); ++i) {
@@ -169,6 +198,7 @@ int run_info(const InfoArgs& a, const Common& c) {
                          {"oriented", o.oriented},
                          {"solid", o.solid()}});
     j["object_list"] = std::move(objects);
+    if (!map_json.is_null()) j["quake3"] = map_json;
     write_json(a.json_path, j);
     c.log("viewcells: wrote " + a.json_path);
   }
