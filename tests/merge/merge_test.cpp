@@ -182,7 +182,9 @@ TEST(Merge, ExtractionByCountMemoryAndCostRatio) {
   for (double ratio : {1.0, 1.05, 1.5, 3.0, 100.0}) {
     const ViewCellSet set = extract_by_cost_ratio(h, ratio);
     EXPECT_LE(set.cost, ratio * h.initial_cost);
-    if (set.cells.size() > h.min_cells()) EXPECT_GT(h.cost_with(set.cells.size() - 1), ratio * h.initial_cost);
+    if (set.cells.size() > h.min_cells()) {
+      EXPECT_GT(h.cost_with(set.cells.size() - 1), ratio * h.initial_cost);
+    }
     expect_tiling(h, f.partition, set.cells);
   }
   EXPECT_EQ(extract_by_cost_ratio(h, 1e9).cells.size(), 1u);

@@ -13,6 +13,38 @@
 
 namespace viewcells {
 
+void put_planes(ByteWriter& w, const std::vector<Plane>& planes) {
+  w.put<uint64_t>(planes.size());
+  for (const Plane& p : planes) {
+    w.put<int32_t>(p.axis);
+    w.put(p.normal);
+    w.put(p.offset);
+    for (const Vec3& q : p.points) w.put(q);
+  }
+}
+
+std::vector<Plane> get_planes(ByteReader& r, uint64_t max_items) {
+  const uint64_t count = r.get<uint64_t>();
+  if (count < 6 || count > max_items) r.fail("invalid plane count");
+  std::vector<Plane> planes(count);
+  for (Plane& p : planes) {
+    p.axis = r.get<int32_t>();
+    p.normal = r.get<Vec3>();
+    p.offset = r.get<double>();
+    for (Vec3& q : p.points) q = r.get<Vec3>();
+    if (p.axis < -1 || p.axis > 2 || !is_finite(p.normal) || !std::isfinite(p.offset)) r.fail("invalid plane");
+  }
+  return planes;
+}
+
+Box3 get_view_box(ByteReader& r) {
+  Box3 b;
+  b.lo = r.get<Vec3>();
+  b.hi = r.get<Vec3>();
+  if (!(b.volume() > 0) || !is_finite(b.lo) || !is_finite(b.hi)) r.fail("invalid view box");
+  return b;
+}
+
 std::vector<std::vector<uint32_t>> leaf_pvs(const Subdivision& s, const SegmentSet& segments) {
   std::vector<std::vector<uint32_t>> pvs(s.nodes.size());
   for (int32_t leaf : s.leaves()) {
@@ -118,13 +150,7 @@ void write_subdivision(const std::string& path, const SubdivisionFile& f) {
   w.put<uint64_t>(f.scene_fingerprint);
   w.put<uint32_t>(f.object_count);
   w.put(s.initial_cost);
-  w.put<uint64_t>(s.planes.size());
-  for (const Plane& p : s.planes) {
-    w.put<int32_t>(p.axis);
-    w.put(p.normal);
-    w.put(p.offset);
-    for (const Vec3& q : p.points) w.put(q);
-  }
+  put_planes(w, s.planes);
   w.put<uint64_t>(s.nodes.size());
   for (const BspNode& n : s.nodes) {
     w.put<int32_t>(n.plane);
@@ -156,8 +182,7 @@ SubdivisionFile read_subdivision(const std::string& path) {
   ByteReader r(payload, path);
   SubdivisionFile f;
   Subdivision& s = f.subdivision;
-  s.view_box.lo = r.get<Vec3>();
-  s.view_box.hi = r.get<Vec3>();
+  s.view_box = get_view_box(r);
   f.cost_model.a = r.get<double>();
   f.cost_model.b = r.get<double>();
   f.cost_model.c = r.get<double>();
@@ -174,18 +199,9 @@ SubdivisionFile read_subdivision(const std::string& path) {
   f.scene_fingerprint = r.get<uint64_t>();
   f.object_count = r.get<uint32_t>();
   s.initial_cost = r.get<double>();
-  if (!(s.view_box.volume() > 0) || !is_finite(s.view_box.lo) || !is_finite(s.view_box.hi)) r.fail("invalid view box");
   const uint64_t max_items = payload.size() / 8;
-  const uint64_t planes = r.get<uint64_t>();
-  if (planes < 6 || planes > max_items) r.fail("invalid plane count");
-  s.planes.resize(planes);
-  for (Plane& p : s.planes) {
-    p.axis = r.get<int32_t>();
-    p.normal = r.get<Vec3>();
-    p.offset = r.get<double>();
-    for (Vec3& q : p.points) q = r.get<Vec3>();
-    if (p.axis < -1 || p.axis > 2 || !is_finite(p.normal) || !std::isfinite(p.offset)) r.fail("invalid plane");
-  }
+  s.planes = get_planes(r, max_items);
+  const uint64_t planes = s.planes.size();
   const uint64_t nodes = r.get<uint64_t>();
   if (nodes == 0 || nodes > max_items || nodes % 2 == 0) r.fail("invalid node count");
   s.nodes.resize(nodes);
@@ -360,8 +376,9 @@ void write_slice_png(const std::string& path, const Subdivision& s, double heigh
       unsigned char* px = &rgb[3 * i];
       const int32_t l = leaf[i];
       cost_colour(l >= 0 ? (view ? view->value[l] : s.nodes[l].pvs_cost) / max_cost : 0.0, px);
-      const int32_t c = cell_of(l);
-      const bool border = (x + 1 < width && cell_of(leaf[i + 1]) != c) || (y + 1 < h && cell_of(leaf[i + width]) != c);
+      const int32_t cell = cell_of(l);
+      const bool border =
+          (x + 1 < width && cell_of(leaf[i + 1]) != cell) || (y + 1 < h && cell_of(leaf[i + width]) != cell);
       if (border)
         for (int c = 0; c < 3; ++c) px[c] = static_cast<unsigned char>(px[c] / 3);
     }

@@ -4,6 +4,7 @@
 #include <iterator>
 #include <map>
 
+#include "viewcells/bsp/subdivision_io.h"
 #include "viewcells/core/error.h"
 #include "viewcells/io/binary_file.h"
 
@@ -254,13 +255,7 @@ void write_pvs(const std::string& path, const PvsFile& f) {
   const Subdivision& s = f.bsp;
   w.put(s.view_box.lo);
   w.put(s.view_box.hi);
-  w.put<uint64_t>(s.planes.size());
-  for (const Plane& p : s.planes) {
-    w.put<int32_t>(p.axis);
-    w.put(p.normal);
-    w.put(p.offset);
-    for (const Vec3& q : p.points) w.put(q);
-  }
+  put_planes(w, s.planes);
   w.put<uint64_t>(s.nodes.size());
   for (size_t n = 0; n < s.nodes.size(); ++n) {
     w.put<int32_t>(s.nodes[n].plane);
@@ -291,19 +286,9 @@ PvsFile read_pvs(const std::string& path) {
   for (uint64_t i = 0; i < names; ++i) f.object_names.push_back(r.get_string());
   f.rule = r.get_string();
   Subdivision& s = f.bsp;
-  s.view_box.lo = r.get<Vec3>();
-  s.view_box.hi = r.get<Vec3>();
-  if (!(s.view_box.volume() > 0) || !is_finite(s.view_box.lo) || !is_finite(s.view_box.hi)) r.fail("invalid view box");
-  const uint64_t planes = r.get<uint64_t>();
-  if (planes < 6 || planes > max_items) r.fail("invalid plane count");
-  s.planes.resize(planes);
-  for (Plane& p : s.planes) {
-    p.axis = r.get<int32_t>();
-    p.normal = r.get<Vec3>();
-    p.offset = r.get<double>();
-    for (Vec3& q : p.points) q = r.get<Vec3>();
-    if (p.axis < -1 || p.axis > 2 || !is_finite(p.normal) || !std::isfinite(p.offset)) r.fail("invalid plane");
-  }
+  s.view_box = get_view_box(r);
+  s.planes = get_planes(r, max_items);
+  const uint64_t planes = s.planes.size();
   const uint64_t nodes = r.get<uint64_t>();
   if (nodes == 0 || nodes > max_items || nodes % 2 == 0) r.fail("invalid node count");
   s.nodes.resize(nodes);

@@ -8,6 +8,7 @@
 
 #include "viewcells/bsp/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
+#include "viewcells/io/binary_file.h"
 #include "viewcells/merge/merge.h"
 
 namespace viewcells {
@@ -22,6 +23,12 @@ struct SubdivisionFile {
   std::optional<MergeHistory> history;
   std::vector<std::string> object_names;  ///< one per object (empty in version 1 and 2 files)
 };
+
+/// Pieces of the hierarchy file that the .pvs file shares: the split planes (count, then
+/// axis, normal, offset and defining points of each), and a validated view box.
+void put_planes(ByteWriter& w, const std::vector<Plane>& planes);
+std::vector<Plane> get_planes(ByteReader& r, uint64_t max_items);
+Box3 get_view_box(ByteReader& r);
 
 /// Sorted object ids seen by the segments of each leaf of `s`.
 std::vector<std::vector<uint32_t>> leaf_pvs(const Subdivision& s, const SegmentSet& segments);
