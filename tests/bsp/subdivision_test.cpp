@@ -93,8 +93,12 @@ void expect_invariants(const Scene& scene, const SegmentSet& segs, const Subdivi
       const double len = length_in_leaf(s, segs, leaf, i);
       const auto& ids = s.segments[leaf];
       const bool listed = std::find(ids.begin(), ids.end(), i) != ids.end();
-      if (len > tol) EXPECT_TRUE(listed) << "segment " << i << " pierces leaf " << leaf << " by " << len;
-      if (len < -tol || (len < 0 && !listed)) EXPECT_FALSE(listed) << "segment " << i << " misses leaf " << leaf;
+      if (len > tol) {
+        EXPECT_TRUE(listed) << "segment " << i << " pierces leaf " << leaf << " by " << len;
+      }
+      if (len < -tol || (len < 0 && !listed)) {
+        EXPECT_FALSE(listed) << "segment " << i << " misses leaf " << leaf;
+      }
       ++checked;
     }
   }

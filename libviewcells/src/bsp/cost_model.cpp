@@ -1,6 +1,7 @@
 #include "viewcells/bsp/cost_model.h"
 
 #include <algorithm>
+#include <iterator>
 #include <cmath>
 #include <numbers>
 
@@ -66,6 +67,25 @@ double cell_object_cost(const ObjectInfo& object, double base, const std::vector
   double sum = 0;
   for (const Vec3& p : points) sum += projected_pixels(object, p, model);
   return std::max(base, model.c * sum / static_cast<double>(points.size()));
+}
+
+double pvs_cost(const Scene& scene, const std::vector<double>& base, const CostModel& model,
+                const std::vector<uint32_t>& pvs, const Box3& bounds) {
+  double c = 0;
+  if (!model.pixel_term()) {
+    for (uint32_t o : pvs) c += base[o];
+    return c;
+  }
+  const std::vector<Vec3> points = pixel_estimation_points(bounds);
+  for (uint32_t o : pvs) c += cell_object_cost(scene.objects[o], base[o], points, model);
+  return c;
+}
+
+std::vector<uint32_t> unite_sorted(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+  std::vector<uint32_t> u;
+  u.reserve(a.size() + b.size());
+  std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(u));
+  return u;
 }
 
 }  // namespace viewcells

@@ -406,9 +406,9 @@ class Builder {
       for (uint32_t t : tris_[node]) {
         bool neg = false, pos = false;
         for (uint32_t v : scene_.triangles[t]) {
-          const int side = plane.side(scene_.vertices[v]);
-          neg |= side < 0;
-          pos |= side > 0;
+          const int at = plane.side(scene_.vertices[v]);
+          neg |= at < 0;
+          pos |= at > 0;
         }
         if (neg) tri_side[0].push_back(t);
         if (pos) tri_side[1].push_back(t);

@@ -51,26 +51,6 @@ double CostCurve::at(uint32_t n) const {
 
 namespace {
 
-/// r(PVS) of a cell with bounds `bounds`.
-double pvs_cost(const Scene& scene, const std::vector<double>& base, const CostModel& model,
-                const std::vector<uint32_t>& pvs, const Box3& bounds) {
-  double c = 0;
-  if (!model.pixel_term()) {
-    for (uint32_t o : pvs) c += base[o];
-    return c;
-  }
-  const std::vector<Vec3> points = pixel_estimation_points(bounds);
-  for (uint32_t o : pvs) c += cell_object_cost(scene.objects[o], base[o], points, model);
-  return c;
-}
-
-std::vector<uint32_t> unite(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
-  std::vector<uint32_t> u;
-  u.reserve(a.size() + b.size());
-  std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(u));
-  return u;
-}
-
 /// Evaluated r(PVS) of every node of the BSP (children have larger ids than their parent).
 std::vector<double> bsp_node_costs(const Scene& scene, const Subdivision& s,
                                    const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
@@ -89,7 +69,7 @@ std::vector<double> bsp_node_costs(const Scene& scene, const Subdivision& s,
         bounds[i] = s.cells[i].bounds();
       }
     } else {
-      pvs[i] = unite(pvs[node.child[0]], pvs[node.child[1]]);
+      pvs[i] = unite_sorted(pvs[node.child[0]], pvs[node.child[1]]);
       bounds[i] = bounds[node.child[0]];
       bounds[i].extend(bounds[node.child[1]]);
       pvs[node.child[0]] = {};
@@ -114,7 +94,7 @@ std::vector<double> mht_node_costs(const Scene& scene, const Subdivision& s, con
     if (m.child[0] < 0) {
       pvs[i] = leaf_pvs[leaves[i]];
     } else {
-      pvs[i] = unite(pvs[m.child[0]], pvs[m.child[1]]);
+      pvs[i] = unite_sorted(pvs[m.child[0]], pvs[m.child[1]]);
       pvs[m.child[0]] = {};
       pvs[m.child[1]] = {};
     }

@@ -211,7 +211,7 @@ class Merger {
       node.volume = h.nodes[e.x].volume + h.nodes[e.y].volume;
       node.bounds = h.nodes[e.x].bounds;
       node.bounds.extend(h.nodes[e.y].bounds);
-      pvs_[z] = unite(pvs_[e.x], pvs_[e.y]);
+      pvs_[z] = unite_sorted(pvs_[e.x], pvs_[e.y]);
       node.pvs_cost = pvs_cost(pvs_[z], node.bounds);
       node.pvs_size = static_cast<uint32_t>(pvs_[z].size());
       // The recorded cost uses the merged cell's actual r(PVS), not the queued estimate.
@@ -250,23 +250,8 @@ class Merger {
   }
 
  private:
-  /// r(PVS) of a cell with bounding box `bounds`.
   double pvs_cost(const std::vector<uint32_t>& pvs, const Box3& bounds) const {
-    double c = 0;
-    if (!model_.pixel_term()) {
-      for (uint32_t o : pvs) c += r_[o];
-      return c;
-    }
-    const std::vector<Vec3> points = pixel_estimation_points(bounds);
-    for (uint32_t o : pvs) c += cell_object_cost(scene_.objects[o], r_[o], points, model_);
-    return c;
-  }
-
-  static std::vector<uint32_t> unite(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
-    std::vector<uint32_t> u;
-    u.reserve(a.size() + b.size());
-    std::set_union(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(u));
-    return u;
+    return viewcells::pvs_cost(scene_, r_, model_, pvs, bounds);
   }
 
   /// delta(x, y) for every entry.
@@ -300,7 +285,7 @@ class Merger {
     } else {
       Box3 bounds = nx.bounds;
       bounds.extend(ny.bounds);
-      merged = pvs_cost(unite(a, b), bounds);
+      merged = pvs_cost(unite_sorted(a, b), bounds);
     }
     return ((nx.weight + ny.weight) * merged - nx.weight * nx.pvs_cost - ny.weight * ny.pvs_cost) / W_;
   }

@@ -55,4 +55,12 @@ std::vector<Vec3> pixel_estimation_points(const Box3& cell_bounds);
 double cell_object_cost(const ObjectInfo& object, double base, const std::vector<Vec3>& points,
                         const CostModel& model);
 
+/// r(PVS) of a cell with bounding box `bounds` whose PVS is `pvs` (object ids): the sum of
+/// cell_object_cost over its objects, or of `base` alone without the pixel term.
+double pvs_cost(const Scene& scene, const std::vector<double>& base, const CostModel& model,
+                const std::vector<uint32_t>& pvs, const Box3& bounds);
+
+/// The union of two sorted id lists, sorted.
+std::vector<uint32_t> unite_sorted(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b);
+
 }  // namespace viewcells
