@@ -20,12 +20,7 @@ namespace viewcells {
 namespace {
 
 SegmentSet sample(const Scene& scene, uint64_t samples, uint64_t seed = 1) {
-  const auto caster = make_embree_caster(scene);
-  SamplerConfig config;
-  config.samples = samples;
-  config.seed = seed;
-  config.show_progress = false;
-  return sample_segments(scene, *caster, config).segments;
+  return test::sample_scene(scene, samples, seed);
 }
 
 Subdivision build_with(const Scene& scene, const SegmentSet& segs, const CostModel& model) {

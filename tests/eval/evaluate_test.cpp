@@ -1,6 +1,8 @@
 // The evaluator and the baselines (view-cell-construction paper, section 6).
 #include <gtest/gtest.h>
 
+#include "support/test_scenes.h"
+
 #include <cmath>
 
 #include "viewcells/bsp/subdivision_io.h"
@@ -15,13 +17,8 @@
 namespace viewcells {
 namespace {
 
-SegmentSet sample(const Scene& scene, uint64_t samples, uint64_t seed) {
-  const auto caster = make_embree_caster(scene);
-  SamplerConfig config;
-  config.samples = samples;
-  config.seed = seed;
-  config.show_progress = false;
-  return sample_segments(scene, *caster, config).segments;
+SegmentSet sample(const Scene& scene, uint64_t samples, uint64_t seed = 1) {
+  return test::sample_scene(scene, samples, seed);
 }
 
 Subdivision build(const Scene& scene, const SegmentSet& segs, const std::string& method, uint32_t cells) {

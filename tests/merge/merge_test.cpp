@@ -1,6 +1,8 @@
 // Merging, the merge history tree and extraction (view-cell-construction paper, 4.3 and 5.1).
 #include <gtest/gtest.h>
 
+#include "support/test_scenes.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -15,12 +17,8 @@
 namespace viewcells {
 namespace {
 
-SegmentSet sample(const Scene& scene, uint64_t samples) {
-  const auto caster = make_embree_caster(scene);
-  SamplerConfig config;
-  config.samples = samples;
-  config.show_progress = false;
-  return sample_segments(scene, *caster, config).segments;
+SegmentSet sample(const Scene& scene, uint64_t samples, uint64_t seed = 1) {
+  return test::sample_scene(scene, samples, seed);
 }
 
 struct Fixture {

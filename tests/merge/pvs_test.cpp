@@ -26,11 +26,7 @@ struct Built {
 Built build(GeneratorKind kind, int size, uint64_t samples, uint32_t cells) {
   Built b;
   b.scene = generate_scene({kind, 1, size});
-  const auto caster = make_embree_caster(b.scene);
-  SamplerConfig sc;
-  sc.samples = samples;
-  sc.show_progress = false;
-  b.segs = sample_segments(b.scene, *caster, sc).segments;
+  b.segs = test::sample_scene(b.scene, samples);
   SubdivisionConfig config;
   config.max_cells = cells;
   config.show_progress = false;

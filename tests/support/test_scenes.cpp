@@ -1,5 +1,8 @@
 #include "support/test_scenes.h"
 
+#include "viewcells/raycast/ray_caster.h"
+#include "viewcells/sampling/sampler.h"
+
 #include <unistd.h>
 
 #include <filesystem>
@@ -50,6 +53,15 @@ std::string temp_path(const std::string& name) {
 void write_file(const std::string& path, const std::string& text) {
   std::ofstream out(path, std::ios::binary);
   out << text;
+}
+
+SegmentSet sample_scene(const Scene& scene, uint64_t samples, uint64_t seed) {
+  const auto caster = make_embree_caster(scene);
+  SamplerConfig config;
+  config.samples = samples;
+  config.seed = seed;
+  config.show_progress = false;
+  return sample_segments(scene, *caster, config).segments;
 }
 
 }  // namespace viewcells::test

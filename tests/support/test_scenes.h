@@ -2,6 +2,7 @@
 // Small scenes built in code for tests, and helpers shared by several test files.
 #include <string>
 
+#include "viewcells/sampling/segments.h"
 #include "viewcells/scene/scene.h"
 
 namespace viewcells::test {
@@ -10,6 +11,8 @@ namespace viewcells::test {
 void add_cube(RawMesh& mesh, const Vec3& lo, const Vec3& hi, const std::string& group);
 /// A scene of `n` x `n` cubes on a grid, each an object; closed and solid.
 Scene cube_grid(int n, double spacing = 3.0, double size = 1.0);
+/// Visibility segments of `samples` samples (Embree, default settings, no progress bar).
+SegmentSet sample_scene(const Scene& scene, uint64_t samples, uint64_t seed = 1);
 /// A temporary directory unique to this test process; files are removed at exit.
 std::string temp_path(const std::string& name);
 /// Writes text to a file (for loader tests).
