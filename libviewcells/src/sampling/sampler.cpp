@@ -77,7 +77,7 @@ Vec3 sample_direction(Rng& rng) {
 
 Vec3 clamp_to_box(const Vec3& p, const Box3& b) { return max(b.lo, min(b.hi, p)); }
 
-/// Draws the points and directions of batch `batch` (samples [first, first + count)).
+/// Draws the points and directions of the `count` samples of batch `batch`.
 void draw_batch(uint64_t seed, uint64_t batch, size_t count, const Box3& box, std::vector<Vec3>& points,
                 std::vector<Vec3>& dirs) {
   Rng rng(seed, batch);
@@ -90,9 +90,9 @@ void draw_batch(uint64_t seed, uint64_t batch, size_t count, const Box3& box, st
   }
 }
 
-/// What one batch produced: its segments sit in the shared output at [first, first + valid).
+/// What one batch produced: its segments are the first `valid` of its scratch set.
 struct BatchOutput {
-  size_t first = 0, valid = 0;
+  size_t valid = 0;
   uint64_t rays = 0, recast_rays = 0, missed_both = 0, stuck = 0, outside = 0, two_sided = 0;
 };
 
@@ -104,8 +104,8 @@ class BatchSampler {
   /// At most one segment per sample, or two when a sample inside a solid re-casts both ways.
   static size_t segments_per_sample(bool esd) { return esd ? 2 : 1; }
 
-  /// Samples batch `batch` and writes its valid segments to `segs` from index out.first on
-  /// (the batch's own slots: at most segments_per_sample() * count of them).
+  /// Samples batch `batch` and writes its valid segments to `segs` from index 0 on (scratch
+  /// slots: at most segments_per_sample() * count of them); out.valid says how many.
   void run(uint64_t seed, uint64_t batch, size_t count, SegmentSet& segs, BatchOutput& out,
            std::vector<Ray>* log = nullptr) {
     segs_ = &segs;
@@ -200,7 +200,7 @@ class BatchSampler {
     if (std::isfinite(t0) && std::isfinite(t1) && t1 - t0 > eps_) {
       const Vec3 a = o + d * t0, b = o + d * t1;
       if (box_.contains(a, eps_) && box_.contains(b, eps_)) {
-        segs_->set(out.first + out.valid++, clamp_to_box(a, box_), clamp_to_box(b, box_), o0, o1, tri0, tri1);
+        segs_->set(out.valid++, clamp_to_box(a, box_), clamp_to_box(b, box_), o0, o1, tri0, tri1);
         return;
       }
     }
@@ -214,7 +214,7 @@ class BatchSampler {
     // Hits beyond the box keep their object: it is visible from the part inside the box.
     const Vec3 a = clamp_to_box(o + d * std::max(t0, c0), box_);
     const Vec3 b = clamp_to_box(o + d * std::min(t1, c1), box_);
-    segs_->set(out.first + out.valid++, a, b, o0, o1, tri0, tri1);
+    segs_->set(out.valid++, a, b, o0, o1, tri0, tri1);
   }
 
   const RayCaster& caster_;
