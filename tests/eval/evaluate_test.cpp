@@ -117,7 +117,9 @@ TEST(Baselines, KdTreesSplitAtTheMedianBreadthFirst) {
       ASSERT_GE(p.axis, 0);
       // Halves of equal volume: the spatial median.
       EXPECT_NEAR(s.nodes[n.child[0]].volume, s.nodes[n.child[1]].volume, 1e-9 * n.volume);
-      if (std::string(method) == "kd-casm") EXPECT_EQ(p.axis, depth[r.node] % 3);
+      if (std::string(method) == "kd-casm") {
+        EXPECT_EQ(p.axis, depth[r.node] % 3);
+      }
     }
   }
 }

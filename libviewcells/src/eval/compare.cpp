@@ -87,16 +87,18 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
       const double merge_seconds = seconds_since(tm);
       r.build_seconds += merge_seconds;
       out.evaluation_seconds -= merge_seconds;  // counted below with the evaluation otherwise
-      r.evaluated = evaluate_merge_history(scene, *s, h, pvs, config.model);
+      const std::vector<double> node_cost = evaluated_merge_costs(scene, *s, h, pvs, config.model);
+      r.evaluated = merge_history_curve(h, node_cost);
       for (size_t cells = h.min_cells(); cells <= h.leaf_count; ++cells) {
         r.constructed.cells.push_back(static_cast<uint32_t>(cells));
         r.constructed.cost.push_back(h.cost_with(cells));
       }
       r.leaves = h.leaf_count;
       if (hist_cells >= h.min_cells() && hist_cells <= h.leaf_count)
-        r.cells = merged_cells_at(scene, *s, h, pvs, config.model, hist_cells);
+        r.cells = merged_cells_at(h, node_cost, hist_cells);
     } else {
-      r.evaluated = evaluate_subdivision(scene, *s, pvs, config.model);
+      const std::vector<double> node_cost = evaluated_bsp_costs(scene, *s, pvs, config.model);
+      r.evaluated = subdivision_curve(*s, node_cost);
       r.constructed.cells.push_back(1);
       r.constructed.cost.push_back(s->initial_cost);
       for (size_t k = 0; k < s->splits.size(); ++k) {
@@ -104,7 +106,7 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
         r.constructed.cost.push_back(s->splits[k].cost_after);
       }
       r.leaves = static_cast<uint32_t>(s->leaf_count());
-      if (hist_cells <= s->leaf_count()) r.cells = subdivision_cells_at(scene, *s, pvs, config.model, hist_cells);
+      if (hist_cells <= s->leaf_count()) r.cells = subdivision_cells_at(*s, node_cost, hist_cells);
     }
     out.evaluation_seconds += seconds_since(t);
     out.methods.push_back(std::move(r));

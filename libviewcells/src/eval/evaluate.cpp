@@ -49,10 +49,8 @@ double CostCurve::at(uint32_t n) const {
   return cost[it - cells.begin()];
 }
 
-namespace {
-
-/// Evaluated r(PVS) of every node of the BSP (children have larger ids than their parent).
-std::vector<double> bsp_node_costs(const Scene& scene, const Subdivision& s,
+// Children have larger ids than their parent in the BSP, smaller ones in the merge history.
+std::vector<double> evaluated_bsp_costs(const Scene& scene, const Subdivision& s,
                                    const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
   if (leaf_pvs.size() != s.nodes.size()) throw Error("evaluation PVSs do not match the subdivision");
   const std::vector<double> base = per_object_costs(scene, model);
@@ -80,8 +78,7 @@ std::vector<double> bsp_node_costs(const Scene& scene, const Subdivision& s,
   return r;
 }
 
-/// Evaluated r(PVS) of every node of the merge history (children have smaller ids).
-std::vector<double> mht_node_costs(const Scene& scene, const Subdivision& s, const MergeHistory& h,
+std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision& s, const MergeHistory& h,
                                    const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
   const std::vector<int32_t> leaves = s.leaves();
   if (leaves.size() != h.leaf_count || leaf_pvs.size() != s.nodes.size())
@@ -103,28 +100,26 @@ std::vector<double> mht_node_costs(const Scene& scene, const Subdivision& s, con
   return r;
 }
 
-}  // namespace
-
-CostCurve evaluate_subdivision(const Scene& scene, const Subdivision& s,
-                               const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
-  const std::vector<double> r = bsp_node_costs(scene, s, leaf_pvs, model);
+CostCurve subdivision_curve(const Subdivision& s, const std::vector<double>& r) {
+  if (r.size() != s.nodes.size()) throw Error("node costs do not match the subdivision");
   const double W = s.nodes[0].weight;
   CostCurve curve;
   double c = r[0];
   curve.cells.push_back(1);
   curve.cost.push_back(c);
   for (size_t k = 0; k < s.splits.size(); ++k) {
-    const BspNode& n = s.nodes[s.splits[k].node];
-    c += (s.nodes[n.child[0]].weight * r[n.child[0]] + s.nodes[n.child[1]].weight * r[n.child[1]] - n.weight * r[s.splits[k].node]) / W;
+    const int32_t n = s.splits[k].node;
+    const BspNode& node = s.nodes[n];
+    c += (s.nodes[node.child[0]].weight * r[node.child[0]] + s.nodes[node.child[1]].weight * r[node.child[1]] -
+          node.weight * r[n]) / W;
     curve.cells.push_back(static_cast<uint32_t>(k + 2));
     curve.cost.push_back(c);
   }
   return curve;
 }
 
-CostCurve evaluate_merge_history(const Scene& scene, const Subdivision& s, const MergeHistory& h,
-                                 const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
-  const std::vector<double> r = mht_node_costs(scene, s, h, leaf_pvs, model);
+CostCurve merge_history_curve(const MergeHistory& h, const std::vector<double>& r) {
+  if (r.size() != h.nodes.size()) throw Error("node costs do not match the merge history");
   const double W = h.total_weight;
   std::vector<double> after(h.merges() + 1);  // after[k]: cost after k merges
   double c = 0;
@@ -144,22 +139,26 @@ CostCurve evaluate_merge_history(const Scene& scene, const Subdivision& s, const
   return curve;
 }
 
-std::vector<CellCost> subdivision_cells_at(const Scene& scene, const Subdivision& s,
-                                           const std::vector<std::vector<uint32_t>>& leaf_pvs,
-                                           const CostModel& model, uint32_t cells) {
+CostCurve evaluate_subdivision(const Scene& scene, const Subdivision& s,
+                               const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
+  return subdivision_curve(s, evaluated_bsp_costs(scene, s, leaf_pvs, model));
+}
+
+CostCurve evaluate_merge_history(const Scene& scene, const Subdivision& s, const MergeHistory& h,
+                                 const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
+  return merge_history_curve(h, evaluated_merge_costs(scene, s, h, leaf_pvs, model));
+}
+
+std::vector<CellCost> subdivision_cells_at(const Subdivision& s, const std::vector<double>& r, uint32_t cells) {
   if (cells < 1 || cells > s.leaf_count()) throw Error("the subdivision has no set of " + std::to_string(cells) + " cells");
-  const std::vector<double> r = bsp_node_costs(scene, s, leaf_pvs, model);
   std::vector<CellCost> out;
   for (int32_t n : s.leaves_after(cells - 1)) out.push_back({r[n], s.nodes[n].volume});
   return out;
 }
 
-std::vector<CellCost> merged_cells_at(const Scene& scene, const Subdivision& s, const MergeHistory& h,
-                                      const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model,
-                                      uint32_t cells) {
+std::vector<CellCost> merged_cells_at(const MergeHistory& h, const std::vector<double>& r, uint32_t cells) {
   if (cells < h.min_cells() || cells > h.leaf_count)
     throw Error("the merge history has no set of " + std::to_string(cells) + " cells");
-  const std::vector<double> r = mht_node_costs(scene, s, h, leaf_pvs, model);
   std::vector<CellCost> out;
   for (int32_t n : h.cut_after(h.leaf_count - cells)) out.push_back({r[n], h.nodes[n].volume});
   return out;

@@ -26,10 +26,22 @@ struct CostCurve {
   double at(uint32_t n) const;
 };
 
-/// c(S) after every split of `s`, 1 .. leaf_count cells, with the leaves' evaluation PVSs.
+/// Evaluated r(PVS) of every node of the BSP `s` (inner nodes: the union of their leaves),
+/// from the leaves' evaluation PVSs; what the curves and cell sets below read.
+std::vector<double> evaluated_bsp_costs(const Scene& scene, const Subdivision& s,
+                                        const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model);
+/// The same for every node of the merge history `h` over the leaves of `s`.
+std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision& s, const MergeHistory& h,
+                                          const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model);
+
+/// c(S) after every split of `s`, 1 .. leaf_count cells, from evaluated_bsp_costs.
+CostCurve subdivision_curve(const Subdivision& s, const std::vector<double>& node_cost);
+/// c(S) along the merge history, min_cells .. leaf_count cells, from evaluated_merge_costs.
+CostCurve merge_history_curve(const MergeHistory& h, const std::vector<double>& node_cost);
+
+/// Both in one call, for a single curve.
 CostCurve evaluate_subdivision(const Scene& scene, const Subdivision& s,
                                const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model);
-/// c(S) along the merge history over the leaves of `s`, min_cells .. leaf_count cells.
 CostCurve evaluate_merge_history(const Scene& scene, const Subdivision& s, const MergeHistory& h,
                                  const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model);
 
@@ -39,12 +51,8 @@ struct CellCost {
   double volume = 0;
 };
 /// The cells of `s` after `cells - 1` splits.
-std::vector<CellCost> subdivision_cells_at(const Scene& scene, const Subdivision& s,
-                                           const std::vector<std::vector<uint32_t>>& leaf_pvs,
-                                           const CostModel& model, uint32_t cells);
+std::vector<CellCost> subdivision_cells_at(const Subdivision& s, const std::vector<double>& node_cost, uint32_t cells);
 /// The cells of the merge history's cut with `cells` cells.
-std::vector<CellCost> merged_cells_at(const Scene& scene, const Subdivision& s, const MergeHistory& h,
-                                      const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model,
-                                      uint32_t cells);
+std::vector<CellCost> merged_cells_at(const MergeHistory& h, const std::vector<double>& node_cost, uint32_t cells);
 
 }  // namespace viewcells
