@@ -620,8 +620,7 @@ int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
   config.subdivision.ga_candidates = ca.ga_candidates;
   config.histogram_cells = ca.histogram_cells;
   config.show_progress = !c.quiet;
-  for (const std::string& m : config.methods)
-    if (m != "av-m") parse_split_strategy(m);
+  check_methods(config.methods);  // before the output directory is made
   std::filesystem::create_directories(ca.output);
   Sampled loaded;
   load_for_sampling(a, c, loaded);

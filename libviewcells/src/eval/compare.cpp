@@ -29,10 +29,14 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 
 }  // namespace
 
+void check_methods(const std::vector<std::string>& methods) {
+  if (methods.empty()) throw Error("no methods to compare");
+  for (const std::string& m : methods)
+    if (m != "av-m") parse_split_strategy(m);
+}
+
 Comparison compare_methods(const Scene& scene, const RayCaster& caster, const CompareConfig& config) {
-  for (const std::string& m : config.methods)
-    if (m != "av-m") parse_split_strategy(m);  // unknown names fail before any work
-  if (config.methods.empty()) throw Error("no methods to compare");
+  check_methods(config.methods);  // unknown names fail before any work
   if (config.construction.seed == config.evaluation.seed)
     throw Error("evaluation samples need their own seed (it equals the construction seed)");
   Comparison out;

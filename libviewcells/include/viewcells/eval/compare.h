@@ -42,6 +42,9 @@ struct Comparison {
   double evaluation_seconds = 0;
 };
 
+/// Throws Error for an empty list or a name that is not one of the methods.
+void check_methods(const std::vector<std::string>& methods);
+
 /// Builds every method of config.methods and evaluates it. Throws Error for unknown methods.
 Comparison compare_methods(const Scene& scene, const RayCaster& caster, const CompareConfig& config);
 
