@@ -3,9 +3,12 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -18,11 +21,12 @@
 #include "viewcells/core/progress.h"
 #include "viewcells/io/binary_file.h"
 #include "viewcells/eval/compare.h"
-#include "viewcells/eval/compare.h"
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/merge/merge.h"
 #include "viewcells/pvs/pvs.h"
+#include "viewcells/q3/compare.h"
+#include "viewcells/q3/view_space.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
 #include "viewcells/scene/generators.h"
@@ -161,8 +165,8 @@ int run_info(const InfoArgs& a, const Common& c) {
     for (const Q3Leaf& l : map.leaves) solid_leaves += l.cluster < 0;
     std::cout << "quake 3 map:        IBSP version " << map.version << ", " << map.shaders.size() << " shaders, "
               << map.nodes.size() << " nodes, " << map.leaves.size() << " leaves (" << solid_leaves << " solid)\n"
-              << "world surfaces:     " << st.surfaces[0] << " opaque, " << st.surfaces[1] << " sky (kept: they close "
-              << "the map for rays), " << st.surfaces[2] << " water/fog/translucent (left out for now), " << st.surfaces[3]
+              << "world surfaces:     " << st.surfaces[0] << " opaque, " << st.surfaces[1] << " sky (they close "
+              << "the map for rays but are not rendered: no render cost), " << st.surfaces[2] << " water/fog/translucent (left out for now), " << st.surfaces[3]
               << " nodraw/hint/skip/flare (left out); " << st.patches << " patches tessellated at level 4\n"
               << "visibility:         "
               << (map.has_visibility() ? std::to_string(map.cluster_count) + " clusters, rows of " +
@@ -242,10 +246,31 @@ void add_sampling_options(CLI::App* cmd, SampleArgs& a) {
 struct Sampled {
   Scene scene;
   std::unique_ptr<RayCaster> caster;
+  std::shared_ptr<const Q3Map> map;  ///< the Quake 3 map, when the scene is one
   SamplerConfig config;
   SamplingResult result;
   double load_s = 0, bvh_s = 0;
+  std::string view_space = "the whole view box";  ///< where sample origins are drawn, in words
 };
+
+bool is_q3_map(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return ext == ".bsp";
+}
+
+/// A Quake 3 map's view space is its non-solid space: sample origins are drawn there, and the
+/// view box defaults to the bounds of its non-solid leaves.
+void use_map_view_space(Sampled& s, SamplerConfig& config) {
+  if (!s.map) return;
+  std::shared_ptr<const Q3Map> map = s.map;
+  config.view_space = [map](const Vec3& p) { return q3_in_view_space(*map, p); };
+  if (config.view_box.empty()) config.view_box = q3_view_box(*map);
+  size_t open = 0;
+  for (const Q3Leaf& l : map->leaves) open += l.cluster >= 0;
+  s.view_space = "the map's non-solid space (" + std::to_string(open) + " of " + std::to_string(map->leaves.size()) +
+                 " leaves): sample origins in solid leaves are drawn again";
+}
 
 SamplerConfig sampler_config(const SampleArgs& a, const Common& c) {
   if (a.samples == 0) throw Error("--samples must be positive");
@@ -265,6 +290,7 @@ SamplerConfig sampler_config(const SampleArgs& a, const Common& c) {
 void load_for_sampling(const SampleArgs& a, const Common& c, Sampled& out) {
   Stopwatch sw;
   out.scene = load_scene(a.scene, parse_grouping(a.objects));
+  if (is_q3_map(a.scene)) out.map = std::make_shared<const Q3Map>(read_q3bsp(a.scene));
   out.load_s = sw.seconds();
   c.log("viewcells: " + a.scene + ": " + std::to_string(out.scene.object_count()) + " objects, " +
         std::to_string(out.scene.triangle_count()) + " triangles, loaded in " + fmt(out.load_s, 2) + " s");
@@ -278,14 +304,15 @@ void load_for_sampling(const SampleArgs& a, const Common& c, Sampled& out) {
 Sampled load_and_sample(const SampleArgs& a, const Common& c, int threads) {
   Sampled out;
   out.config = sampler_config(a, c);
-  const SamplerConfig& config = out.config;
   load_for_sampling(a, c, out);
+  use_map_view_space(out, out.config);
+  const SamplerConfig& config = out.config;
   const EmptySpaceDecision esd = decide_empty_space(out.scene, config.empty_space);
   c.log("viewcells: sampling " +
         (a.segments ? "until " + std::to_string(a.segments) + " segments" : std::to_string(a.samples) + " samples") +
         ", seed " + std::to_string(a.seed) + ", " + std::to_string(threads) + " threads, " + out.caster->name() +
         "; view box " + (config.view_box.empty() ? "= scene bounds" : describe_box(config.view_box)) +
-        "; empty space detection " + esd.reason);
+        "; view space " + out.view_space + "; empty space detection " + esd.reason);
   out.result = sample_segments(out.scene, *out.caster, config);
   const SamplingStats& st = out.result.stats;
   c.log("viewcells: " + std::to_string(st.valid_segments) + " valid segments of " + std::to_string(st.samples) +
@@ -304,7 +331,10 @@ json sampling_report(const SampleArgs& a, const Sampled& s, int threads) {
                         {"threads", threads},
                         {"object_grouping", to_string(s.scene.grouping)},
                         {"view_box", to_json(st.view_box)},
-                        {"view_box_source", st.view_box_from_scene ? "scene bounds" : "user (--view-box)"},
+                        {"view_box_source", st.view_box_from_scene ? "scene bounds"
+                                            : (s.map && a.view_box.empty() ? "the map's non-solid leaves"
+                                                                           : "user (--view-box)")},
+                        {"view_space", s.view_space},
                         {"ray_caster", s.caster->name()},
                         {"max_recasts", a.max_recasts},
                         {"batch_size", s.config.batch_size}};
@@ -327,6 +357,7 @@ json sampling_report(const SampleArgs& a, const Sampled& s, int threads) {
                       {"stuck_in_solid", st.stuck_in_solid},
                       {"outside_view_box", st.outside_view_box},
                       {"two_sided_samples", st.two_sided_samples},
+                      {"rejected_origins", st.rejected_origins},
                       {"objects_hit", objects_hit},
                       {"objects_never_hit", s.scene.object_count() - objects_hit},
                       {"max_segments_per_object", max_per_object},
@@ -468,6 +499,11 @@ int run_build(const SampleArgs& a, const BuildArgs& b, const Common& c) {
   Subdivision sub = subdivide(s.scene, s.result.segments, model, config);
   c.log("viewcells: " + std::to_string(sub.leaf_count()) + " cells in " + fmt(sub.stats.seconds, 2) +
         " s, render cost " + fmt(sub.initial_cost, 1) + " -> " + fmt(sub.cost(), 1) + " (" + sub.stats.stop_reason + ")");
+  if (s.map && !density.enabled) {
+    // p(i) over the map's non-solid space: merging, extraction and the file use these weights.
+    weight_by_view_space(sub, q3_subdivision(*s.map, sub.view_box));
+    c.log("viewcells: cells weighted by their volume in the map's non-solid space");
+  }
 
   SubdivisionFile file;
   file.leaf_pvs = leaf_pvs(sub, s.result.segments);
@@ -580,7 +616,9 @@ int run_export(const ExportArgs& e, const Common& c) {
 
 struct CompareArgs {
   std::string methods = "av-m,av-s,kd-casm,kd-lasm,kd-vt,kd-vt-star,bsp";
+  bool methods_given = false;
   uint32_t max_cells = 1000;
+  bool max_cells_given = false;
   uint64_t eval_samples = 0;
   uint64_t eval_seed = 0;
   uint32_t histogram_cells = 0;
@@ -601,11 +639,67 @@ std::vector<std::string> split_list(const std::string& text) {
 
 bool has_point(const CostCurve& c, uint32_t n) { return std::binary_search(c.cells.begin(), c.cells.end(), n); }
 
+/// The q3map2 part of compare's summary; writes every excluded-but-seen object to
+/// DIR/excluded.csv and logs the headline numbers.
+json q3_report(const Q3Comparison& q, const Scene& scene, const Q3Map& map, const std::string& dir, const Common& c) {
+  std::string csv = "cluster,object,name,cause,ax,ay,az,bx,by,bz\n";
+  const SegmentSet& eval = q.ours.evaluation_segments;
+  for (const Q3Excluded& e : q.excluded) {
+    char line[512];
+    std::snprintf(line, sizeof line, "%d,%u,\"%s\",%s,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f\n", e.cluster, e.object,
+                  scene.objects[e.object].name.c_str(), e.cause.c_str(), eval.ax[e.segment], eval.ay[e.segment],
+                  eval.az[e.segment], eval.bx[e.segment], eval.by[e.segment], eval.bz[e.segment]);
+    csv += line;
+  }
+  write_text_file(dir + "/excluded.csv", csv);
+  const bool reached = std::isfinite(q.avm_cost_at_clusters);
+  const double ours_bytes = static_cast<double>(q.ours_compressed_bytes);
+  c.log("viewcells: q3map2: " + std::to_string(q.cluster_count) + " clusters, evaluated cost " +
+        fmt(q.clusters.cost, 1) + "; AV-M at " + std::to_string(q.cluster_count) + " cells " +
+        (reached ? fmt(q.avm_cost_at_clusters, 1) + " (" + fmt(q.avm_cost_at_clusters / q.clusters.cost, 3) + " x)"
+                 : std::string("not reached")) +
+        "; AV-M matches q3map2 from " +
+        (q.avm_cells_to_match ? std::to_string(q.avm_cells_to_match) + " cells" : std::string("no cell count built")));
+  c.log("viewcells: q3map2: PVS size ratio ours / q3map2 " + fmt(q.mean_pvs_ratio, 3) + "; " +
+        std::to_string(q.excluded.size()) + " objects seen from clusters q3map2 excludes them from (" + dir +
+        "/excluded.csv); storage: q3map2 rows " + std::to_string(q.q3_row_bytes) + " B, ours " +
+        std::to_string(q.ours_compressed_bytes) + " B (" + fmt(ours_bytes / std::max<double>(1, q.q3_row_bytes), 2) +
+        " x)");
+  json causes = json::object();
+  for (const auto& [cause, n] : q.excluded_by_cause) causes[cause] = n;
+  return {{"map", map.path},
+          {"clusters", q.cluster_count},
+          {"q3map2_cost", q.clusters.cost},
+          {"av_m_cost_at_clusters", reached ? json(q.avm_cost_at_clusters) : json(nullptr)},
+          {"av_m_cost_ratio", reached ? json(q.avm_cost_at_clusters / q.clusters.cost) : json(nullptr)},
+          {"av_m_cells_to_match", q.avm_cells_to_match ? json(q.avm_cells_to_match) : json(nullptr)},
+          {"pvs_size_ratio", q.mean_pvs_ratio},
+          {"pvs_entries", {{"ours", q.ours_entries}, {"q3map2", q.q3_entries}}},
+          {"excluded_but_seen", q.excluded.size()},
+          {"excluded_by_cause", causes},
+          {"storage_bytes",
+           {{"q3map2_rows", q.q3_row_bytes},
+            {"q3map2_leaf_surface_lists", q.q3_leaf_surface_bytes},
+            {"ours_compressed", q.ours_compressed_bytes},
+            {"ours_rle_rows", q.ours_rle_bytes}}},
+          {"build_seconds", q.build_seconds}};
+}
+
 int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
   ThreadLimit threads(c.threads);
   CompareConfig config;
   config.methods = split_list(ca.methods);
-  config.max_cells = ca.max_cells;
+  // q3-clusters is not built but read from the map: compare_with_q3map2 adds it.
+  const auto q3_entry = std::find(config.methods.begin(), config.methods.end(), "q3-clusters");
+  bool with_q3 = q3_entry != config.methods.end();
+  if (with_q3) config.methods.erase(q3_entry);
+  if (!ca.methods_given && is_q3_map(a.scene)) {
+    config.methods = {"av-m", "av-s", "kd-casm"};
+    with_q3 = true;
+  }
+  if (with_q3 && !is_q3_map(a.scene)) throw Error("q3-clusters needs a Quake 3 map (.bsp) as the scene");
+  // On a map, by default three times as many cells as the map has clusters (0 below).
+  config.max_cells = with_q3 && !ca.max_cells_given ? 0 : ca.max_cells;
   config.construction = sampler_config(a, c);
   config.evaluation = config.construction;
   config.evaluation.target_segments = 0;
@@ -624,16 +718,41 @@ int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
   std::filesystem::create_directories(ca.output);
   Sampled loaded;
   load_for_sampling(a, c, loaded);
-  c.log("viewcells: comparing " + ca.methods + " up to " + std::to_string(ca.max_cells) + " cells; " +
+  std::string method_list;
+  for (const std::string& m : config.methods) method_list += (method_list.empty() ? "" : ",") + m;
+  if (with_q3) {
+    method_list += ",q3-clusters";
+    if (!loaded.map->has_visibility())
+      throw Error(a.scene, 0, "the map has no visibility data: there are no q3map2 clusters to compare with");
+    if (config.max_cells == 0) config.max_cells = 3 * static_cast<uint32_t>(loaded.map->cluster_count);
+  }
+  // On a map the view space is its non-solid space, for both samplers and the cells' weights.
+  std::optional<Subdivision> map_bsp;
+  if (loaded.map) {
+    use_map_view_space(loaded, config.construction);
+    config.evaluation.view_space = config.construction.view_space;
+    config.evaluation.view_box = config.construction.view_box;
+    if (!with_q3) {
+      map_bsp = q3_subdivision(*loaded.map, config.construction.view_box);
+      config.prepare = [&map_bsp](Subdivision& s) { weight_by_view_space(s, *map_bsp); };
+    }
+  }
+  const uint32_t max_cells = config.max_cells;
+  c.log("viewcells: comparing " + method_list + " up to " + std::to_string(max_cells) + " cells; " +
         std::to_string(config.construction.samples) + " construction samples (seed " +
         std::to_string(config.construction.seed) + "), " + std::to_string(config.evaluation.samples) +
-        " evaluation samples (seed " + std::to_string(config.evaluation.seed) + ")");
-  const Comparison cmp = compare_methods(loaded.scene, *loaded.caster, config);
+        " evaluation samples (seed " + std::to_string(config.evaluation.seed) + "); view space " +
+        loaded.view_space);
+  std::optional<Q3Comparison> q3;
+  Comparison plain;
+  if (with_q3) q3 = compare_with_q3map2(loaded.scene, *loaded.map, *loaded.caster, config);
+  else plain = compare_methods(loaded.scene, *loaded.caster, config);
+  const Comparison& cmp = q3 ? q3->ours : plain;
 
   const MethodResult* avm = nullptr;
   for (const MethodResult& m : cmp.methods)
     if (m.method == "av-m") avm = &m;
-  const std::vector<uint32_t> counts = report_cell_counts(ca.max_cells);
+  const std::vector<uint32_t> counts = report_cell_counts(max_cells);
   std::string csv = "method,cells,cost,ratio_to_av_m,constructed_cost\n";
   json methods = json::array();
   for (const MethodResult& m : cmp.methods) {
@@ -662,6 +781,14 @@ int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
                        {"evaluated_cost_at_most_cells", m.evaluated.at(last)},
                        {"constructed_cost_at_most_cells", m.constructed.at(last)}});
   }
+  if (q3) {
+    // q3map2's clusters: one point, at the map's cluster count.
+    const uint32_t n = q3->cluster_count;
+    const std::string ratio = avm && has_point(avm->evaluated, n) ? fmt(q3->clusters.cost / avm->evaluated.at(n), 6) : "";
+    char line[256];
+    std::snprintf(line, sizeof line, "q3-clusters,%u,%.6g,%s,\n", n, q3->clusters.cost, ratio.c_str());
+    csv += line;
+  }
   write_text_file(ca.output + "/curves.csv", csv);
   std::string hist = "method,cell,cost,volume\n";
   for (const MethodResult& m : cmp.methods)
@@ -681,7 +808,7 @@ int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
         {"construction_seed", config.construction.seed},
         {"evaluation_samples", config.evaluation.samples},
         {"evaluation_seed", config.evaluation.seed},
-        {"histogram_cells", ca.histogram_cells ? ca.histogram_cells : ca.max_cells},
+        {"histogram_cells", ca.histogram_cells ? ca.histogram_cells : max_cells},
         {"cost_model", {{"a", config.model.a}, {"b", config.model.b}, {"c", 0}}},
         {"axis_candidates", ca.axis_candidates},
         {"ga_candidates", ca.ga_candidates},
@@ -693,12 +820,14 @@ int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
          {{"enabled", cmp.construction.empty_space.enabled}, {"reason", cmp.construction.empty_space.reason}}},
         {"pixel_cost_term", {{"enabled", false}, {"reason", "c = 0: the comparison uses r(o) = max(a, b t)"}}}}},
       {"methods", methods},
+      {"view_space", loaded.view_space},
       {"timings",
        {{"load_seconds", loaded.load_s},
         {"bvh_build_seconds", loaded.bvh_s},
         {"construction_sampling_seconds", cmp.construction.seconds},
         {"evaluation_sampling_seconds", cmp.evaluation.seconds},
         {"evaluation_seconds", cmp.evaluation_seconds}}}};
+  if (q3) summary["q3map2"] = q3_report(*q3, loaded.scene, *loaded.map, ca.output, c);
   write_json(ca.output + "/summary.json", summary);
   for (const MethodResult& m : cmp.methods) {
     const uint32_t last = m.evaluated.cells.back();
@@ -1012,9 +1141,15 @@ int run(int argc, char** argv) {
                                 "Build view cells with several methods from the same samples and score them all on "
                                 "independent evaluation samples (paper, section 6)");
   add_sampling_options(cm, csmp);
-  cm->add_option("--methods", cmpa.methods, "Comma-separated: av-m, av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp")
-      ->capture_default_str();
-  cm->add_option("--max-cells", cmpa.max_cells, "Cells per method at most")->capture_default_str()->check(CLI::PositiveNumber);
+  cm->add_option("--methods", cmpa.methods,
+                 "Comma-separated: av-m, av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp, and q3-clusters (the clusters "
+                 "q3map2 compiled into a Quake 3 map; the default on a .bsp with visibility data, with av-m,av-s,kd-casm)")
+      ->capture_default_str()
+      ->each([&](const std::string&) { cmpa.methods_given = true; });
+  cm->add_option("--max-cells", cmpa.max_cells, "Cells per method at most (on a Quake 3 map: 3 x its clusters)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber)
+      ->each([&](const std::string&) { cmpa.max_cells_given = true; });
   cm->add_option("--eval-samples", cmpa.eval_samples, "Evaluation samples (default: 4 x --samples)");
   cm->add_option("--eval-seed", cmpa.eval_seed, "Evaluation seed (default: --seed + 1000003)");
   cm->add_option("--histogram-cells", cmpa.histogram_cells, "Cell count of the cost histograms (default: --max-cells)");

@@ -17,8 +17,17 @@ packages=(openarena-081-maps openarena-085-data openarena-088-data)
 for p in "${packages[@]}"; do
   if ! ls "$cache/debs/${p}"_*.deb >/dev/null 2>&1; then
     echo "fetch-maps: downloading $p"
-    (cd "$cache/debs" && apt-get download "$p" 2>&1 | grep -v "^W: Download is performed unsandboxed" || true)
-    ls "$cache/debs/${p}"_*.deb >/dev/null 2>&1 || { echo "fetch-maps: could not download $p (apt-get update first?)" >&2; exit 1; }
+    download() { (cd "$cache/debs" && apt-get download "$p" 2>&1 | grep -v "^W: Download is performed unsandboxed" || true); }
+    download
+    if ! ls "$cache/debs/${p}"_*.deb >/dev/null 2>&1; then
+      # A fresh machine may not know the package yet: refresh the lists once and retry.
+      echo "fetch-maps: refreshing the package lists (apt-get update)"
+      SUDO=""
+      if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+      $SUDO apt-get update -q >/dev/null
+      download
+    fi
+    ls "$cache/debs/${p}"_*.deb >/dev/null 2>&1 || { echo "fetch-maps: could not download $p" >&2; exit 1; }
   fi
 done
 for deb in "$cache"/debs/*.deb; do

@@ -5,6 +5,7 @@
 set -u
 VC="$1"
 WORK="$2"
+MAPS="$(cd "$(dirname "$0")/../../data/maps/bsp" 2>/dev/null && pwd)"
 rm -rf "$WORK" && mkdir -p "$WORK" && cd "$WORK" || exit 1
 passed=0
 failed=0
@@ -184,6 +185,31 @@ head -c 100 office.vcells > cut.vcells
 expect_error "cut.vcells" "$VC" export cut.vcells --mesh x.ply
 expect_error "nothing to export" "$VC" export office.vcells
 expect_error "outside the view space" "$VC" export office.vcells --slice-png x.png --slice-z 1000
+
+# q3-clusters needs a Quake 3 map; and a real map, when fetched (CI fetches it).
+expect_error "q3-clusters needs a Quake 3 map" "$VC" compare office.obj --samples 1000 --methods av-m,q3-clusters -o cmpq
+if [ -n "$MAPS" ] && [ -f "$MAPS/oa_dm2.bsp" ]; then
+  expect_ok "$VC" info "$MAPS/oa_dm2.bsp"
+  grep -q "1041 clusters" out.txt && ok || bad "info lacks the map's clusters"
+  expect_ok "$VC" compare "$MAPS/oa_dm2.bsp" --samples 200000 --methods av-m,q3-clusters -o q3cmp -q
+  python3 -c "
+import json, math
+s = json.load(open('q3cmp/summary.json'))
+q = s['q3map2']
+assert q['clusters'] == 1041 and q['q3map2_cost'] > 0, q
+assert q['av_m_cost_at_clusters'] is not None and q['pvs_size_ratio'] > 0, q
+assert sum(q['excluded_by_cause'].values()) == q['excluded_but_seen'], q
+assert 'non-solid' in s['view_space'], s['view_space']
+" && ok || bad "compare on oa_dm2: summary"
+  grep -q "^q3-clusters,1041," q3cmp/curves.csv && ok || bad "curves lack q3-clusters"
+  [ "$(wc -l < q3cmp/excluded.csv)" -ge 1 ] && ok || bad "no excluded.csv"
+  expect_error "needs av-m" "$VC" compare "$MAPS/oa_dm2.bsp" --samples 1000 --methods av-s,q3-clusters -o q3bad
+  expect_error "not one surface" "$VC" compare "$MAPS/oa_dm2.bsp" --samples 1000 --objects components -o q3bad
+  expect_ok "$VC" build "$MAPS/oa_dm2.bsp" --samples 50000 --max-cells 100 -o dm2.vcells --report dm2.json -q
+  [ "$(json_get dm2.json "['settings']['view_box_source']")" = "the map's non-solid leaves" ] && ok || bad "build on a map: view box"
+elif [ -n "${VIEWCELLS_REQUIRE_MAPS:-}" ]; then
+  bad "oa_dm2.bsp is missing (scripts/fetch-maps.sh)"
+fi
 
 # A failing run leaves what was already written untouched.
 cp a.vseg keep.vseg

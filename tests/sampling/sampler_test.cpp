@@ -228,6 +228,34 @@ TEST(Sampler, SampledRaysAreTheSamplersRays) {
   EXPECT_EQ(recasts, r.stats.recast_rays);
 }
 
+TEST(Sampler, ViewSpaceRejectsOriginsOutsideIt) {
+  // A view space that is half the box: every origin lies in it, about half the draws are
+  // rejected, and the output still does not depend on the thread count.
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 2, 1});
+  const auto caster = make_embree_caster(scene);
+  SamplerConfig config;
+  config.samples = 20000;
+  config.empty_space = EmptySpaceMode::kOff;  // no re-casts: the rays come in origin pairs
+  config.show_progress = false;
+  const double mid = scene.bounds.center().x;
+  config.view_space = [mid](const Vec3& p) { return p.x < mid; };
+  SamplingResult one;
+  {
+    ThreadLimit limit(1);
+    one = sample_segments(scene, *caster, config);
+  }
+  const SamplingResult two = sample_segments(scene, *caster, config);
+  EXPECT_TRUE(one.segments == two.segments);
+  EXPECT_EQ(one.stats.samples, 20000u);
+  EXPECT_NEAR(static_cast<double>(one.stats.rejected_origins), 20000.0, 1500.0);
+  const std::vector<Ray> rays = sampled_rays(scene, *caster, config);
+  ASSERT_EQ(rays.size(), 40000u);
+  for (size_t i = 0; i < rays.size(); i += 2) ASSERT_LT(rays[i].origin.x, mid);
+  // An empty view space is an error, not an endless loop.
+  config.view_space = [](const Vec3&) { return false; };
+  EXPECT_THROW(sample_segments(scene, *caster, config), Error);
+}
+
 TEST(Sampler, DirectionsAreUniformOnTheSphere) {
   const Scene scene = test::cube_grid(2);
   const auto caster = make_embree_caster(scene);

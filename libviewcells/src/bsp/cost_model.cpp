@@ -32,7 +32,9 @@ std::vector<double> per_object_costs(const Scene& scene, const CostModel& model)
   model.validate();
   std::vector<double> r(scene.objects.size());
   for (size_t o = 0; o < r.size(); ++o)
-    r[o] = std::max(model.a, model.b * static_cast<double>(scene.objects[o].triangle_count));
+    r[o] = scene.objects[o].rendered
+               ? std::max(model.a, model.b * static_cast<double>(scene.objects[o].triangle_count))
+               : 0.0;
   return r;
 }
 
@@ -63,7 +65,7 @@ std::vector<Vec3> pixel_estimation_points(const Box3& b) {
 
 double cell_object_cost(const ObjectInfo& object, double base, const std::vector<Vec3>& points,
                         const CostModel& model) {
-  if (!model.pixel_term() || points.empty()) return base;
+  if (!model.pixel_term() || points.empty() || !object.rendered) return base;
   double sum = 0;
   for (const Vec3& p : points) sum += projected_pixels(object, p, model);
   return std::max(base, model.c * sum / static_cast<double>(points.size()));

@@ -55,6 +55,7 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
     sc.show_progress = config.show_progress;
     const auto t = std::chrono::steady_clock::now();
     Subdivision s = subdivide(scene, built.segments, config.model, sc);
+    if (config.prepare) config.prepare(s);
     return std::make_pair(std::move(s), seconds_since(t));
   };
   for (const std::string& method : config.methods) {
@@ -87,7 +88,7 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
       MergeConfig mc;
       mc.show_progress = config.show_progress;
       const auto tm = std::chrono::steady_clock::now();
-      const MergeHistory h = merge_cells(scene, partition_from_subdivision(*s, leaf_pvs(*s, built.segments)), config.model, mc);
+      MergeHistory h = merge_cells(scene, partition_from_subdivision(*s, leaf_pvs(*s, built.segments)), config.model, mc);
       const double merge_seconds = seconds_since(tm);
       r.build_seconds += merge_seconds;
       out.evaluation_seconds -= merge_seconds;  // counted below with the evaluation otherwise
@@ -100,6 +101,7 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
       r.leaves = h.leaf_count;
       if (hist_cells >= h.min_cells() && hist_cells <= h.leaf_count)
         r.cells = merged_cells_at(h, node_cost, hist_cells);
+      if (config.keep_models) out.av_m = std::move(h);
     } else {
       const std::vector<double> node_cost = evaluated_bsp_costs(scene, *s, pvs, config.model);
       r.evaluated = subdivision_curve(*s, node_cost);
@@ -114,6 +116,11 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
     }
     out.evaluation_seconds += seconds_since(t);
     out.methods.push_back(std::move(r));
+  }
+  if (config.keep_models) {
+    out.construction_segments = std::move(built.segments);
+    out.evaluation_segments = std::move(eval.segments);
+    out.av_s = std::move(av_s);
   }
   return out;
 }

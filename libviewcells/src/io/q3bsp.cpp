@@ -232,6 +232,7 @@ RawMesh q3_world_mesh(const Q3Map& map, int patch_level, bool with_sky, Q3MeshSt
     if (kind == Q3SurfaceKind::kSky && !with_sky) continue;
     const uint32_t group = static_cast<uint32_t>(mesh.group_names.size());
     mesh.group_names.push_back(map.shaders[s.shader].name + "#" + std::to_string(si));
+    mesh.group_rendered.push_back(kind != Q3SurfaceKind::kSky);  // the sky closes the map but is not drawn as one
     auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
       mesh.triangles.push_back({a, b, c});
       mesh.triangle_group.push_back(group);

@@ -77,15 +77,28 @@ Vec3 sample_direction(Rng& rng) {
 
 Vec3 clamp_to_box(const Vec3& p, const Box3& b) { return max(b.lo, min(b.hi, p)); }
 
-/// Draws the points and directions of the `count` samples of batch `batch`.
-void draw_batch(uint64_t seed, uint64_t batch, size_t count, const Box3& box, std::vector<Vec3>& points,
-                std::vector<Vec3>& dirs) {
+/// Consecutive origins outside the view space after which it is taken to be empty.
+constexpr uint64_t kMaxRejections = 1'000'000;
+
+/// Draws the points and directions of the `count` samples of batch `batch`; origins outside
+/// `view_space` (when given) are drawn again and counted in `rejected`.
+void draw_batch(uint64_t seed, uint64_t batch, size_t count, const Box3& box,
+                const std::function<bool(const Vec3&)>& view_space, std::vector<Vec3>& points,
+                std::vector<Vec3>& dirs, uint64_t& rejected) {
   Rng rng(seed, batch);
   points.resize(count);
   dirs.resize(count);
   const Vec3 e = box.extent();
   for (size_t i = 0; i < count; ++i) {
-    points[i] = {box.lo.x + e.x * rng.uniform(), box.lo.y + e.y * rng.uniform(), box.lo.z + e.z * rng.uniform()};
+    uint64_t misses = 0;
+    do {
+      points[i] = {box.lo.x + e.x * rng.uniform(), box.lo.y + e.y * rng.uniform(), box.lo.z + e.z * rng.uniform()};
+      if (!view_space || view_space(points[i])) break;
+      if (++misses == kMaxRejections)
+        throw Error("no sample origin in the view space after " + std::to_string(kMaxRejections) +
+                    " tries: is the view space empty within the view box?");
+    } while (true);
+    rejected += misses;
     dirs[i] = sample_direction(rng);
   }
 }
@@ -93,13 +106,14 @@ void draw_batch(uint64_t seed, uint64_t batch, size_t count, const Box3& box, st
 /// What one batch produced: its segments are the first `valid` of its scratch set.
 struct BatchOutput {
   size_t valid = 0;
-  uint64_t rays = 0, recast_rays = 0, missed_both = 0, stuck = 0, outside = 0, two_sided = 0;
+  uint64_t rays = 0, recast_rays = 0, missed_both = 0, stuck = 0, outside = 0, two_sided = 0, rejected = 0;
 };
 
 class BatchSampler {
  public:
-  BatchSampler(const RayCaster& caster, const Box3& box, bool esd, int max_recasts, double recast_eps)
-      : caster_(caster), box_(box), esd_(esd), max_recasts_(max_recasts), eps_(recast_eps) {}
+  BatchSampler(const RayCaster& caster, const Box3& box, const std::function<bool(const Vec3&)>& view_space,
+               bool esd, int max_recasts, double recast_eps)
+      : caster_(caster), box_(box), view_space_(view_space), esd_(esd), max_recasts_(max_recasts), eps_(recast_eps) {}
 
   /// At most one segment per sample, or two when a sample inside a solid re-casts both ways.
   static size_t segments_per_sample(bool esd) { return esd ? 2 : 1; }
@@ -109,7 +123,7 @@ class BatchSampler {
   void run(uint64_t seed, uint64_t batch, size_t count, SegmentSet& segs, BatchOutput& out,
            std::vector<Ray>* log = nullptr) {
     segs_ = &segs;
-    draw_batch(seed, batch, count, box_, points_, dirs_);
+    draw_batch(seed, batch, count, box_, view_space_, points_, dirs_, out.rejected);
     hits_.resize(2 * count);
     caster_.intersect_pairs(points_, dirs_, hits_);
     if (log) {
@@ -219,6 +233,7 @@ class BatchSampler {
 
   const RayCaster& caster_;
   Box3 box_;
+  const std::function<bool(const Vec3&)>& view_space_;
   bool esd_;
   int max_recasts_;
   double eps_;
@@ -263,7 +278,8 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
   // Embree's float resolution in its local frame and well below the generators' 2 mm gaps.
   const double eps = 1e-6 * std::max(scene.bounds.diagonal(), stats.view_box.diagonal());
   tbb::enumerable_thread_specific<BatchSampler> samplers(
-      [&] { return BatchSampler(caster, stats.view_box, stats.empty_space.enabled, config.max_recasts, eps); });
+      [&] { return BatchSampler(caster, stats.view_box, config.view_space, stats.empty_space.enabled,
+                                                config.max_recasts, eps); });
   const bool by_segments = config.target_segments > 0;
   Progress progress(by_segments ? "segments" : "sampling", by_segments ? config.target_segments : config.samples);
   const bool show = config.show_progress;
@@ -332,6 +348,7 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
             stats.stuck_in_solid += out.stuck;
             stats.outside_view_box += out.outside;
             stats.two_sided_samples += out.two_sided;
+            stats.rejected_origins += out.rejected;
             if (show) progress.advance(by_segments ? out.valid : t->count);
             // Nothing seen after a million samples: the target is out of reach, say so now.
             if (by_segments && segs.size() == 0 && stats.samples >= kGiveUpSamples) finished = true;

@@ -37,7 +37,8 @@ struct CostModel {
   std::string describe_pixel_term() const;
 };
 
-/// The part of r(o) that does not depend on the viewpoint, max(a, b * t_o), per object.
+/// The part of r(o) that does not depend on the viewpoint, max(a, b * t_o), per object
+/// (0 for objects that are not rendered: they occlude but cost nothing).
 std::vector<double> per_object_costs(const Scene& scene, const CostModel& model);
 
 /// Estimated pixels covered by `object` seen from `eye` when the viewer looks at it: its

@@ -3,6 +3,8 @@
 /// method builds from the same construction samples, and one evaluator scores them all on
 /// independent evaluation samples.
 #include <cstdint>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +24,11 @@ struct CompareConfig {
   SubdivisionConfig subdivision;  ///< shared settings (strategy is set per method)
   uint32_t histogram_cells = 0;   ///< cell count of the histograms (0: max_cells)
   bool show_progress = true;
+  /// Optional: applied to every subdivision once built, before merging and evaluation (e.g.
+  /// weight_by_view_space, when the view space is not the whole box).
+  std::function<void(Subdivision&)> prepare;
+  /// Keep the segments, the AV-S subdivision and the AV-M merge history in the Comparison.
+  bool keep_models = false;
 };
 
 struct MethodResult {
@@ -40,6 +47,10 @@ struct Comparison {
   std::vector<MethodResult> methods;
   SamplingStats construction, evaluation;
   double evaluation_seconds = 0;
+  // With CompareConfig::keep_models:
+  SegmentSet construction_segments, evaluation_segments;
+  std::optional<Subdivision> av_s;      ///< when av-s or av-m was built
+  std::optional<MergeHistory> av_m;     ///< when av-m was built (over av_s's leaves)
 };
 
 /// Throws Error for an empty list or a name that is not one of the methods.

@@ -89,7 +89,7 @@ struct Q3MeshStats {
 
 /// The world model's geometry as a RawMesh with one group per surface (named
 /// "shader#surface"): opaque surfaces, and sky surfaces when `with_sky` (they close the map
-/// for rays). Patches are tessellated with `patch_level` segments per Bezier piece side.
+/// for rays; their groups are marked not rendered, so they cost nothing). Patches are tessellated with `patch_level` segments per Bezier piece side.
 RawMesh q3_world_mesh(const Q3Map& map, int patch_level, bool with_sky, Q3MeshStats* stats = nullptr);
 
 /// Spawn points (origin of info_player_deathmatch / info_player_start entities).

@@ -5,6 +5,7 @@
 /// fixed-size batches, each with its own random stream, so the output is bit-identical for
 /// any number of threads.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,10 @@ struct SamplerConfig {
   uint64_t max_samples = 4'000'000'000;  ///< give up (Error) beyond this with a segment target
   uint64_t seed = 1;
   Box3 view_box;  ///< empty: the scene bounds
+  /// Optional: the view space within the box (e.g. a game level's non-solid space). Sample
+  /// origins outside it are rejected and drawn again, so origins are uniform in the view
+  /// space; segments still run to their hits. Must be thread-safe and deterministic.
+  std::function<bool(const Vec3&)> view_space;
   /// Empty view space detection (back-face hit: move the origin there and re-cast). kAuto
   /// enables it only when every object is a closed, consistently outward-oriented solid.
   /// A sample inside a solid re-casts from both exits and may give two segments.
@@ -52,6 +57,8 @@ struct SamplingStats {
   /// Samples inside a solid re-cast from both exits: each has two outcomes, so
   /// valid + missed_both + stuck + outside == samples + two_sided_samples.
   uint64_t two_sided_samples = 0;
+  /// Origins drawn outside SamplerConfig::view_space and drawn again (not samples).
+  uint64_t rejected_origins = 0;
   EmptySpaceDecision empty_space;
   Box3 view_box;
   bool view_box_from_scene = true;

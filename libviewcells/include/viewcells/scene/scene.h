@@ -33,6 +33,9 @@ struct ObjectInfo {
   bool closed = false;    ///< every edge is shared by exactly two of the object's triangles
   bool oriented = false;  ///< closed, and each edge is traversed once in each direction
   double signed_volume = 0;  ///< > 0 when normals point outwards (only meaningful if oriented)
+  /// Drawn by the renderer, so it counts in r(PVS). False for geometry that only closes the
+  /// scene for rays, such as a game level's sky (it occludes but costs nothing).
+  bool rendered = true;
   /// Closed, consistently oriented, normals outwards: back-face hits mean "inside".
   bool solid() const { return closed && oriented && signed_volume > 0; }
 };
@@ -43,6 +46,8 @@ struct RawMesh {
   std::vector<std::array<uint32_t, 3>> triangles;
   std::vector<uint32_t> triangle_group;  ///< index into group_names, one per triangle
   std::vector<std::string> group_names;  ///< empty when the file has no groups
+  /// Per group: false when the group is not rendered (ObjectInfo::rendered); empty: all are.
+  std::vector<uint8_t> group_rendered;
 };
 
 class Scene {

@@ -1,0 +1,64 @@
+#pragma once
+/// A Quake 3 map's view space and its own view cells. Players stand in the map's non-solid
+/// space (the leaves with a cluster), so that is the view space: sample origins are drawn
+/// there, and p(i) of any view cell is the volume of its non-solid part over the non-solid
+/// volume of the view box. The map compiler's BSP is turned into a Subdivision (same point
+/// location, segment distribution and evaluator as our own cells), so q3map2's clusters are
+/// scored on exactly the samples ours are.
+#include <cstdint>
+#include <vector>
+
+#include "viewcells/bsp/cost_model.h"
+#include "viewcells/bsp/subdivision.h"
+#include "viewcells/io/q3bsp.h"
+#include "viewcells/scene/scene.h"
+
+namespace viewcells {
+
+/// Whether p lies in the map's non-solid space (its leaf has a cluster).
+bool q3_in_view_space(const Q3Map& map, const Vec3& p);
+
+/// The bounding box of the non-solid leaves (Error when the map has none).
+Box3 q3_view_box(const Q3Map& map);
+
+/// The map's BSP over `box` as a Subdivision: map node i is node i, map leaf l is node
+/// map.nodes.size() + l (so leaf_of_node() inverts it). Q3 planes become Planes (axial ones
+/// exact), each leaf's cell is the box clipped along its path, and weight is the leaf's volume
+/// when it has a cluster, 0 when it is solid; inner nodes sum their children.
+Subdivision q3_subdivision(const Q3Map& map, const Box3& box);
+/// The map leaf of node n of a q3_subdivision (-1 for inner nodes).
+inline int32_t q3_leaf_of_node(const Q3Map& map, int32_t n) {
+  return n >= static_cast<int32_t>(map.nodes.size()) ? n - static_cast<int32_t>(map.nodes.size()) : -1;
+}
+
+/// Volume of the part of `cell` in the non-solid leaves of `q3` (a q3_subdivision).
+double view_space_volume(const Subdivision& q3, const ConvexPolyhedron& cell);
+
+/// Sets the weight of every node of `s` to the volume of its non-solid part (leaves from their
+/// cells, which must be present; inner nodes as sums): p(i) over the map's view space. The
+/// split records keep the costs the construction saw.
+void weight_by_view_space(Subdivision& s, const Subdivision& q3);
+
+/// q3map2's clusters as view cells, scored like ours: a cluster's PVS is the union of its
+/// leaves' PVSs, its weight their non-solid volume, p(i) = weight / total weight.
+struct Q3ClusterCells {
+  std::vector<double> weight;                ///< per cluster
+  std::vector<Box3> bounds;                  ///< per cluster (the pixel term's points)
+  std::vector<std::vector<uint32_t>> pvs;    ///< per cluster: sorted object ids
+  std::vector<double> pvs_cost;              ///< per cluster: r(PVS)
+  double total_weight = 0;
+  double cost = 0;  ///< c(S) = sum weight * pvs_cost / total_weight
+};
+/// `leaf_pvs` is per node of `q3` (evaluation_pvs(q3, segments)).
+Q3ClusterCells q3_cluster_cells(const Scene& scene, const Q3Map& map, const Subdivision& q3,
+                                const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model);
+
+/// The map surface each object of `scene` stands for (objects named "shader#surface", as
+/// load_scene names a map's surfaces); Error when an object is not one surface.
+std::vector<int32_t> q3_object_surfaces(const Scene& scene, const Q3Map& map);
+
+/// For every cluster, the objects q3map2's PVS admits: those with a surface listed in a leaf of
+/// a cluster visible from it (sorted object ids). Only rendered objects are listed.
+std::vector<std::vector<uint32_t>> q3_admitted_objects(const Scene& scene, const Q3Map& map);
+
+}  // namespace viewcells
