@@ -160,7 +160,7 @@ int run_info(const InfoArgs& a, const Common& c) {
     // What the Quake 3 map itself holds besides the geometry.
     const Q3Map map = read_q3bsp(a.scene);
     Q3MeshStats st;
-    q3_world_mesh(map, 4, true, &st);
+    q3_world_mesh(map, {}, &st);
     size_t solid_leaves = 0;
     for (const Q3Leaf& l : map.leaves) solid_leaves += l.cluster < 0;
     std::cout << "quake 3 map:        IBSP version " << map.version << ", " << map.shaders.size() << " shaders, "
@@ -168,6 +168,8 @@ int run_info(const InfoArgs& a, const Common& c) {
               << "world surfaces:     " << st.surfaces[0] << " opaque, " << st.surfaces[1] << " sky (they close "
               << "the map for rays but are not rendered: no render cost), " << st.surfaces[2] << " water/fog/translucent (left out for now), " << st.surfaces[3]
               << " nodraw/hint/skip/flare (left out); " << st.patches << " patches tessellated at level 4\n"
+              << "solid brushes:      " << st.brush_hulls << " of " << map.world_brush_count
+              << " as hulls 0.5 units inside their sides (occlude, not rendered)\n"
               << "visibility:         "
               << (map.has_visibility() ? std::to_string(map.cluster_count) + " clusters, rows of " +
                                              std::to_string(map.cluster_bytes) + " bytes (q3map2's PVS)"
@@ -178,6 +180,7 @@ int run_info(const InfoArgs& a, const Common& c) {
                 {"solid_leaves", solid_leaves},
                 {"surfaces", {{"opaque", st.surfaces[0]}, {"sky", st.surfaces[1]}, {"non_occluding", st.surfaces[2]},
                               {"skipped", st.surfaces[3]}, {"patches", st.patches}}},
+                {"brush_hulls", st.brush_hulls},
                 {"clusters", map.cluster_count},
                 {"cluster_row_bytes", map.cluster_bytes},
                 {"spawn_points", st.spawn_points}};

@@ -130,4 +130,9 @@ print("\nReading it. AV-S and AV-M lead in the office and the rotated office by 
 print("\nKD-VT* is depth-first: its curve shows the order in which it refines, which is why the paper "
       "calls it not scalable; its final set, where it stops, is what such tools ship.")
 PY
+# The Quake 3 maps section is scripts/maps-table.sh's; keep what it last wrote.
+printf '\n## Real game levels: OpenArena maps against q3map2\n\n<!-- q3maps:begin -->\nNot generated yet: run scripts/maps-table.sh.\n<!-- q3maps:end -->\n' >> docs/results.md
+if [ -f docs/results/q3-maps.md ] && [ -f docs/results/q3-maps.command ]; then
+  python3 scripts/replace-section.py docs/results.md q3maps "$(cat docs/results/q3-maps.command)" docs/results/q3-maps.md
+fi
 echo "results: docs/results.md"

@@ -85,6 +85,39 @@ TEST(Polyhedron, RepeatedRandomSplitsKeepVolume) {
   EXPECT_NEAR(sum / total, 1.0, 1e-9);
 }
 
+TEST(Polyhedron, SplitAtAFaceWhoseCutVerticesRounded) {
+  // Oblique cuts put new vertices on the box's edges by interpolation, which can round a
+  // coordinate off the face they lie on (352 (1 - t) + 352 t != 352). Splitting then by that
+  // face's own plane sees a face with vertices on the plane and one a hair beyond: the
+  // children must still add up to the parent, with no face counted twice.
+  Rng rng(11);
+  int checked = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const Box3 box{{2214.11, 205.518, -5.45443}, {2283.0, 352.0, 59.2391}};
+    ConvexPolyhedron cell = ConvexPolyhedron::box(box, 0);
+    for (int cut = 0; cut < 2; ++cut) {
+      const Vec3 c = cell.centroid();
+      const Vec3 n = normalize(Vec3{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)});
+      const Vec3 u = normalize(cross(n, Vec3{0.3, 0.5, 0.7})), w = cross(n, u);
+      const auto halves = cell.split(Plane::through(c, c + u * 100, c + w * 100), 10 + cut);
+      if (halves) cell = halves->first;
+    }
+    for (int axis = 0; axis < 3; ++axis)
+      for (double at : {box.lo[axis], box.hi[axis]}) {
+        const Plane plane = Plane::axis_aligned(axis, at);
+        bool neg = false, pos = false;
+        for (const Vec3& v : cell.vertices()) neg |= plane.side(v) < 0, pos |= plane.side(v) > 0;
+        if (!neg || !pos) continue;
+        ++checked;  // the exact sides say the face's own plane cuts the cell
+        const auto halves = cell.split(plane, 20);
+        if (!halves) continue;  // refused as rounding: the cell stays whole
+        const double v = cell.volume();
+        ASSERT_NEAR(halves->first.volume() + halves->second.volume(), v, 1e-9 * v) << "trial " << trial;
+      }
+  }
+  EXPECT_GT(checked, 10) << "the rounding case must occur for the test to mean anything";
+}
+
 TEST(Polyhedron, SliversFromNearlyParallelPlanes) {
   // Planes at angles of 1e-7 radians to each other, cutting thinner and thinner slices.
   ConvexPolyhedron cell = ConvexPolyhedron::box({{0, 0, 0}, {1, 1, 1}}, 0);

@@ -54,7 +54,8 @@ struct BspBuilder {
 };
 
 /// A map of two leaves split by z = 0: an opaque quad, a 3x3 patch, a sky quad and a nodraw
-/// quad; two clusters, where 0 sees both and 1 sees only itself.
+/// quad; two clusters, where 0 sees both and 1 sees only itself; one solid caulked brush, the
+/// cube [20, 40]^3, in leaf 0.
 BspBuilder small_map() {
   BspBuilder b;
   b.lumps[0] = "{\n\"classname\" \"worldspawn\"\n}\n{\n\"classname\" \"info_player_deathmatch\"\n\"origin\" \"8 16 24\"\n}\n";
@@ -64,15 +65,26 @@ BspBuilder small_map() {
   b.shader("textures/common/nodraw", kQ3SurfNodraw, kQ3ContentsSolid);
   b.shader("textures/liquids/water", 0, kQ3ContentsWater);
   for (float f : {0.f, 0.f, 1.f, 0.f}) BspBuilder::put(b.lumps[2], f);  // plane z = 0
+  for (int axis = 0; axis < 3; ++axis)  // planes 1-6: the brush's sides, +axis at 40, -axis at 20
+    for (float sign : {1.f, -1.f}) {
+      for (int k = 0; k < 3; ++k) BspBuilder::put(b.lumps[2], k == axis ? sign : 0.f);
+      BspBuilder::put(b.lumps[2], sign > 0 ? 40.f : -20.f);
+    }
+  for (int32_t side = 0; side < 6; ++side) {  // brush sides: plane, shader (nodraw)
+    BspBuilder::put(b.lumps[9], side + 1);
+    BspBuilder::put(b.lumps[9], int32_t{2});
+  }
+  for (int32_t v : {0, 6, 0}) BspBuilder::put(b.lumps[8], v);  // the brush: sides 0-5, solid shader
+  BspBuilder::put(b.lumps[6], int32_t{0});                     // leaf 0 holds brush 0
   for (int32_t v : {0, -1, -2, -64, -64, -64, 64, 64, 64}) BspBuilder::put(b.lumps[3], v);  // node
   for (int32_t cluster : {0, 1}) {  // leaves: cluster, area, mins, maxs, surfaces, brushes
-    for (int32_t v : {cluster, 0, -64, -64, cluster ? -64 : 0, 64, 64, cluster ? 0 : 64, 0, 2, 0, 0})
+    for (int32_t v : {cluster, 0, -64, -64, cluster ? -64 : 0, 64, 64, cluster ? 0 : 64, 0, 2, 0, cluster ? 0 : 1})
       BspBuilder::put(b.lumps[4], v);
   }
   for (int32_t s : {0, 1}) BspBuilder::put(b.lumps[5], s);
   // The world model: mins, maxs, first surface, surfaces, brushes.
   for (float f : {-64.f, -64.f, -64.f, 64.f, 64.f, 64.f}) BspBuilder::put(b.lumps[7], f);
-  for (int32_t v : {0, 5, 0, 0}) BspBuilder::put(b.lumps[7], v);
+  for (int32_t v : {0, 5, 0, 1}) BspBuilder::put(b.lumps[7], v);
   // Quads: 4 vertices each, indices 0 2 1, 0 3 2 (clockwise seen from +z, as Quake 3 writes).
   auto quad = [&](float z) {
     b.vertex(0, 0, z), b.vertex(10, 0, z), b.vertex(10, 10, z), b.vertex(0, 10, z);
@@ -115,19 +127,31 @@ TEST(Q3Bsp, ReadsAHandBuiltMap) {
   EXPECT_EQ(spawns[0], (Vec3{8, 16, 24}));
 
   Q3MeshStats st;
-  const RawMesh mesh = q3_world_mesh(m, 2, true, &st);
+  Q3MeshOptions options;
+  options.patch_level = 2;
+  const RawMesh mesh = q3_world_mesh(m, options, &st);
   EXPECT_EQ(st.surfaces[static_cast<int>(Q3SurfaceKind::kOpaque)], 2u);
   EXPECT_EQ(st.patches, 1u);
   EXPECT_EQ(st.spawn_points, 1u);
   // Opaque quad 2 + patch (2x2 pieces of... one 3x3 piece at level 2: 8) + sky 2.
-  EXPECT_EQ(mesh.triangles.size(), 2u + 8u + 2u);
-  EXPECT_EQ(mesh.group_names.size(), 3u);
-  // Every triangle faces +z, as the vertex normals say: winding turned counter-clockwise.
-  for (const auto& t : mesh.triangles) {
+  EXPECT_EQ(st.brush_hulls, 1u);
+  // + the brush hull: 6 faces of 2 triangles.
+  EXPECT_EQ(mesh.triangles.size(), 2u + 8u + 2u + 12u);
+  EXPECT_EQ(mesh.group_names.size(), 4u);
+  EXPECT_EQ(mesh.group_rendered, std::vector<uint8_t>({1, 1, 0, 0})) << "neither the sky nor the hulls are rendered";
+  // Every surface triangle faces +z, as the vertex normals say: winding turned counter-clockwise.
+  for (size_t i = 0; i < mesh.triangles.size(); ++i) {
+    if (mesh.triangle_group[i] == 3) continue;  // the hull
+    const auto& t = mesh.triangles[i];
     const Vec3 n = cross(mesh.vertices[t[1]] - mesh.vertices[t[0]], mesh.vertices[t[2]] - mesh.vertices[t[0]]);
     EXPECT_GT(n.z, 0);
   }
-  EXPECT_EQ(q3_world_mesh(m, 2, false).triangles.size(), 10u) << "without the sky";
+  options.sky = false;
+  options.brush_hulls = false;
+  EXPECT_EQ(q3_world_mesh(m, options).triangles.size(), 10u) << "without the sky and the hulls";
+  options.hull_inset = 10;  // thinner than twice the inset: nothing left
+  options.brush_hulls = true;
+  EXPECT_EQ(q3_world_mesh(m, options).triangles.size(), 10u);
 }
 
 TEST(Q3Bsp, LoadsAsAScene) {
@@ -137,8 +161,16 @@ TEST(Q3Bsp, LoadsAsAScene) {
     out << small_map().bytes();
   }
   const Scene s = load_scene(path);
-  EXPECT_EQ(s.object_count(), 3u);
-  EXPECT_EQ(s.triangle_count(), 2u + 32u + 2u) << "patches at level 4 in scenes";
+  EXPECT_EQ(s.object_count(), 4u);
+  EXPECT_EQ(s.triangle_count(), 2u + 32u + 2u + 12u) << "patches at level 4 in scenes";
+  // The brush hull: a closed, outward box half a unit inside the brush, occluding, not rendered.
+  const ObjectInfo& hull = s.objects[3];
+  EXPECT_EQ(hull.name, "solid brushes");
+  EXPECT_FALSE(hull.rendered);
+  EXPECT_TRUE(hull.solid());
+  EXPECT_EQ(hull.bounds.lo, (Vec3{20.5, 20.5, 20.5}));
+  EXPECT_EQ(hull.bounds.hi, (Vec3{39.5, 39.5, 39.5}));
+  EXPECT_TRUE(s.objects[0].rendered);
   std::filesystem::remove(path);
 }
 
@@ -175,6 +207,15 @@ TEST(Q3Bsp, RejectsCorruptFiles) {
   b = small_map();
   b.lumps[2].pop_back();  // planes not a whole number of records
   expect_rejected(b.bytes(), "whole number");
+  b = small_map();
+  b.lumps[9].replace(0, 4, std::string("\x63\x00\x00\x00", 4));  // a brush side on plane 99
+  expect_rejected(b.bytes(), "brush side 0 names a missing plane");
+  b = small_map();
+  b.lumps[8].replace(4, 4, std::string("\x07\x00\x00\x00", 4));  // 7 sides of 6
+  expect_rejected(b.bytes(), "brush 0 has sides outside");
+  b = small_map();
+  b.lumps[6].replace(0, 4, std::string("\x05\x00\x00\x00", 4));  // leaf brush 5 of 1
+  expect_rejected(b.bytes(), "missing brush");
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "viewcells/core/error.h"
@@ -24,12 +25,20 @@ std::optional<std::pair<ConvexPolyhedron, ConvexPolyhedron>> ConvexPolyhedron::s
   const size_t nv = vertices_.size();
   std::vector<int> side(nv);
   std::vector<double> dist(nv);
+  // Vertices made by earlier cuts are rounded: one meant to lie on a face's plane can sit a
+  // few ulps off it, so a face can be a hair non-planar. A vertex within that rounding of
+  // the plane does not make the plane cut, nor keep a face part that otherwise lies in it.
+  double scale = 0;
+  for (const Vec3& v : vertices_) scale = std::max({scale, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+  const double eps = 64 * std::numeric_limits<double>::epsilon() * std::max(scale, std::abs(plane.offset));
+  std::vector<char> beyond(nv);  // strictly on its side by more than the rounding
   bool any_neg = false, any_pos = false;
   for (size_t i = 0; i < nv; ++i) {
     side[i] = plane.side(vertices_[i]);
     dist[i] = plane.distance(vertices_[i]);
-    any_neg |= side[i] < 0;
-    any_pos |= side[i] > 0;
+    beyond[i] = side[i] != 0 && std::abs(dist[i]) > eps;
+    any_neg |= side[i] < 0 && beyond[i];
+    any_pos |= side[i] > 0 && beyond[i];
   }
   if (!any_neg || !any_pos) return std::nullopt;
 
@@ -57,10 +66,13 @@ std::optional<std::pair<ConvexPolyhedron, ConvexPolyhedron>> ConvexPolyhedron::s
   std::vector<uint32_t> cap_vertices;  // parent-numbered (cuts numbered after the vertices)
   for (const PolyFace& f : faces_) {
     std::vector<uint32_t> poly[2];
+    bool off_plane[2] = {false, false};  // the part has a vertex strictly on its side
     const size_t n = f.vertices.size();
     for (size_t k = 0; k < n; ++k) {
       const uint32_t u = f.vertices[k], v = f.vertices[(k + 1) % n];
       const int su = side[u], sv = side[v];
+      off_plane[0] |= su < 0 && beyond[u];
+      off_plane[1] |= su > 0 && beyond[u];
       if (su <= 0) poly[0].push_back(u);
       if (su >= 0) poly[1].push_back(u);
       if (su == 0) cap_vertices.push_back(u);
@@ -71,8 +83,12 @@ std::optional<std::pair<ConvexPolyhedron, ConvexPolyhedron>> ConvexPolyhedron::s
         cap_vertices.push_back(c);
       }
     }
+    // A part with every vertex on the plane (up to rounding) lies in it, where the cap goes:
+    // it is dropped.
+    // (Only a face made a hair non-planar by rounded vertices has one; a planar face in the
+    // plane means the plane does not cut.)
     for (int s = 0; s < 2; ++s)
-      if (poly[s].size() >= 3) child[s].faces_.push_back({poly[s], f.plane, f.outward_positive});
+      if (poly[s].size() >= 3 && off_plane[s]) child[s].faces_.push_back({poly[s], f.plane, f.outward_positive});
   }
 
   // Cap: the plane's section, ordered by angle around its centre in a frame of the plane.

@@ -121,19 +121,24 @@ namespace {
 
 }  // namespace
 
-void Subdivision::leaves_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
-                                    std::vector<std::tuple<int32_t, double, double>>& stack) const {
+namespace {
+
+/// Walks the segment a-b down the tree of `s`, calling at_leaf(leaf, t0, t1) for every leaf it
+/// has length in (the part a + t (b - a), t in [t0, t1]).
+template <class AtLeaf>
+void walk_segment(const Subdivision& s, const Vec3& a, const Vec3& b,
+                  std::vector<std::tuple<int32_t, double, double>>& stack, AtLeaf&& at_leaf) {
   stack.clear();
   stack.emplace_back(0, 0.0, 1.0);
   while (!stack.empty()) {
     const auto [n, t0, t1] = stack.back();
     stack.pop_back();
-    const BspNode& node = nodes[n];
+    const BspNode& node = s.nodes[n];
     if (node.plane < 0) {
-      out.push_back(n);
+      at_leaf(n, t0, t1);
       continue;
     }
-    const Plane& plane = planes[node.plane];
+    const Plane& plane = s.planes[node.plane];
     const Vec3 p0 = a * (1.0 - t0) + b * t0, p1 = a * (1.0 - t1) + b * t1;
     const int s0 = plane.side(p0), s1 = plane.side(p1);
     if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) {  // as Builder::apply_split
@@ -147,6 +152,18 @@ void Subdivision::leaves_of_segment(const Vec3& a, const Vec3& b, std::vector<in
     if (in_plane || s0 < 0 || s1 < 0) stack.emplace_back(node.child[0], t0, t1);
     if (in_plane || s0 > 0 || s1 > 0) stack.emplace_back(node.child[1], t0, t1);
   }
+}
+
+}  // namespace
+
+void Subdivision::leaves_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
+                                    std::vector<std::tuple<int32_t, double, double>>& stack) const {
+  walk_segment(*this, a, b, stack, [&](int32_t n, double, double) { out.push_back(n); });
+}
+
+void Subdivision::pieces_of_segment(const Vec3& a, const Vec3& b, std::vector<std::tuple<int32_t, double, double>>& out,
+                                    std::vector<std::tuple<int32_t, double, double>>& stack) const {
+  walk_segment(*this, a, b, stack, [&](int32_t n, double t0, double t1) { out.emplace_back(n, t0, t1); });
 }
 
 namespace {

@@ -211,8 +211,9 @@ Scene load_scene(const std::string& path, ObjectGrouping grouping) {
   } else if (ext == ".ply" || ext == ".off" || ext == ".stl") {
     mesh = read_with_openmesh(path);
   } else if (ext == ".bsp") {
-    // Quake 3 maps: the world's opaque surfaces and the sky that closes it, patches at level 4.
-    mesh = q3_world_mesh(read_q3bsp(path), 4, true);
+    // Quake 3 maps: the world's opaque surfaces, the sky and the solid brushes that close it
+    // (neither rendered), patches at level 4.
+    mesh = q3_world_mesh(read_q3bsp(path));
   } else {
     throw Error(path, 0, "unknown scene format '" + ext + "' (expected .obj, .ply, .off, .stl or .bsp)");
   }

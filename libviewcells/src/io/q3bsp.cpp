@@ -128,6 +128,8 @@ Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
                 {double(r.i32(at + 20)), double(r.i32(at + 24)), double(r.i32(at + 28))}};
     l.first_surface = r.i32(at + 32);
     l.surface_count = r.i32(at + 36);
+    l.first_brush = r.i32(at + 40);
+    l.brush_count = r.i32(at + 44);
     m.leaves.push_back(l);
   }
   auto [no, nn] = r.lump(3, 36);
@@ -186,6 +188,8 @@ Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
   if (mn == 0) r.fail("the map has no world model");
   m.world_first_surface = r.i32(mo + 24);
   m.world_surface_count = r.i32(mo + 28);
+  m.world_first_brush = r.i32(mo + 32);
+  m.world_brush_count = r.i32(mo + 36);
   if (m.world_first_surface < 0 || m.world_surface_count < 0 ||
       static_cast<size_t>(m.world_first_surface) + m.world_surface_count > fn)
     r.fail("the world model's surfaces lie outside the surfaces lump");
@@ -194,6 +198,35 @@ Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
       r.fail("a leaf's surfaces lie outside the leafsurfaces lump");
   for (int32_t s : m.leaf_surfaces)
     if (s < 0 || static_cast<size_t>(s) >= fn) r.fail("a leaf names a missing surface");
+
+  // Brushes: what made a leaf solid (for explaining rays that cross solid space).
+  auto [bso, bsn] = r.lump(9, 8);
+  for (size_t i = 0; i < bsn; ++i) {
+    Q3BrushSide side{r.i32(bso + 8 * i), r.i32(bso + 8 * i + 4)};
+    if (side.plane < 0 || static_cast<size_t>(side.plane) >= m.planes.size() || side.shader < 0 ||
+        static_cast<size_t>(side.shader) >= m.shaders.size())
+      r.fail("brush side " + std::to_string(i) + " names a missing plane or shader");
+    m.brush_sides.push_back(side);
+  }
+  auto [bo, bn] = r.lump(8, 12);
+  for (size_t i = 0; i < bn; ++i) {
+    Q3Brush b{r.i32(bo + 12 * i), r.i32(bo + 12 * i + 4), r.i32(bo + 12 * i + 8)};
+    if (b.first_side < 0 || b.side_count < 0 || static_cast<size_t>(b.first_side) + b.side_count > bsn ||
+        b.shader < 0 || static_cast<size_t>(b.shader) >= m.shaders.size())
+      r.fail("brush " + std::to_string(i) + " has sides outside the brushsides lump or a missing shader");
+    m.brushes.push_back(b);
+  }
+  auto [lbo, lbn] = r.lump(6, 4);
+  for (size_t i = 0; i < lbn; ++i) {
+    m.leaf_brushes.push_back(r.i32(lbo + 4 * i));
+    if (m.leaf_brushes.back() < 0 || static_cast<size_t>(m.leaf_brushes.back()) >= bn) r.fail("a leaf names a missing brush");
+  }
+  if (m.world_first_brush < 0 || m.world_brush_count < 0 ||
+      static_cast<size_t>(m.world_first_brush) + m.world_brush_count > bn)
+    r.fail("the world model's brushes lie outside the brushes lump");
+  for (const Q3Leaf& l : m.leaves)
+    if (l.first_brush < 0 || l.brush_count < 0 || static_cast<size_t>(l.first_brush) + l.brush_count > lbn)
+      r.fail("a leaf's brushes lie outside the leafbrushes lump");
 
   auto [viso, vislen] = r.lump(16, 1);
   if (vislen > 0) {
@@ -218,8 +251,61 @@ Q3Map read_q3bsp(const std::string& path) {
   return parse_q3bsp(bytes, path);
 }
 
-RawMesh q3_world_mesh(const Q3Map& map, int patch_level, bool with_sky, Q3MeshStats* stats) {
+namespace {
+
+/// The faces of brush `b` with its sides moved `inset` inwards, as triangles appended to
+/// `mesh` in `group` (outward facing): each side's plane cut to a polygon by all the others.
+/// Returns false when nothing is left (a brush thinner than twice the inset).
+bool add_brush_hull(const Q3Map& map, const Q3Brush& b, double inset, uint32_t group, RawMesh& mesh) {
+  constexpr double kHuge = 1 << 17;  // beyond any Quake 3 coordinate
+  bool any = false;
+  std::vector<Vec3> poly, next;
+  for (int32_t i = 0; i < b.side_count; ++i) {
+    const Q3Plane& pi = map.planes[map.brush_sides[b.first_side + i].plane];
+    const Vec3 n = normalize(pi.normal);
+    const double d = pi.dist / length(pi.normal) - inset;
+    // A huge square on the plane, counter-clockwise seen from its front (outside the brush).
+    int least = 0;
+    for (int k = 1; k < 3; ++k)
+      if (std::abs(n[k]) < std::abs(n[least])) least = k;
+    Vec3 e;
+    e[least] = 1;
+    const Vec3 u = normalize(cross(n, e)), v = cross(n, u), c = n * d;
+    poly = {c - u * kHuge - v * kHuge, c + u * kHuge - v * kHuge, c + u * kHuge + v * kHuge, c - u * kHuge + v * kHuge};
+    for (int32_t j = 0; j < b.side_count && !poly.empty(); ++j) {
+      if (j == i) continue;
+      const Q3Plane& pj = map.planes[map.brush_sides[b.first_side + j].plane];
+      const Vec3 nj = normalize(pj.normal);
+      const double dj = pj.dist / length(pj.normal) - inset;
+      next.clear();  // keep the part behind side j (Sutherland-Hodgman)
+      for (size_t k = 0; k < poly.size(); ++k) {
+        const Vec3& p = poly[k];
+        const Vec3& q = poly[(k + 1) % poly.size()];
+        const double dp = dot(nj, p) - dj, dq = dot(nj, q) - dj;
+        if (dp <= 0) next.push_back(p);
+        if ((dp < 0 && dq > 0) || (dp > 0 && dq < 0)) next.push_back(p + (q - p) * (dp / (dp - dq)));
+      }
+      poly.swap(next);
+    }
+    if (poly.size() < 3) continue;
+    any = true;
+    const uint32_t first = static_cast<uint32_t>(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(), poly.begin(), poly.end());
+    for (uint32_t k = 1; k + 1 < poly.size(); ++k) {
+      mesh.triangles.push_back({first, first + k, first + k + 1});
+      mesh.triangle_group.push_back(group);
+    }
+  }
+  return any;
+}
+
+}  // namespace
+
+RawMesh q3_world_mesh(const Q3Map& map, const Q3MeshOptions& options, Q3MeshStats* stats) {
+  const int patch_level = options.patch_level;
+  const bool with_sky = options.sky;
   if (patch_level < 1 || patch_level > 64) throw Error("patch tessellation level must be between 1 and 64");
+  if (!(options.hull_inset >= 0) || !std::isfinite(options.hull_inset)) throw Error("the brush hull inset must be >= 0");
   RawMesh mesh;
   Q3MeshStats local;
   Q3MeshStats& st = stats ? *stats : local;
@@ -265,6 +351,17 @@ RawMesh q3_world_mesh(const Q3Map& map, int patch_level, bool with_sky, Q3MeshSt
       // Quake 3 winds triangles clockwise seen from the front (checked against the maps'
       // vertex normals); the scene wants counter-clockwise.
       add(base + idx[0], base + idx[2], base + idx[1]);
+    }
+  }
+  if (options.brush_hulls) {
+    const uint32_t group = static_cast<uint32_t>(mesh.group_names.size());
+    mesh.group_names.push_back("solid brushes");
+    mesh.group_rendered.push_back(false);
+    for (int32_t bi = map.world_first_brush; bi < map.world_first_brush + map.world_brush_count; ++bi) {
+      const Q3Brush& b = map.brushes[bi];
+      const int32_t contents = map.shaders[b.shader].content_flags;
+      if (!(contents & kQ3ContentsSolid) || (contents & kQ3ContentsTranslucent)) continue;
+      st.brush_hulls += add_brush_hull(map, b, options.hull_inset, group, mesh);
     }
   }
   st.spawn_points = q3_spawn_points(map).size();

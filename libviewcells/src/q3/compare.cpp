@@ -19,6 +19,15 @@ namespace {
 
 uint64_t pair_key(int32_t cluster, uint32_t object) { return (uint64_t(uint32_t(cluster)) << 32) | object; }
 
+/// Whether p lies in brush b (behind all of its sides, with a little slack).
+bool in_brush(const Q3Map& map, const Q3Brush& b, const Vec3& p) {
+  for (int32_t k = 0; k < b.side_count; ++k) {
+    const Q3Plane& pl = map.planes[map.brush_sides[b.first_side + k].plane];
+    if (dot(pl.normal, p) - pl.dist > 1e-3) return false;
+  }
+  return true;
+}
+
 /// Why segment i, seen from `cluster`, shows `object` although q3map2 does not admit it.
 std::string classify(const Q3Map& map, const Subdivision& q3, const SegmentSet& eval, size_t i, int32_t cluster,
                      uint32_t object) {
@@ -26,15 +35,48 @@ std::string classify(const Q3Map& map, const Subdivision& q3, const SegmentSet& 
   const bool at_a = eval.object_a[i] == object;
   const Vec3 p = at_a ? eval.a(i) : eval.b(i), q = at_a ? eval.b(i) : eval.a(i);
   const double len = length(q - p);
-  if (!(len > 0)) return "leak";
+  if (!(len > 0)) return "crack";
   // Leave the surfaces at both ends alone: their hit points may round into the wall.
   const double d = std::min(1.0, 0.1 * len) / len;
   const Vec3 p1 = p + (q - p) * d, q1 = q + (p - q) * d;
-  std::vector<int32_t> leaves;
-  std::vector<std::tuple<int32_t, double, double>> stack;
-  q3.leaves_of_segment(p1, q1, leaves, stack);
-  for (int32_t n : leaves)
-    if (map.leaves[q3_leaf_of_node(map, n)].cluster < 0) return "leak";
+  std::vector<std::tuple<int32_t, double, double>> pieces, stack;
+  q3.pieces_of_segment(p1, q1, pieces, stack);
+  // The solid piece nearest the object, if any: what made that space solid for q3map2?
+  int32_t solid_leaf = -1;
+  double t_mid = 0, t_first = 2;
+  for (const auto& [n, t0, t1] : pieces) {
+    const int32_t leaf = q3_leaf_of_node(map, n);
+    if (map.leaves[leaf].cluster >= 0 || t0 >= t_first) continue;
+    solid_leaf = leaf;
+    t_first = t0;
+    t_mid = 0.5 * (t0 + t1);
+  }
+  if (solid_leaf >= 0) {
+    const Vec3 m = p1 + (q1 - p1) * t_mid;
+    const Q3Leaf& leaf = map.leaves[solid_leaf];
+    for (int32_t k = 0; k < leaf.brush_count; ++k) {
+      const Q3Brush& b = map.brushes[map.leaf_brushes[leaf.first_brush + k]];
+      if (!in_brush(map, b, m)) continue;
+      // The sides where the segment enters and leaves the brush (clipping the line by it):
+      // if the eye passes one that is not drawn, the brush is invisible from there.
+      double t_in = -1, t_out = 2;
+      int32_t side_in = -1, side_out = -1;
+      for (int32_t j = 0; j < b.side_count; ++j) {
+        const Q3Plane& pl = map.planes[map.brush_sides[b.first_side + j].plane];
+        const double d0 = dot(pl.normal, p1) - pl.dist, d1 = dot(pl.normal, q1) - pl.dist;
+        if (d0 == d1) continue;
+        const double t = d0 / (d0 - d1);
+        if (d0 > d1 && t > t_in) t_in = t, side_in = j;
+        if (d0 < d1 && t < t_out) t_out = t, side_out = j;
+      }
+      bool undrawn = false;
+      for (const auto [t, j] : {std::pair{t_in, side_in}, std::pair{t_out, side_out}})
+        if (j >= 0 && t > 0 && t < 1)
+          undrawn |= (map.shaders[map.brush_sides[b.first_side + j].shader].surface_flags & kQ3SurfNodraw) != 0;
+      return undrawn ? "invisible" : "crack";
+    }
+    return "void";
+  }
   const int32_t seen_in = map.leaves[map.leaf_at(p1)].cluster;
   return seen_in == cluster || map.cluster_sees(cluster, seen_in) ? "unlisted" : "rejected";
 }

@@ -184,8 +184,9 @@ Q3ClusterCells q3_cluster_cells(const Scene& scene, const Q3Map& map, const Subd
 }
 
 std::vector<int32_t> q3_object_surfaces(const Scene& scene, const Q3Map& map) {
-  std::vector<int32_t> out(scene.object_count());
+  std::vector<int32_t> out(scene.object_count(), -1);
   for (size_t o = 0; o < out.size(); ++o) {
+    if (!scene.objects[o].rendered) continue;  // the solid brushes, or the sky
     const std::string& name = scene.objects[o].name;
     const size_t hash = name.rfind('#');
     char* end = nullptr;
@@ -204,7 +205,7 @@ std::vector<std::vector<uint32_t>> q3_admitted_objects(const Scene& scene, const
   const std::vector<int32_t> surface = q3_object_surfaces(scene, map);
   std::vector<int32_t> object_of(map.surfaces.size(), -1);
   for (size_t o = 0; o < surface.size(); ++o)
-    if (scene.objects[o].rendered) object_of[surface[o]] = static_cast<int32_t>(o);
+    if (surface[o] >= 0) object_of[surface[o]] = static_cast<int32_t>(o);
   // The objects whose surfaces the leaves of each cluster list, as bit rows.
   const size_t nc = static_cast<size_t>(map.cluster_count), words = (scene.object_count() + 63) / 64;
   std::vector<uint64_t> touched(nc * words, 0);

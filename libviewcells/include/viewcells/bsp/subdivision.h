@@ -128,6 +128,10 @@ struct Subdivision {
   /// subdivision distributes its own segments with; appended to `out`, `stack` is scratch.
   void leaves_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
                          std::vector<std::tuple<int32_t, double, double>>& stack) const;
+  /// The same, with the part of the segment in each leaf: (leaf, t0, t1) for the points
+  /// a + t (b - a), t in [t0, t1].
+  void pieces_of_segment(const Vec3& a, const Vec3& b, std::vector<std::tuple<int32_t, double, double>>& out,
+                         std::vector<std::tuple<int32_t, double, double>>& stack) const;
 };
 
 /// Decides whether geometry-aligned candidates are used, and why.

@@ -35,6 +35,16 @@ struct Q3Leaf {
   int32_t area = 0;
   Box3 bounds;
   int32_t first_surface = 0, surface_count = 0;  ///< into leaf_surfaces
+  int32_t first_brush = 0, brush_count = 0;      ///< into leaf_brushes
+};
+/// A convex brush of the map source: the intersection of its sides' back half-spaces.
+struct Q3Brush {
+  int32_t first_side = 0, side_count = 0;  ///< into brush_sides
+  int32_t shader = 0;                      ///< content flags of the brush
+};
+struct Q3BrushSide {
+  int32_t plane = 0;   ///< the side's plane; the brush lies behind it
+  int32_t shader = 0;  ///< what the side's face would be drawn with
 };
 enum class Q3SurfaceType : int32_t { kBad = 0, kPlanar = 1, kPatch = 2, kTriangleSoup = 3, kFlare = 4 };
 struct Q3Surface {
@@ -61,10 +71,14 @@ struct Q3Map {
   std::vector<Q3Node> nodes;
   std::vector<Q3Leaf> leaves;
   std::vector<int32_t> leaf_surfaces;
+  std::vector<Q3Brush> brushes;
+  std::vector<Q3BrushSide> brush_sides;
+  std::vector<int32_t> leaf_brushes;
   std::vector<Vec3> vertices;  ///< drawVerts positions
   std::vector<int32_t> indices;
   std::vector<Q3Surface> surfaces;
   int32_t world_first_surface = 0, world_surface_count = 0;  ///< model 0
+  int32_t world_first_brush = 0, world_brush_count = 0;      ///< model 0
   int32_t cluster_count = 0, cluster_bytes = 0;  ///< 0 clusters: no visibility data
   std::vector<uint8_t> visibility;               ///< cluster_count rows of cluster_bytes
 
@@ -85,12 +99,25 @@ struct Q3MeshStats {
   size_t surfaces[4] = {0, 0, 0, 0};  ///< world surfaces by Q3SurfaceKind
   size_t patches = 0;                  ///< patch surfaces tessellated
   size_t spawn_points = 0;             ///< info_player_deathmatch / _start entities
+  size_t brush_hulls = 0;              ///< solid brushes added as hulls
 };
 
-/// The world model's geometry as a RawMesh with one group per surface (named
-/// "shader#surface"): opaque surfaces, and sky surfaces when `with_sky` (they close the map
-/// for rays; their groups are marked not rendered, so they cost nothing). Patches are tessellated with `patch_level` segments per Bezier piece side.
-RawMesh q3_world_mesh(const Q3Map& map, int patch_level, bool with_sky, Q3MeshStats* stats = nullptr);
+struct Q3MeshOptions {
+  int patch_level = 4;  ///< segments per side of each Bezier piece of a patch
+  /// Sky surfaces close the map for rays; their groups are marked not rendered (no cost).
+  bool sky = true;
+  /// The world's solid, non-translucent brushes as closed hulls set `hull_inset` inside their
+  /// sides, in one group that occludes but is not rendered. The eye stops at solid matter even
+  /// where no surface is drawn: caulk or clip sides (faces players never see from where they
+  /// can stand) and cracks between triangles. Without hulls, rays cross such brushes.
+  bool brush_hulls = true;
+  double hull_inset = 0.5;  ///< map units: drawn faces lie on the sides and are hit first
+};
+
+/// The world model's geometry as a RawMesh with one group per surface, named
+/// "shader#surface" (opaque surfaces and, per the options, the sky), plus the group
+/// "solid brushes" of the brush hulls.
+RawMesh q3_world_mesh(const Q3Map& map, const Q3MeshOptions& options = {}, Q3MeshStats* stats = nullptr);
 
 /// Spawn points (origin of info_player_deathmatch / info_player_start entities).
 std::vector<Vec3> q3_spawn_points(const Q3Map& map);

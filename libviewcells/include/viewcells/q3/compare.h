@@ -19,10 +19,16 @@ struct Q3Excluded {
   int32_t cluster = -1;
   uint32_t object = 0;
   size_t segment = 0;
-  /// "leak": the segment crosses solid space (a crack between surfaces, or a brush side that
-  /// has no surface); "unlisted": the object is seen in a cluster q3map2 admits but the map
-  /// does not list its surface in that cluster's leaves; "rejected": a line of sight through
-  /// non-solid space that q3map2's PVS rejects.
+  /// The segment crosses the map's solid space:
+  ///  - "crack": it enters and leaves a brush through drawn sides, so it slipped through a
+  ///    drawn surface (a crack between triangles, a gap at a T-junction);
+  ///  - "invisible": it enters or leaves a brush through a side that is not drawn (caulk,
+  ///    clip, an invisible wall): solid for q3map2's vis, open to the eye;
+  ///  - "void": in solid space no brush fills: space q3map2 filled as outside the map.
+  /// The segment stays in non-solid space:
+  ///  - "unlisted": the object is seen in a cluster q3map2 admits, but the map does not list
+  ///    its surface in that cluster's leaves;
+  ///  - "rejected": a line of sight that q3map2's PVS rejects (a q3map2 omission).
   std::string cause;
 };
 

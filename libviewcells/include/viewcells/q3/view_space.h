@@ -53,8 +53,9 @@ struct Q3ClusterCells {
 Q3ClusterCells q3_cluster_cells(const Scene& scene, const Q3Map& map, const Subdivision& q3,
                                 const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model);
 
-/// The map surface each object of `scene` stands for (objects named "shader#surface", as
-/// load_scene names a map's surfaces); Error when an object is not one surface.
+/// The map surface each rendered object of `scene` stands for (objects named
+/// "shader#surface", as load_scene names a map's surfaces; -1 for objects not rendered);
+/// Error when a rendered object is not one surface.
 std::vector<int32_t> q3_object_surfaces(const Scene& scene, const Q3Map& map);
 
 /// For every cluster, the objects q3map2's PVS admits: those with a surface listed in a leaf of
