@@ -166,7 +166,7 @@ int run_info(const InfoArgs& a, const Common& c) {
     std::cout << "quake 3 map:        IBSP version " << map.version << ", " << map.shaders.size() << " shaders, "
               << map.nodes.size() << " nodes, " << map.leaves.size() << " leaves (" << solid_leaves << " solid)\n"
               << "world surfaces:     " << st.surfaces[0] << " opaque, " << st.surfaces[1] << " sky (they close "
-              << "the map for rays but are not rendered: no render cost), " << st.surfaces[2] << " water/fog/translucent (left out for now), " << st.surfaces[3]
+              << "the map for rays but are not rendered: no render cost), " << st.surfaces[2] << " water/fog/translucent (rendered, seen through: they stop no ray), " << st.surfaces[3]
               << " nodraw/hint/skip/flare (left out); " << st.patches << " patches tessellated at level 4\n"
               << "solid brushes:      " << st.brush_hulls << " of " << map.world_brush_count
               << " as hulls 0.5 units inside their sides (occlude, not rendered)\n"
@@ -346,7 +346,15 @@ json sampling_report(const SampleArgs& a, const Sampled& s, int threads) {
       {"embree_robust_mode",
        {{"enabled", !a.fast},
         {"reason", a.fast ? "disabled by --fast: faster, but rays may slip through shared edges"
-                          : "enabled by default: fewer rays slip through shared edges"}}}};
+                          : "enabled by default: fewer rays slip through shared edges"}}},
+      {"see_through_objects",
+       {{"enabled", st.see_through_objects > 0},
+        {"reason", st.see_through_objects
+                       ? std::to_string(st.see_through_objects) +
+                             " objects are seen through (water, glass, fog): they stop no ray, and every segment "
+                             "crossing one sees it"
+                       : std::string("every object occludes")}}},
+      {"restricted_view_space", {{"enabled", static_cast<bool>(s.config.view_space)}, {"reason", s.view_space}}}};
   uint64_t objects_hit = 0, max_per_object = 0;
   for (uint64_t n : st.segments_per_object) {
     objects_hit += n > 0;
@@ -361,6 +369,9 @@ json sampling_report(const SampleArgs& a, const Sampled& s, int threads) {
                       {"outside_view_box", st.outside_view_box},
                       {"two_sided_samples", st.two_sided_samples},
                       {"rejected_origins", st.rejected_origins},
+                      {"see_through_objects", st.see_through_objects},
+                      {"see_through_segments", st.see_through_segments},
+                      {"see_through_rays", st.see_through_rays},
                       {"objects_hit", objects_hit},
                       {"objects_never_hit", s.scene.object_count() - objects_hit},
                       {"max_segments_per_object", max_per_object},

@@ -135,20 +135,22 @@ TEST(Q3Bsp, ReadsAHandBuiltMap) {
   EXPECT_EQ(st.spawn_points, 1u);
   // Opaque quad 2 + patch (2x2 pieces of... one 3x3 piece at level 2: 8) + sky 2.
   EXPECT_EQ(st.brush_hulls, 1u);
-  // + the brush hull: 6 faces of 2 triangles.
-  EXPECT_EQ(mesh.triangles.size(), 2u + 8u + 2u + 12u);
-  EXPECT_EQ(mesh.group_names.size(), 4u);
-  EXPECT_EQ(mesh.group_rendered, std::vector<uint8_t>({1, 1, 0, 0})) << "neither the sky nor the hulls are rendered";
+  // Opaque quad, patch, sky, water, and the brush hull: 6 faces of 2 triangles.
+  EXPECT_EQ(mesh.triangles.size(), 2u + 8u + 2u + 2u + 12u);
+  EXPECT_EQ(mesh.group_names.size(), 5u);
+  EXPECT_EQ(mesh.group_rendered, std::vector<uint8_t>({1, 1, 0, 1, 0})) << "neither the sky nor the hulls are rendered";
+  EXPECT_EQ(mesh.group_occluder, std::vector<uint8_t>({1, 1, 1, 0, 1})) << "water is seen through";
   // Every surface triangle faces +z, as the vertex normals say: winding turned counter-clockwise.
   for (size_t i = 0; i < mesh.triangles.size(); ++i) {
-    if (mesh.triangle_group[i] == 3) continue;  // the hull
+    if (mesh.triangle_group[i] == 4) continue;  // the hull
     const auto& t = mesh.triangles[i];
     const Vec3 n = cross(mesh.vertices[t[1]] - mesh.vertices[t[0]], mesh.vertices[t[2]] - mesh.vertices[t[0]]);
     EXPECT_GT(n.z, 0);
   }
   options.sky = false;
   options.brush_hulls = false;
-  EXPECT_EQ(q3_world_mesh(m, options).triangles.size(), 10u) << "without the sky and the hulls";
+  options.see_through = false;
+  EXPECT_EQ(q3_world_mesh(m, options).triangles.size(), 10u) << "without the sky, the water and the hulls";
   options.hull_inset = 10;  // thinner than twice the inset: nothing left
   options.brush_hulls = true;
   EXPECT_EQ(q3_world_mesh(m, options).triangles.size(), 10u);
@@ -161,10 +163,12 @@ TEST(Q3Bsp, LoadsAsAScene) {
     out << small_map().bytes();
   }
   const Scene s = load_scene(path);
-  EXPECT_EQ(s.object_count(), 4u);
-  EXPECT_EQ(s.triangle_count(), 2u + 32u + 2u + 12u) << "patches at level 4 in scenes";
+  EXPECT_EQ(s.object_count(), 5u);
+  EXPECT_EQ(s.triangle_count(), 2u + 32u + 2u + 2u + 12u) << "patches at level 4 in scenes";
+  EXPECT_FALSE(s.objects[3].occluder) << "water";
+  EXPECT_TRUE(s.objects[3].rendered);
   // The brush hull: a closed, outward box half a unit inside the brush, occluding, not rendered.
-  const ObjectInfo& hull = s.objects[3];
+  const ObjectInfo& hull = s.objects[4];
   EXPECT_EQ(hull.name, "solid brushes");
   EXPECT_FALSE(hull.rendered);
   EXPECT_TRUE(hull.solid());

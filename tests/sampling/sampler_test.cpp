@@ -4,7 +4,9 @@
 // runs inside a solid.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <set>
 
 #include "support/test_scenes.h"
 #include "viewcells/core/error.h"
@@ -254,6 +256,65 @@ TEST(Sampler, ViewSpaceRejectsOriginsOutsideIt) {
   // An empty view space is an error, not an endless loop.
   config.view_space = [](const Vec3&) { return false; };
   EXPECT_THROW(sample_segments(scene, *caster, config), Error);
+}
+
+TEST(Sampler, SeeThroughObjectsAreSeenButStopNoRay) {
+  // Two walls facing each other (x = 0 and x = 10) and a pane of glass between them at x = 5,
+  // y and z in [2, 8], that occludes nothing.
+  RawMesh mesh;
+  auto quad = [&](double x, double lo, double hi, uint32_t group, bool facing_plus_x) {
+    const uint32_t b = static_cast<uint32_t>(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(), {{x, lo, lo}, {x, hi, lo}, {x, hi, hi}, {x, lo, hi}});
+    for (auto t : {std::array<uint32_t, 3>{b, b + 1, b + 2}, std::array<uint32_t, 3>{b, b + 2, b + 3}}) {
+      if (!facing_plus_x) std::swap(t[1], t[2]);
+      mesh.triangles.push_back(t);
+      mesh.triangle_group.push_back(group);
+    }
+  };
+  quad(0, 0, 10, 0, true);
+  quad(10, 0, 10, 1, false);
+  quad(5, 2, 8, 2, true);
+  mesh.group_names = {"left", "right", "glass"};
+  mesh.group_occluder = {1, 1, 0};
+  const Scene scene = make_scene(mesh, ObjectGrouping::kGroups, "glass");
+  ASSERT_FALSE(scene.objects[2].occluder);
+  const auto caster = make_embree_caster(scene);
+  EXPECT_FALSE(caster->intersect(Ray{{2, 5, 5}, {1, 0, 0}}).object == 2) << "the glass stops no ray";
+  SamplerConfig config;
+  config.samples = 20000;
+  config.show_progress = false;
+  SamplingResult r;
+  {
+    ThreadLimit limit(1);
+    r = sample_segments(scene, *caster, config);
+  }
+  EXPECT_TRUE(sample_segments(scene, *caster, config).segments == r.segments) << "thread count";
+  EXPECT_EQ(r.stats.see_through_objects, 1u);
+  const SegmentSet& s = r.segments;
+  std::set<std::array<double, 6>> with_glass;
+  for (size_t i = 0; i < s.size(); ++i)
+    if (s.object_a[i] == 2 || s.object_b[i] == 2) {
+      ASSERT_TRUE(s.object_a[i] == 2 && s.object_b[i] == 2) << "a see-through object ends no ray";
+      with_glass.insert({s.ax[i], s.ay[i], s.az[i], s.bx[i], s.by[i], s.bz[i]});
+    }
+  EXPECT_EQ(with_glass.size(), r.stats.see_through_segments);
+  size_t crossing = 0;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s.object_a[i] == 2) continue;
+    const Vec3 a = s.a(i), b = s.b(i);
+    if ((a.x - 5) * (b.x - 5) >= 0) continue;  // does not cross x = 5
+    const Vec3 p = a + (b - a) * ((5 - a.x) / (b.x - a.x));
+    const bool inside = p.y > 2.01 && p.y < 7.99 && p.z > 2.01 && p.z < 7.99;
+    const bool outside = p.y < 1.99 || p.y > 8.01 || p.z < 1.99 || p.z > 8.01;
+    const bool companion = with_glass.count({a.x, a.y, a.z, b.x, b.y, b.z}) > 0;
+    if (inside) EXPECT_TRUE(companion) << "crosses the glass at " << p.y << " " << p.z;
+    if (outside) EXPECT_FALSE(companion);
+    crossing += inside;
+  }
+  EXPECT_GT(crossing, 500u);
+  EXPECT_EQ(r.stats.valid_segments - r.stats.see_through_segments + r.stats.missed_both + r.stats.stuck_in_solid +
+                r.stats.outside_view_box,
+            r.stats.samples + r.stats.two_sided_samples);
 }
 
 TEST(Sampler, DirectionsAreUniformOnTheSphere) {

@@ -314,11 +314,13 @@ RawMesh q3_world_mesh(const Q3Map& map, const Q3MeshOptions& options, Q3MeshStat
     const Q3Surface& s = map.surfaces[si];
     const Q3SurfaceKind kind = map.kind(s);
     ++st.surfaces[static_cast<int>(kind)];
-    if (kind == Q3SurfaceKind::kSkipped || kind == Q3SurfaceKind::kNonOccluding) continue;
+    if (kind == Q3SurfaceKind::kSkipped) continue;
     if (kind == Q3SurfaceKind::kSky && !with_sky) continue;
+    if (kind == Q3SurfaceKind::kNonOccluding && !options.see_through) continue;
     const uint32_t group = static_cast<uint32_t>(mesh.group_names.size());
     mesh.group_names.push_back(map.shaders[s.shader].name + "#" + std::to_string(si));
     mesh.group_rendered.push_back(kind != Q3SurfaceKind::kSky);  // the sky closes the map but is not drawn as one
+    mesh.group_occluder.push_back(kind != Q3SurfaceKind::kNonOccluding);
     auto add = [&](uint32_t a, uint32_t b, uint32_t c) {
       mesh.triangles.push_back({a, b, c});
       mesh.triangle_group.push_back(group);
@@ -357,6 +359,7 @@ RawMesh q3_world_mesh(const Q3Map& map, const Q3MeshOptions& options, Q3MeshStat
     const uint32_t group = static_cast<uint32_t>(mesh.group_names.size());
     mesh.group_names.push_back("solid brushes");
     mesh.group_rendered.push_back(false);
+    mesh.group_occluder.push_back(true);
     for (int32_t bi = map.world_first_brush; bi < map.world_first_brush + map.world_brush_count; ++bi) {
       const Q3Brush& b = map.brushes[bi];
       const int32_t contents = map.shaders[b.shader].content_flags;

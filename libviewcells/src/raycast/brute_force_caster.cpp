@@ -53,6 +53,7 @@ class BruteForceCaster final : public RayCaster {
     best.t = ray.tfar;
     bool found = false;
     for (uint32_t t = 0; t < scene_.triangles.size(); ++t) {
+      if (!scene_.objects[scene_.triangle_object[t]].occluder) continue;  // seen through
       const auto& tri = scene_.triangles[t];
       const Vec3 a = scene_.vertices[tri[0]] - ray.origin;
       const Vec3 b = scene_.vertices[tri[1]] - ray.origin;

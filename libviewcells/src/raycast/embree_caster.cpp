@@ -48,6 +48,11 @@ class EmbreeCaster final : public RayCaster {
  public:
   EmbreeCaster(const Scene& scene, const EmbreeConfig& config) : scene_(scene), config_(config) {
     center_ = scene.bounds.empty() ? Vec3{} : scene.bounds.center();
+    for (uint32_t t = 0; t < scene.triangles.size(); ++t)
+      if (scene.objects[scene.triangle_object[t]].occluder != config.see_through) selected_.push_back(t);
+    if (selected_.empty())
+      throw Error(config.see_through ? "the scene has no see-through triangles" : "the scene has no occluding triangles");
+    if (selected_.size() == scene.triangles.size()) selected_.clear();  // all: primitive = triangle
     device_ = rtcNewDevice("verbose=0");
     if (!device_) throw Error(std::string("embree: cannot create device: ") + error_name(rtcGetDeviceError(nullptr)));
     rtcSetDeviceErrorFunction(device_, error_callback, &sink_);
@@ -103,10 +108,12 @@ class EmbreeCaster final : public RayCaster {
   }
 
   std::string name() const override {
-    return std::string("embree ") + (config_.robust ? "robust" : "fast");
+    return std::string("embree ") + (config_.robust ? "robust" : "fast") + (config_.see_through ? " see-through" : "");
   }
 
  private:
+  size_t primitive_count() const { return selected_.empty() ? scene_.triangles.size() : selected_.size(); }
+
   void build() {
     rtc_scene_ = rtcNewScene(device_);
     check("rtcNewScene");
@@ -117,7 +124,7 @@ class EmbreeCaster final : public RayCaster {
     auto* verts = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                                               3 * sizeof(float), scene_.vertices.size()));
     auto* index = static_cast<unsigned*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                                 3 * sizeof(unsigned), scene_.triangles.size()));
+                                                                 3 * sizeof(unsigned), primitive_count()));
     if (!verts || !index) {
       rtcReleaseGeometry(geom);
       check("rtcSetNewGeometryBuffer");
@@ -129,8 +136,8 @@ class EmbreeCaster final : public RayCaster {
       verts[3 * i + 1] = static_cast<float>(p.y);
       verts[3 * i + 2] = static_cast<float>(p.z);
     }
-    for (size_t t = 0; t < scene_.triangles.size(); ++t)
-      for (int k = 0; k < 3; ++k) index[3 * t + k] = scene_.triangles[t][k];
+    for (size_t p = 0; p < primitive_count(); ++p)
+      for (int k = 0; k < 3; ++k) index[3 * p + k] = scene_.triangles[selected_.empty() ? p : selected_[p]][k];
     rtcCommitGeometry(geom);
     rtcAttachGeometry(rtc_scene_, geom);
     rtcReleaseGeometry(geom);
@@ -178,8 +185,9 @@ class EmbreeCaster final : public RayCaster {
     // The object of a hit triangle is a read from a table of megabytes: a cache miss each.
     // Ask for all of them first, so that the misses overlap instead of queueing.
     const uint32_t* object_of = scene_.triangle_object.data();
+    const bool all = selected_.empty();
     for (unsigned i = 0; i < n; ++i)
-      if (native[i].hit.geomID != RTC_INVALID_GEOMETRY_ID) __builtin_prefetch(object_of + native[i].hit.primID);
+      if (native[i].hit.geomID != RTC_INVALID_GEOMETRY_ID && all) __builtin_prefetch(object_of + native[i].hit.primID);
     for (unsigned i = 0; i < n; ++i) {
       const RTCRayHit& rh = native[i];
       Hit& h = hits[i];
@@ -188,8 +196,8 @@ class EmbreeCaster final : public RayCaster {
         continue;
       }
       h.t = rh.ray.tfar;
-      h.triangle = rh.hit.primID;
-      h.object = object_of[rh.hit.primID];
+      h.triangle = all ? rh.hit.primID : selected_[rh.hit.primID];
+      h.object = object_of[h.triangle];
       // Embree's Ng is (v1-v0)x(v2-v0) like Scene::triangle_normal (checked against the oracle);
       // using it avoids reading three vertices from random memory per hit.
       h.front = rh.hit.Ng_x * rh.ray.dir_x + rh.hit.Ng_y * rh.ray.dir_y + rh.hit.Ng_z * rh.ray.dir_z < 0.0f;
@@ -205,6 +213,7 @@ class EmbreeCaster final : public RayCaster {
 
   const Scene& scene_;
   EmbreeConfig config_;
+  std::vector<uint32_t> selected_;  ///< the triangle of each primitive; empty when all are
   Vec3 center_;
   RTCDevice device_ = nullptr;
   RTCScene rtc_scene_ = nullptr;

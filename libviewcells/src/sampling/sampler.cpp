@@ -107,13 +107,20 @@ void draw_batch(uint64_t seed, uint64_t batch, size_t count, const Box3& box,
 struct BatchOutput {
   size_t valid = 0;
   uint64_t rays = 0, recast_rays = 0, missed_both = 0, stuck = 0, outside = 0, two_sided = 0, rejected = 0;
+  uint64_t see_through_rays = 0, see_through_segments = 0;
 };
 
 class BatchSampler {
  public:
-  BatchSampler(const RayCaster& caster, const Box3& box, const std::function<bool(const Vec3&)>& view_space,
-               bool esd, int max_recasts, double recast_eps)
-      : caster_(caster), box_(box), view_space_(view_space), esd_(esd), max_recasts_(max_recasts), eps_(recast_eps) {}
+  BatchSampler(const RayCaster& caster, const RayCaster* see_through, const Box3& box,
+               const std::function<bool(const Vec3&)>& view_space, bool esd, int max_recasts, double recast_eps)
+      : caster_(caster),
+        see_through_(see_through),
+        box_(box),
+        view_space_(view_space),
+        esd_(esd),
+        max_recasts_(max_recasts),
+        eps_(recast_eps) {}
 
   /// At most one segment per sample, or two when a sample inside a solid re-casts both ways.
   static size_t segments_per_sample(bool esd) { return esd ? 2 : 1; }
@@ -181,6 +188,31 @@ class BatchSampler {
       }
       pending_.swap(next_);
     }
+    if (see_through_) add_see_through(out);
+  }
+
+  /// Every see-through object a segment of this batch crosses is seen from all of it: one
+  /// more segment, the same line with that object at both ends.
+  void add_see_through(BatchOutput& out) {
+    constexpr int kMaxCrossings = 64;
+    const size_t primary = out.valid;
+    for (size_t i = 0; i < primary; ++i) {
+      const Vec3 a = segs_->a(i), d = segs_->b(i) - a;
+      crossed_.clear();
+      double t0 = 0;
+      for (int k = 0; k < kMaxCrossings; ++k) {
+        const Hit h = see_through_->intersect(Ray{a, d, t0, 1.0});
+        ++out.see_through_rays;
+        if (!h.hit()) break;
+        if (std::find(crossed_.begin(), crossed_.end(), h.object) == crossed_.end()) crossed_.push_back(h.object);
+        t0 = h.t + 1e-7;  // t in units of the segment: past this crossing
+      }
+      for (uint32_t o : crossed_) {
+        if (out.valid >= segs_->size()) segs_->resize(2 * segs_->size() + 16);
+        segs_->set(out.valid++, a, segs_->b(i), o, o, kNoObject, kNoObject);
+        ++out.see_through_segments;
+      }
+    }
   }
 
   /// Queues a re-cast from the exit point `origin` of a solid (into next_ while re-casting,
@@ -232,6 +264,8 @@ class BatchSampler {
   }
 
   const RayCaster& caster_;
+  const RayCaster* see_through_;  ///< see-through triangles, or null when the scene has none
+  std::vector<uint32_t> crossed_;
   Box3 box_;
   const std::function<bool(const Vec3&)>& view_space_;
   bool esd_;
@@ -277,9 +311,19 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
   // Re-cast rays start a little past the exit surface: 1e-6 of the scene diagonal is well above
   // Embree's float resolution in its local frame and well below the generators' 2 mm gaps.
   const double eps = 1e-6 * std::max(scene.bounds.diagonal(), stats.view_box.diagonal());
+  // Objects one sees through (water, glass) do not stop rays: where segments cross them is
+  // found against their own triangles.
+  std::unique_ptr<RayCaster> see_through;
+  stats.see_through_objects = static_cast<uint64_t>(
+      std::count_if(scene.objects.begin(), scene.objects.end(), [](const ObjectInfo& o) { return !o.occluder; }));
+  if (stats.see_through_objects) {
+    EmbreeConfig ec;
+    ec.see_through = true;
+    see_through = make_embree_caster(scene, ec);
+  }
   tbb::enumerable_thread_specific<BatchSampler> samplers(
-      [&] { return BatchSampler(caster, stats.view_box, config.view_space, stats.empty_space.enabled,
-                                                config.max_recasts, eps); });
+      [&] { return BatchSampler(caster, see_through.get(), stats.view_box, config.view_space,
+                                stats.empty_space.enabled, config.max_recasts, eps); });
   const bool by_segments = config.target_segments > 0;
   Progress progress(by_segments ? "segments" : "sampling", by_segments ? config.target_segments : config.samples);
   const bool show = config.show_progress;
@@ -349,6 +393,8 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
             stats.outside_view_box += out.outside;
             stats.two_sided_samples += out.two_sided;
             stats.rejected_origins += out.rejected;
+            stats.see_through_rays += out.see_through_rays;
+            stats.see_through_segments += out.see_through_segments;
             if (show) progress.advance(by_segments ? out.valid : t->count);
             // Nothing seen after a million samples: the target is out of reach, say so now.
             if (by_segments && segs.size() == 0 && stats.samples >= kGiveUpSamples) finished = true;

@@ -235,13 +235,15 @@ Scene make_scene(RawMesh mesh, ObjectGrouping grouping, const std::string& sourc
       break;
     }
   }
-  // An object is rendered unless all of its triangles come from groups that are not.
-  if (has_groups && !mesh.group_rendered.empty()) {
-    if (mesh.group_rendered.size() != mesh.group_names.size())
-      throw Error(source, 0, "internal: group_rendered does not match the groups");
-    for (ObjectInfo& o : scene.objects) o.rendered = false;
+  // An object is rendered (occludes) unless all of its triangles come from groups that are not
+  // (do not).
+  for (auto [flags, member] : {std::pair{&mesh.group_rendered, &ObjectInfo::rendered},
+                               std::pair{&mesh.group_occluder, &ObjectInfo::occluder}}) {
+    if (!has_groups || flags->empty()) continue;
+    if (flags->size() != mesh.group_names.size()) throw Error(source, 0, "internal: group flags do not match the groups");
+    for (ObjectInfo& o : scene.objects) o.*member = false;
     for (size_t t = 0; t < n; ++t)
-      if (mesh.group_rendered[kept_group[t]]) scene.objects[scene.triangle_object[t]].rendered = true;
+      if ((*flags)[kept_group[t]]) scene.objects[scene.triangle_object[t]].*member = true;
   }
   scene.finalize();
   return scene;

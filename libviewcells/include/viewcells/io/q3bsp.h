@@ -58,7 +58,7 @@ struct Q3Surface {
 enum class Q3SurfaceKind {
   kOpaque,        ///< occludes and is rendered: an object of the scene
   kSky,           ///< closes the map for rays; not rendered as an object
-  kNonOccluding,  ///< water, fog, slime, lava, translucent: rays pass through
+  kNonOccluding,  ///< water, fog, slime, lava, translucent: rendered, but rays pass through
   kSkipped,       ///< nodraw, hint, skip, flares, empty: not geometry at all
 };
 
@@ -106,6 +106,9 @@ struct Q3MeshOptions {
   int patch_level = 4;  ///< segments per side of each Bezier piece of a patch
   /// Sky surfaces close the map for rays; their groups are marked not rendered (no cost).
   bool sky = true;
+  /// Water, fog, slime, lava and translucent surfaces as objects that are rendered and seen
+  /// through (they do not stop rays).
+  bool see_through = true;
   /// The world's solid, non-translucent brushes as closed hulls set `hull_inset` inside their
   /// sides, in one group that occludes but is not rendered. The eye stops at solid matter even
   /// where no surface is drawn: caulk or clip sides (faces players never see from where they
@@ -115,7 +118,8 @@ struct Q3MeshOptions {
 };
 
 /// The world model's geometry as a RawMesh with one group per surface, named
-/// "shader#surface" (opaque surfaces and, per the options, the sky), plus the group
+/// "shader#surface" (opaque surfaces and, per the options, the sky and the see-through
+/// surfaces), plus the group
 /// "solid brushes" of the brush hulls.
 RawMesh q3_world_mesh(const Q3Map& map, const Q3MeshOptions& options = {}, Q3MeshStats* stats = nullptr);
 

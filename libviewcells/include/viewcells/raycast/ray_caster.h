@@ -1,6 +1,7 @@
 #pragma once
 /// Closest-hit ray casting against a Scene. Two implementations: Embree 3 (fast, the default)
-/// and brute force (every triangle, watertight double-precision test; the test oracle).
+/// and brute force (every triangle, watertight double-precision test; the test oracle). Both
+/// cast against the triangles of occluding objects only: see-through ones do not stop rays.
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -59,10 +60,14 @@ struct EmbreeConfig {
   bool robust = true;
   /// RTC_BUILD_QUALITY_HIGH: slower BVH build, faster rays; worth it for millions of rays.
   bool high_quality_build = true;
+  /// Which triangles: those of occluding objects (what stops rays: the default), or those of
+  /// the see-through ones (ObjectInfo::occluder false), to find where segments cross them.
+  bool see_through = false;
 };
 
 /// Builds the Embree BVH (in a local frame centred on the scene, so float precision holds
-/// for coordinates around 1e5). Throws Error when Embree reports an error.
+/// for coordinates around 1e5). Throws Error when Embree reports an error or when no
+/// triangle is selected.
 std::unique_ptr<RayCaster> make_embree_caster(const Scene& scene, const EmbreeConfig& config = {});
 
 /// O(triangles) per ray; for tests and as an oracle only. The scene must outlive the caster.

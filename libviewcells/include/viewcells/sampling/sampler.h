@@ -1,7 +1,8 @@
 #pragma once
 /// Visibility segment sampling (view-cell-construction paper, section 4.1): points uniform in
 /// the view space box, directions uniform on the sphere, a forward and a backward ray, the
-/// segment between their termination points. Parallel and reproducible: samples are drawn in
+/// segment between their termination points. Objects one sees through do not stop the rays;
+/// each one a segment crosses gets a segment of its own along the same line. Parallel and reproducible: samples are drawn in
 /// fixed-size batches, each with its own random stream, so the output is bit-identical for
 /// any number of threads.
 #include <cstdint>
@@ -55,10 +56,14 @@ struct SamplingStats {
   uint64_t stuck_in_solid = 0;    ///< still inside solids after max_recasts
   uint64_t outside_view_box = 0;  ///< no length inside the view box (re-cast past its boundary)
   /// Samples inside a solid re-cast from both exits: each has two outcomes, so
-  /// valid + missed_both + stuck + outside == samples + two_sided_samples.
+  /// valid - see_through_segments + missed_both + stuck + outside == samples + two_sided_samples.
   uint64_t two_sided_samples = 0;
   /// Origins drawn outside SamplerConfig::view_space and drawn again (not samples).
   uint64_t rejected_origins = 0;
+  /// See-through objects (ObjectInfo::occluder false) of the scene; segments crossing them get
+  /// a companion segment seeing each at both ends (counted in valid_segments too), found by
+  /// see_through_rays rays against their triangles (not in `rays`).
+  uint64_t see_through_objects = 0, see_through_segments = 0, see_through_rays = 0;
   EmptySpaceDecision empty_space;
   Box3 view_box;
   bool view_box_from_scene = true;

@@ -36,6 +36,9 @@ struct ObjectInfo {
   /// Drawn by the renderer, so it counts in r(PVS). False for geometry that only closes the
   /// scene for rays, such as a game level's sky (it occludes but costs nothing).
   bool rendered = true;
+  /// Stops rays. False for surfaces one sees through (water, glass, fog): they are seen, and
+  /// so in PVSs, wherever a segment crosses them, but hide nothing.
+  bool occluder = true;
   /// Closed, consistently oriented, normals outwards: back-face hits mean "inside".
   bool solid() const { return closed && oriented && signed_volume > 0; }
 };
@@ -48,6 +51,8 @@ struct RawMesh {
   std::vector<std::string> group_names;  ///< empty when the file has no groups
   /// Per group: false when the group is not rendered (ObjectInfo::rendered); empty: all are.
   std::vector<uint8_t> group_rendered;
+  /// Per group: false when the group does not stop rays (ObjectInfo::occluder); empty: all do.
+  std::vector<uint8_t> group_occluder;
 };
 
 class Scene {
