@@ -92,6 +92,19 @@ int32_t Q3Map::leaf_at(const Vec3& p) const {
   return -(n + 1);
 }
 
+bool Q3Map::in_brush(const Q3Brush& b, const Vec3& p, double slack) const {
+  for (int32_t k = 0; k < b.side_count; ++k) {
+    const Q3Plane& pl = planes[brush_sides[b.first_side + k].plane];
+    if (dot(pl.normal, p) - pl.dist > slack) return false;
+  }
+  return true;
+}
+
+bool Q3Map::opaque_brush(const Q3Brush& b) const {
+  const int32_t contents = shaders[b.shader].content_flags;
+  return (contents & kQ3ContentsSolid) && !(contents & kQ3ContentsTranslucent);
+}
+
 Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
   Reader r(bytes, name);
   if (bytes.size() < 8 || bytes.compare(0, 4, "IBSP") != 0) r.fail("not a Quake 3 BSP file (no IBSP header)");
@@ -362,8 +375,7 @@ RawMesh q3_world_mesh(const Q3Map& map, const Q3MeshOptions& options, Q3MeshStat
     mesh.group_occluder.push_back(true);
     for (int32_t bi = map.world_first_brush; bi < map.world_first_brush + map.world_brush_count; ++bi) {
       const Q3Brush& b = map.brushes[bi];
-      const int32_t contents = map.shaders[b.shader].content_flags;
-      if (!(contents & kQ3ContentsSolid) || (contents & kQ3ContentsTranslucent)) continue;
+      if (!map.opaque_brush(b)) continue;
       st.brush_hulls += add_brush_hull(map, b, options.hull_inset, group, mesh);
     }
   }

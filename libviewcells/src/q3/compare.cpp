@@ -19,15 +19,6 @@ namespace {
 
 uint64_t pair_key(int32_t cluster, uint32_t object) { return (uint64_t(uint32_t(cluster)) << 32) | object; }
 
-/// Whether p lies in brush b (behind all of its sides, with a little slack).
-bool in_brush(const Q3Map& map, const Q3Brush& b, const Vec3& p) {
-  for (int32_t k = 0; k < b.side_count; ++k) {
-    const Q3Plane& pl = map.planes[map.brush_sides[b.first_side + k].plane];
-    if (dot(pl.normal, p) - pl.dist > 1e-3) return false;
-  }
-  return true;
-}
-
 /// Why segment i, seen from `cluster`, shows `object` although q3map2 does not admit it.
 std::string classify(const Q3Map& map, const Subdivision& q3, const SegmentSet& eval, size_t i, int32_t cluster,
                      uint32_t object) {
@@ -56,7 +47,7 @@ std::string classify(const Q3Map& map, const Subdivision& q3, const SegmentSet& 
     const Q3Leaf& leaf = map.leaves[solid_leaf];
     for (int32_t k = 0; k < leaf.brush_count; ++k) {
       const Q3Brush& b = map.brushes[map.leaf_brushes[leaf.first_brush + k]];
-      if (!in_brush(map, b, m)) continue;
+      if (!map.in_brush(b, m)) continue;
       // The sides where the segment enters and leaves the brush (clipping the line by it):
       // if the eye passes one that is not drawn, the brush is invisible from there.
       double t_in = -1, t_out = 2;

@@ -10,7 +10,16 @@
 
 namespace viewcells {
 
-bool q3_in_view_space(const Q3Map& map, const Vec3& p) { return map.leaves[map.leaf_at(p)].cluster >= 0; }
+bool q3_in_view_space(const Q3Map& map, const Vec3& p) {
+  const Q3Leaf& leaf = map.leaves[map.leaf_at(p)];
+  if (leaf.cluster < 0) return false;
+  // Detail brushes fill parts of non-solid leaves: no eye is inside them either.
+  for (int32_t k = 0; k < leaf.brush_count; ++k) {
+    const Q3Brush& b = map.brushes[map.leaf_brushes[leaf.first_brush + k]];
+    if (map.opaque_brush(b) && map.in_brush(b, p, 0.0)) return false;
+  }
+  return true;
+}
 
 Box3 q3_view_box(const Q3Map& map) {
   Box3 box;

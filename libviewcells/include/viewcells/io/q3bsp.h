@@ -88,6 +88,10 @@ struct Q3Map {
   Q3SurfaceKind kind(const Q3Surface& s) const;
   /// The leaf containing p (walking the nodes).
   int32_t leaf_at(const Vec3& p) const;
+  /// Whether p lies in brush b: behind all of its sides, up to `slack` map units.
+  bool in_brush(const Q3Brush& b, const Vec3& p, double slack = 1e-3) const;
+  /// Whether brush b is solid matter that stops the eye (solid and not translucent contents).
+  bool opaque_brush(const Q3Brush& b) const;
 };
 
 /// Parses a BSP file's bytes (`name` labels errors).

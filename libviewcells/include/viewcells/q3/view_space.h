@@ -15,7 +15,9 @@
 
 namespace viewcells {
 
-/// Whether p lies in the map's non-solid space (its leaf has a cluster).
+/// Whether p lies in the map's non-solid space: its leaf has a cluster, and no opaque brush
+/// of that leaf (a detail brush) contains it. Cell weights (below) count whole leaves: detail
+/// brushes take a small share of a leaf's volume.
 bool q3_in_view_space(const Q3Map& map, const Vec3& p);
 
 /// The bounding box of the non-solid leaves (Error when the map has none).
