@@ -14,6 +14,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "viewcells/agvs/agvs.h"
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/bsp/subdivision_io.h"
 #include "viewcells/core/error.h"
@@ -855,6 +856,19 @@ int run_compare(const SampleArgs& a, const CompareArgs& ca, const Common& c) {
   return 0;
 }
 
+// -------------------------------------------------------------------------------- pvs
+
+struct PvsArgs {
+  std::string input, scene, output, report, method = "agvs", objects = "auto";
+  uint32_t cells = 0;
+  double pixel_error = 0, seconds = 0;
+  uint64_t samples = 0, seed = 1;
+  uint32_t batch = 20000;
+  bool fast = false;
+};
+
+int run_pvs(const PvsArgs& a, const Common& c);
+
 // ---------------------------------------------------------------- extract, compress, query
 
 /// "123", "64K", "2M", "1G" (powers of 1024) -> bytes.
@@ -968,6 +982,102 @@ struct CompressArgs {
   std::string input, output, flat, report;
   CutArgs cut;
 };
+
+int run_pvs(const PvsArgs& a, const Common& c) {
+  ThreadLimit threads(c.threads);
+  AgvsConfig config;
+  config.method = parse_agvs_method(a.method);
+  config.seed = a.seed;
+  config.batch_size = a.batch;
+  config.max_samples = a.samples;
+  config.max_seconds = a.seconds;
+  config.pixel_error = a.pixel_error;
+  config.show_progress = !c.quiet;
+  if (!a.samples && !(a.seconds > 0) && !(a.pixel_error > 0))
+    throw Error("give when to stop: --pixel-error, --time or --samples");
+  SubdivisionFile file = read_merged(a.input);
+  const MergeHistory& h = *file.history;
+  CutArgs cut;
+  cut.count = a.cells;
+  const ViewCellSet set = choose_cells(h, cut, true);
+  Stopwatch sw;
+  const Scene scene = load_scene(a.scene, parse_grouping(a.objects));
+  if (scene.fingerprint() != file.scene_fingerprint)
+    throw Error(a.scene, 0, "is not the scene " + a.input + " was built from (fingerprints differ)");
+  EmbreeConfig ec;
+  ec.robust = !a.fast;
+  const auto caster = make_embree_caster(scene, ec);
+  PvsFile pf = make_pvs_file(file.subdivision, file.leaf_pvs, h, set.cells);
+  pf.object_count = file.object_count;
+  pf.object_names = file.object_names;
+  pf.scene_fingerprint = file.scene_fingerprint;
+  pf.rule = set.rule + "; PVS by " + a.method;
+  const CellLocator cells(pf.bsp, pf.leaf_cell, pf.pvs.cell_count);
+  const double setup_s = sw.seconds();
+  c.log("viewcells: " + std::to_string(cells.cell_count()) + " view cells (" + set.rule + "), PVS by " + a.method +
+        " until " +
+        (a.pixel_error > 0 ? "an estimated pixel error of " + fmt(a.pixel_error, 2) + " "
+                           : std::string()) +
+        (a.seconds > 0 ? std::to_string(a.seconds) + " s " : std::string()) +
+        (a.samples ? std::to_string(a.samples) + " samples" : std::string()));
+  AgvsSolver solver(scene, *caster, cells, config);
+  solver.run();
+  const AgvsStats& st = solver.stats();
+  // The sampled PVSs replace the construction ones, compressed through the hierarchy.
+  std::vector<std::vector<uint32_t>> lists(cells.cell_count());
+  for (uint32_t i = 0; i < cells.cell_count(); ++i) lists[i] = solver.pvs().list(i);
+  pf.pvs = compress_pvs(h, set.cells, lists);
+  write_pvs(a.output, pf);
+  const PvsFile back = read_pvs(a.output);
+  for (uint32_t i = 0; i < back.pvs.cell_count; ++i)
+    if (back.pvs.cell_pvs(i) != lists[i]) throw Error(a.output, 0, "read-back check failed for cell " + std::to_string(i));
+  const double err = solver.pixel_error();
+  c.log("viewcells: " + std::to_string(st.samples) + " samples (" + std::to_string(st.rays) + " rays) in " +
+        fmt(st.seconds, 2) + " s; mean PVS " + fmt(solver.mean_pvs(), 1) + " objects; estimated pixel error " +
+        (std::isnan(err) ? std::string("not yet known") : fmt(err, 2)) + " (" + st.stop_reason + "); -> " + a.output);
+  if (!a.report.empty()) {
+    json dists = json::array();
+    for (int d = 0; d < 4; ++d)
+      dists.push_back({{"distribution", to_string(static_cast<AgvsDistribution>(d))},
+                       {"samples", st.dist_samples[d]},
+                       {"rays", st.dist_rays[d]},
+                       {"contribution", st.dist_contribution[d]},
+                       {"last_probability", st.dist_probability[d]}});
+    json curve = json::array();
+    for (const AgvsPoint& p : st.curve)
+      curve.push_back({{"seconds", p.seconds}, {"samples", p.samples}, {"rays", p.rays}, {"mean_pvs_size", p.mean_pvs},
+                       {"pixel_error", std::isnan(p.pixel_error) ? json(nullptr) : json(p.pixel_error)}});
+    const json report = {
+        {"command", "pvs"},
+        {"input", a.input},
+        {"scene", a.scene},
+        {"output", a.output},
+        {"method", a.method},
+        {"cells", cells.cell_count()},
+        {"rule", set.rule},
+        {"settings",
+         {{"seed", a.seed}, {"batch_size", a.batch}, {"resolution", config.resolution}, {"threads", threads.threads()},
+          {"window_p", config.window_p}, {"window_k", config.window_k}}},
+        {"effects",
+         {{"empty_space_detection", {{"enabled", st.empty_space.enabled}, {"reason", st.empty_space.reason}}},
+          {"silhouette_mutation", {{"enabled", false}, {"reason", "not implemented yet"}}},
+          {"visibility_filter", {{"enabled", false}, {"reason", "not implemented yet"}}}}},
+        {"samples", st.samples},
+        {"rays", st.rays},
+        {"seconds", st.seconds},
+        {"setup_seconds", setup_s},
+        {"samples_per_second", st.seconds > 0 ? st.samples / st.seconds : 0.0},
+        {"mean_pvs_size", solver.mean_pvs()},
+        {"pvs_entries", solver.pvs().entries()},
+        {"estimated_pixel_error", std::isnan(err) ? json(nullptr) : json(err)},
+        {"stop_reason", st.stop_reason},
+        {"distributions", dists},
+        {"curve", curve}};
+    write_json(a.report, report);
+    c.log("viewcells: report -> " + a.report);
+  }
+  return 0;
+}
 
 int run_compress(const CompressArgs& a, const Common& c) {
   SubdivisionFile file = read_merged(a.input);
@@ -1196,6 +1306,27 @@ int run(int argc, char** argv) {
   cp->add_option("--flat", cmp.flat, "Also write Quake-style run-length coded bit rows, to compare sizes");
   cp->add_option("--report", cmp.report, "JSON report: entries and bytes before and after");
 
+  PvsArgs pva;
+  auto* pv = app.add_subcommand("pvs",
+                                "Compute the view cells' PVSs by adaptive global visibility sampling (AGVS) and write "
+                                "them, compressed, as a .pvs file");
+  pv->add_option("cells", pva.input, "Hierarchy file (.vcells, built with merging)")->required();
+  pv->add_option("--scene", pva.scene, "The scene the hierarchy was built from")->required();
+  pv->add_option("--objects", pva.objects, "Object grouping used when building")->capture_default_str();
+  pv->add_option("--cells", pva.cells, "View cells cut from the merge history (default: every elementary cell)")
+      ->check(CLI::PositiveNumber);
+  pv->add_option("--pixel-error", pva.pixel_error,
+                 "Stop when the estimated pixel error (pixels of a 1024x1024 image that differ) is at most this");
+  pv->add_option("--time", pva.seconds, "Stop after this many seconds");
+  pv->add_option("--samples", pva.samples, "Stop after this many samples");
+  pv->add_option("--method", pva.method, "agvs (adaptive mixture), sgvs (view space-direction only) or ref (per cell)")
+      ->capture_default_str();
+  pv->add_option("--seed", pva.seed, "Random seed")->capture_default_str();
+  pv->add_option("--batch", pva.batch, "Samples per batch")->capture_default_str()->check(CLI::PositiveNumber);
+  pv->add_flag("--fast", pva.fast, "Embree without robust mode");
+  pv->add_option("-o,--output", pva.output, "The .pvs file to write")->required();
+  pv->add_option("--report", pva.report, "JSON report: samples, rays, mean PVS size, estimated pixel error, curve");
+
   QueryArgs qry;
   auto* qy = app.add_subcommand("query", "Print the view cell containing a point and its PVS");
   qy->add_option("pvs", qry.input, "A .pvs file (from compress)")->required();
@@ -1225,6 +1356,7 @@ int run(int argc, char** argv) {
       return run_compare(csmp, cmpa, common);
     }
     if (*cp) return run_compress(cmp, common);
+    if (*pv) return run_pvs(pva, common);
     if (*qy) return run_query(qry, common);
   } catch (const Error& e) {
     std::cerr << "viewcells: error: " << e.what() << '\n';

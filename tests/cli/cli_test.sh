@@ -28,7 +28,7 @@ json_get() { python3 -c "import json,sys; d=json.load(open('$1')); print(eval('d
 
 # --help explains every subcommand.
 expect_ok "$VC" --help
-for sub in generate info sample build export extract compress query compare; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
+for sub in generate info sample build export extract compress pvs query compare; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
 expect_ok "$VC" sample --help
 grep -q -- "--measure-raw" out.txt && ok || bad "sample --help lacks --measure-raw"
 
@@ -162,6 +162,20 @@ import json; r=json.load(open('out.txt')); assert r['cells'] == 16 and len(r['pv
 expect_error "outside the view space" "$VC" query office.pvs 1e6 0 0
 head -c 60 office.pvs > cut.pvs
 expect_error "cut.pvs" "$VC" query cut.pvs 2 2 1.5
+# pvs: the cells' PVSs by global visibility sampling, written like compress's.
+expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 40000 -o agvs.pvs --report agvs.json -q
+python3 -c "
+import json; r=json.load(open('agvs.json'))
+assert r['cells'] == 16 and r['samples'] == 40000 and r['mean_pvs_size'] > 0, r
+assert 'estimated_pixel_error' in r and r['samples_per_second'] > 0 and len(r['curve']) > 0
+assert sum(d['samples'] for d in r['distributions']) == 40000
+" && ok || bad "pvs report"
+expect_ok "$VC" query agvs.pvs 2 2 1.5
+grep -q "^cell [0-9]* of 16" out.txt && ok || bad "query on a pvs from AGVS"
+expect_error "give when to stop" "$VC" pvs office.vcells --scene office.obj -o x.pvs
+expect_error "fingerprints differ" "$VC" pvs office.vcells --scene city.obj --samples 10 -o x.pvs
+expect_error "unknown PVS method" "$VC" pvs office.vcells --scene office.obj --samples 10 --method fast -o x.pvs
+[ ! -e x.pvs ] && ok || bad "a refused pvs wrote its output"
 expect_ok "$VC" build office.obj --samples 5000 --max-cells 8 --no-merge -o nomerge.vcells -q
 expect_error "no merge history" "$VC" extract nomerge.vcells --count 2
 # compare: every method from the same samples, scored on independent ones.

@@ -156,6 +156,30 @@ void walk_segment(const Subdivision& s, const Vec3& a, const Vec3& b,
 
 }  // namespace
 
+void clip_to_leaves(const Subdivision& s, const ConvexPolyhedron& cell,
+                    const std::function<void(int32_t, const ConvexPolyhedron&)>& at_leaf) {
+  if (cell.empty() || s.nodes.empty()) return;
+  std::vector<std::pair<int32_t, ConvexPolyhedron>> stack;
+  stack.emplace_back(0, cell);
+  while (!stack.empty()) {
+    auto [n, part] = std::move(stack.back());
+    stack.pop_back();
+    const BspNode& bn = s.nodes[n];
+    if (bn.plane < 0) {
+      at_leaf(n, part);
+      continue;
+    }
+    const Plane& plane = s.planes[bn.plane];
+    auto halves = part.split(plane, bn.plane);
+    if (halves) {
+      stack.emplace_back(bn.child[0], std::move(halves->first));
+      stack.emplace_back(bn.child[1], std::move(halves->second));
+    } else {  // the plane does not cut the part: it lies on one side
+      stack.emplace_back(bn.child[plane.side(part.centroid()) > 0 ? 1 : 0], std::move(part));
+    }
+  }
+}
+
 void Subdivision::leaves_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
                                     std::vector<std::tuple<int32_t, double, double>>& stack) const {
   walk_segment(*this, a, b, stack, [&](int32_t n, double, double) { out.push_back(n); });

@@ -61,7 +61,7 @@ std::string classify(const Q3Map& map, const Subdivision& q3, const SegmentSet& 
         if (d0 < d1 && t < t_out) t_out = t, side_out = j;
       }
       bool undrawn = false;
-      for (const auto [t, j] : {std::pair{t_in, side_in}, std::pair{t_out, side_out}})
+      for (const auto& [t, j] : {std::pair{t_in, side_in}, std::pair{t_out, side_out}})
         if (j >= 0 && t > 0 && t < 1)
           undrawn |= (map.shaders[map.brush_sides[b.first_side + j].shader].surface_flags & kQ3SurfNodraw) != 0;
       return undrawn ? "invisible" : "crack";

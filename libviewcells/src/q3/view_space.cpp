@@ -54,32 +54,6 @@ Plane to_plane(const Q3Plane& q, bool& flipped) {
   return Plane::through(a, a + u * kSpan, a + v * kSpan);
 }
 
-/// Pushes `cell` down the tree of `s` from `node`, calling at_leaf(leaf node, part) for every
-/// leaf the cell has volume in.
-template <class AtLeaf>
-void descend(const Subdivision& s, ConvexPolyhedron cell, int32_t node, AtLeaf&& at_leaf) {
-  std::vector<std::pair<int32_t, ConvexPolyhedron>> stack;
-  stack.emplace_back(node, std::move(cell));
-  while (!stack.empty()) {
-    auto [n, part] = std::move(stack.back());
-    stack.pop_back();
-    const BspNode& bn = s.nodes[n];
-    if (bn.plane < 0) {
-      at_leaf(n, part);
-      continue;
-    }
-    const Plane& plane = s.planes[bn.plane];
-    auto halves = part.split(plane, bn.plane);
-    if (halves) {
-      stack.emplace_back(bn.child[0], std::move(halves->first));
-      stack.emplace_back(bn.child[1], std::move(halves->second));
-    } else {  // the plane does not cut the part: it lies on one side
-      const int side = plane.side(part.centroid());
-      stack.emplace_back(bn.child[side > 0 ? 1 : 0], std::move(part));
-    }
-  }
-}
-
 }  // namespace
 
 Subdivision q3_subdivision(const Q3Map& map, const Box3& box) {
@@ -114,7 +88,7 @@ Subdivision q3_subdivision(const Q3Map& map, const Box3& box) {
     }
   }
   s.cells.resize(s.nodes.size());
-  descend(s, whole, 0, [&](int32_t n, ConvexPolyhedron& part) { s.cells[n] = std::move(part); });
+  clip_to_leaves(s, whole, [&](int32_t n, const ConvexPolyhedron& part) { s.cells[n] = part; });
   // Volumes and weights bottom-up (iterative post-order: map nodes need not be in any order).
   std::vector<std::pair<int32_t, bool>> stack{{0, false}};
   while (!stack.empty()) {
@@ -140,7 +114,7 @@ double view_space_volume(const Subdivision& q3, const ConvexPolyhedron& cell) {
   if (cell.empty()) return 0.0;
   double v = 0;
   // Leaves of weight 0 are solid (or outside the box, where the cell has no volume either).
-  descend(q3, cell, 0, [&](int32_t n, const ConvexPolyhedron& part) {
+  clip_to_leaves(q3, cell, [&](int32_t n, const ConvexPolyhedron& part) {
     if (q3.nodes[n].weight > 0) v += part.volume();
   });
   return v;

@@ -129,8 +129,26 @@ class BatchSampler {
   /// slots: at most segments_per_sample() * count of them); out.valid says how many.
   void run(uint64_t seed, uint64_t batch, size_t count, SegmentSet& segs, BatchOutput& out,
            std::vector<Ray>* log = nullptr) {
-    segs_ = &segs;
     draw_batch(seed, batch, count, box_, view_space_, points_, dirs_, out.rejected);
+    sample_of_ = nullptr;
+    cast_drawn(count, segs, out, log);
+  }
+
+  /// The same for samples given by the caller; sample_of[k] receives the sample of segment k.
+  void run_given(std::span<const Vec3> points, std::span<const Vec3> dirs, SegmentSet& segs, BatchOutput& out,
+                 std::vector<uint32_t>& sample_of) {
+    points_.assign(points.begin(), points.end());
+    dirs_.assign(dirs.begin(), dirs.end());
+    sample_of.clear();
+    sample_of_ = &sample_of;
+    cast_drawn(points.size(), segs, out, nullptr);
+    sample_of_ = nullptr;
+  }
+
+ private:
+  /// Casts the samples in points_, dirs_.
+  void cast_drawn(size_t count, SegmentSet& segs, BatchOutput& out, std::vector<Ray>* log) {
+    segs_ = &segs;
     hits_.resize(2 * count);
     caster_.intersect_pairs(points_, dirs_, hits_);
     if (log) {
@@ -143,6 +161,7 @@ class BatchSampler {
     pending_.clear();
 
     for (size_t i = 0; i < count; ++i) {
+      current_ = static_cast<uint32_t>(i);
       const Hit& fwd = hits_[2 * i];
       const Hit& bwd = hits_[2 * i + 1];
       const bool fwd_inside = fwd.hit() && !fwd.front, bwd_inside = bwd.hit() && !bwd.front;
@@ -174,6 +193,7 @@ class BatchSampler {
       for (size_t k = 0; k < pending_.size(); ++k) {
         const Pending& p = pending_[k];
         const Hit& h = recast_hits_[k];
+        current_ = p.sample;
         if (h.hit() && !h.front) {  // left one solid straight into another
           if (p.depth >= max_recasts_) {
             ++out.stuck;
@@ -210,6 +230,7 @@ class BatchSampler {
       for (uint32_t o : crossed_) {
         if (out.valid >= segs_->size()) segs_->resize(2 * segs_->size() + 16);
         segs_->set(out.valid++, a, segs_->b(i), o, o, kNoObject, kNoObject);
+        if (sample_of_) sample_of_->push_back((*sample_of_)[i]);
         ++out.see_through_segments;
       }
     }
@@ -224,7 +245,7 @@ class BatchSampler {
       ++out.outside;
       return;
     }
-    (depth == 1 ? pending_ : next_).push_back({origin, dir, object, triangle, depth});
+    (depth == 1 ? pending_ : next_).push_back({origin, dir, object, triangle, depth, current_});
   }
 
  private:
@@ -232,7 +253,10 @@ class BatchSampler {
     Vec3 origin, dir;
     uint32_t exit_object, exit_triangle;
     int depth;
+    uint32_t sample;  ///< index of the sample in its batch
   };
+  uint32_t current_ = 0;                        ///< the sample being emitted
+  std::vector<uint32_t>* sample_of_ = nullptr;  ///< when set: the sample of each segment
 
   /// The segment o + t*d, t in [t0, t1], seeing object o0 at t0 and o1 at t1, clipped to the box.
   void emit(const Vec3& o, const Vec3& d, double t0, uint32_t o0, uint32_t tri0, double t1, uint32_t o1, uint32_t tri1,
@@ -247,6 +271,7 @@ class BatchSampler {
       const Vec3 a = o + d * t0, b = o + d * t1;
       if (box_.contains(a, eps_) && box_.contains(b, eps_)) {
         segs_->set(out.valid++, clamp_to_box(a, box_), clamp_to_box(b, box_), o0, o1, tri0, tri1);
+        if (sample_of_) sample_of_->push_back(current_);
         return;
       }
     }
@@ -261,6 +286,7 @@ class BatchSampler {
     const Vec3 a = clamp_to_box(o + d * std::max(t0, c0), box_);
     const Vec3 b = clamp_to_box(o + d * std::min(t1, c1), box_);
     segs_->set(out.valid++, a, b, o0, o1, tri0, tri1);
+    if (sample_of_) sample_of_->push_back(current_);
   }
 
   const RayCaster& caster_;
@@ -278,6 +304,24 @@ class BatchSampler {
   std::vector<Hit> recast_hits_;
   std::vector<Pending> pending_, next_;
 };
+
+/// Re-cast rays start a little past the exit surface: 1e-6 of the scene diagonal is well above
+/// Embree's float resolution in its local frame and well below the generators' 2 mm gaps.
+double recast_epsilon(const Scene& scene, const Box3& view_box) {
+  return 1e-6 * std::max(scene.bounds.diagonal(), view_box.diagonal());
+}
+
+/// Objects one sees through (water, glass) do not stop rays: where segments cross them is found
+/// against their own triangles. Null when the scene has none.
+std::unique_ptr<RayCaster> make_see_through_caster(const Scene& scene, uint64_t* count) {
+  const uint64_t n = static_cast<uint64_t>(
+      std::count_if(scene.objects.begin(), scene.objects.end(), [](const ObjectInfo& o) { return !o.occluder; }));
+  if (count) *count = n;
+  if (n == 0) return nullptr;
+  EmbreeConfig ec;
+  ec.see_through = true;
+  return make_embree_caster(scene, ec);
+}
 
 Box3 resolve_view_box(const Scene& scene, const SamplerConfig& config, bool& from_scene) {
   if (scene.triangles.empty()) throw Error("cannot sample an empty scene");
@@ -308,19 +352,8 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
   SegmentSet& segs = result.segments;
   segs.view_box = stats.view_box;
 
-  // Re-cast rays start a little past the exit surface: 1e-6 of the scene diagonal is well above
-  // Embree's float resolution in its local frame and well below the generators' 2 mm gaps.
-  const double eps = 1e-6 * std::max(scene.bounds.diagonal(), stats.view_box.diagonal());
-  // Objects one sees through (water, glass) do not stop rays: where segments cross them is
-  // found against their own triangles.
-  std::unique_ptr<RayCaster> see_through;
-  stats.see_through_objects = static_cast<uint64_t>(
-      std::count_if(scene.objects.begin(), scene.objects.end(), [](const ObjectInfo& o) { return !o.occluder; }));
-  if (stats.see_through_objects) {
-    EmbreeConfig ec;
-    ec.see_through = true;
-    see_through = make_embree_caster(scene, ec);
-  }
+  const double eps = recast_epsilon(scene, stats.view_box);
+  std::unique_ptr<RayCaster> see_through = make_see_through_caster(scene, &stats.see_through_objects);
   tbb::enumerable_thread_specific<BatchSampler> samplers(
       [&] { return BatchSampler(caster, see_through.get(), stats.view_box, config.view_space,
                                 stats.empty_space.enabled, config.max_recasts, eps); });
@@ -420,6 +453,39 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
 
 SamplingResult sample_segments(const Scene& scene, const RayCaster& caster, const SamplerConfig& config) {
   return sample_impl(scene, caster, config, nullptr);
+}
+
+struct SegmentCaster::Impl {
+  std::unique_ptr<RayCaster> see_through;
+  std::function<bool(const Vec3&)> no_view_space;
+  EmptySpaceDecision esd;
+  tbb::enumerable_thread_specific<BatchSampler> samplers;
+  Impl(const Scene& scene, const RayCaster& caster, const Box3& box, EmptySpaceMode mode, int max_recasts)
+      : see_through(make_see_through_caster(scene, nullptr)),
+        esd(decide_empty_space(scene, mode)),
+        samplers([this, &caster, box, max_recasts, eps = recast_epsilon(scene, box)] {
+          return BatchSampler(caster, see_through.get(), box, no_view_space, esd.enabled, max_recasts, eps);
+        }) {}
+};
+
+SegmentCaster::SegmentCaster(const Scene& scene, const RayCaster& caster, const Box3& view_box, EmptySpaceMode mode,
+                             int max_recasts) {
+  if (view_box.empty() || !(view_box.volume() > 0)) throw Error("the view space box has zero volume");
+  impl_ = std::make_unique<Impl>(scene, caster, view_box, mode, max_recasts);
+}
+
+SegmentCaster::~SegmentCaster() = default;
+
+const EmptySpaceDecision& SegmentCaster::empty_space() const { return impl_->esd; }
+
+uint64_t SegmentCaster::cast(std::span<const Vec3> points, std::span<const Vec3> dirs, SegmentSet& out,
+                             std::vector<uint32_t>& sample_of) const {
+  if (points.size() != dirs.size()) throw Error("SegmentCaster: as many directions as points are needed");
+  out.resize(BatchSampler::segments_per_sample(impl_->esd.enabled) * points.size());
+  BatchOutput o;
+  impl_->samplers.local().run_given(points, dirs, out, o, sample_of);
+  out.resize(o.valid);
+  return o.rays + o.see_through_rays;
 }
 
 std::vector<Ray> sampled_rays(const Scene& scene, const RayCaster& caster, const SamplerConfig& config) {

@@ -7,6 +7,7 @@
 /// planes of scene triangles hit inside the node, a random subset of at most ga_candidates.
 /// Deterministic: the same inputs and seed give the same tree for any number of threads.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -133,6 +134,12 @@ struct Subdivision {
   void pieces_of_segment(const Vec3& a, const Vec3& b, std::vector<std::tuple<int32_t, double, double>>& out,
                          std::vector<std::tuple<int32_t, double, double>>& stack) const;
 };
+
+/// Pushes `cell` down the tree of `s` from its root (convex clipping at every node it
+/// straddles), calling at_leaf(leaf, part) for every leaf it has volume in. Works on any
+/// tree of Subdivision nodes, in any node order.
+void clip_to_leaves(const Subdivision& s, const ConvexPolyhedron& cell,
+                    const std::function<void(int32_t, const ConvexPolyhedron&)>& at_leaf);
 
 /// Decides whether geometry-aligned candidates are used, and why.
 bool use_geometry_aligned(const Scene& scene, const SubdivisionConfig& config, std::string& reason);

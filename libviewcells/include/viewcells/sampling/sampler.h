@@ -7,6 +7,8 @@
 /// any number of threads.
 #include <cstdint>
 #include <functional>
+#include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -79,6 +81,26 @@ struct SamplingResult {
 /// Draws config.samples samples (or until config.target_segments segments exist). Throws
 /// Error for an empty scene, a view box of zero volume, or a segment target out of reach.
 SamplingResult sample_segments(const Scene& scene, const RayCaster& caster, const SamplerConfig& config);
+
+/// Casts samples whose origins and directions the caller chooses (AGVS's distributions) by the
+/// sampler's rule: forward and backward rays, empty view space detection, see-through
+/// objects, clipping to the view box. Thread-safe: each thread has its own scratch.
+class SegmentCaster {
+ public:
+  SegmentCaster(const Scene& scene, const RayCaster& caster, const Box3& view_box,
+                EmptySpaceMode mode = EmptySpaceMode::kAuto, int max_recasts = 8);
+  ~SegmentCaster();
+  /// The segments of the samples (points[i], dirs[i]) into `out` (replaced): those of the
+  /// first rays in sample order, then those of re-casts; sample_of[k] is the sample of
+  /// segment k. Returns the rays cast. The scene and caster must outlive this object.
+  uint64_t cast(std::span<const Vec3> points, std::span<const Vec3> dirs, SegmentSet& out,
+                std::vector<uint32_t>& sample_of) const;
+  const EmptySpaceDecision& empty_space() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 /// Every ray sample_segments(scene, caster, config) casts, re-casts included, in batch order
 /// (the forward and backward ray of a sample first, then its batch's re-casts). Runs the

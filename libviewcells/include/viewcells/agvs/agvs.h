@@ -1,0 +1,168 @@
+#pragma once
+/// Adaptive global visibility sampling (AGVS; adaptive-global-visibility-sampling paper,
+/// sections 4.1 to 4.5): the PVS of every view cell at once. Each visibility sample is a
+/// maximal free segment (a forward and a backward ray); its objects go into every cell it
+/// pierces, and its contribution c(s) (equation 2) is the number of PVS entries it adds. The
+/// samples come from a mixture of distributions whose weights follow their contribution per
+/// unit of cost, and the estimated pixel error (section 4.5) says when to stop.
+///
+/// Deterministic: work is done in batches; samples are drawn serially (Halton sequences for
+/// the stationary distributions, seeded streams for the mutations), cast in parallel, and
+/// their contributions applied in sample order. The cost unit of a distribution's weight is
+/// the ray, not the second (the paper measures time): rays dominate the cost, and wall-clock
+/// weights would make results depend on the machine and the thread count.
+///
+/// Not yet here: the silhouette mutation, the visibility filter, dynamic edits and resuming
+/// from a file.
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "viewcells/bsp/subdivision.h"
+#include "viewcells/raycast/ray_caster.h"
+#include "viewcells/sampling/sampler.h"
+#include "viewcells/scene/scene.h"
+
+namespace viewcells {
+
+/// View cells for global visibility: a BSP whose leaves map to cells (a PvsFile's, or any
+/// subdivision's leaves with a leaf -> cell map). Point location, the cells a segment
+/// pierces, and each cell's bounds and volume (from the BSP's convex cells).
+class CellLocator {
+ public:
+  /// `leaf_cell` per node of `bsp` (-1 for inner nodes); every leaf in a cell < cell_count.
+  CellLocator(Subdivision bsp, std::vector<int32_t> leaf_cell, uint32_t cell_count);
+  uint32_t cell_count() const { return cell_count_; }
+  const Box3& view_box() const { return bsp_.view_box; }
+  /// The cell containing p, or -1 outside the view box.
+  int32_t cell_at(const Vec3& p) const;
+  /// The cells the segment a-b (inside the view box) has length in, sorted, into `out`.
+  void cells_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
+                        std::vector<std::tuple<int32_t, double, double>>& stack,
+                        std::vector<int32_t>& leaves) const;
+  const Box3& cell_bounds(uint32_t c) const { return bounds_[c]; }
+  double cell_volume(uint32_t c) const { return volume_[c]; }
+
+ private:
+  Subdivision bsp_;
+  std::vector<int32_t> leaf_cell_;
+  uint32_t cell_count_ = 0;
+  std::vector<Box3> bounds_;
+  std::vector<double> volume_;
+};
+
+/// The PVS of every cell as a bit row over the objects; entries are only ever added.
+class GlobalPvs {
+ public:
+  GlobalPvs() = default;
+  GlobalPvs(uint32_t cells, uint32_t objects);
+  uint32_t cell_count() const { return cells_; }
+  uint32_t object_count() const { return objects_; }
+  bool contains(uint32_t cell, uint32_t object) const {
+    return (bits_[size_t(cell) * words_ + object / 64] >> (object % 64)) & 1;
+  }
+  /// Adds the entry; true when it is new.
+  bool insert(uint32_t cell, uint32_t object);
+  uint32_t size(uint32_t cell) const { return sizes_[cell]; }
+  uint64_t entries() const { return entries_; }
+  std::vector<uint32_t> list(uint32_t cell) const;  ///< sorted object ids
+  bool operator==(const GlobalPvs& o) const { return cells_ == o.cells_ && objects_ == o.objects_ && bits_ == o.bits_; }
+
+ private:
+  uint32_t cells_ = 0, objects_ = 0;
+  size_t words_ = 0;
+  std::vector<uint64_t> bits_;
+  std::vector<uint32_t> sizes_;
+  uint64_t entries_ = 0;
+};
+
+/// Adds a visibility sample's objects (kNoObject: none) to the PVS of every cell in `cells`
+/// (those its segment pierces) and returns its contribution there, equation 2: the number of
+/// new entries. contributed[e] tells whether end e's object added one; at_origin whether an
+/// entry went to `origin_cell` (the pixel error estimator's contributing ray).
+uint32_t contribute(GlobalPvs& pvs, const std::vector<int32_t>& cells, uint32_t object_a, uint32_t object_b,
+                    bool contributed[2] = nullptr, int32_t origin_cell = -1, bool* at_origin = nullptr);
+
+enum class AgvsMethod {
+  kAgvs,  ///< the adaptive mixture of every distribution
+  kSgvs,  ///< global, but the view space-direction distribution alone (stationary)
+  kRef,   ///< per cell: a random cell, a random ray from a random point in it, for that cell only
+};
+/// Parses "agvs", "sgvs", "ref" (Error otherwise).
+AgvsMethod parse_agvs_method(const std::string& name);
+const char* to_string(AgvsMethod m);
+
+enum class AgvsDistribution : int {
+  kViewSpaceDirection = 0,  ///< uniform point in view space, uniform direction
+  kObjectDirection,         ///< point on an object, cosine-weighted direction about its normal
+  kTwoPoint,                ///< from a point in view space towards a point on an object
+  kTwoPointMutation,        ///< both ends of a contributing segment moved by Gaussians
+  kCount
+};
+const char* to_string(AgvsDistribution d);
+
+struct AgvsConfig {
+  AgvsMethod method = AgvsMethod::kAgvs;
+  uint64_t seed = 1;
+  uint32_t batch_size = 20000;  ///< samples per batch: the window of the mixture's weights
+  // Termination: the first criterion met (0: not used; at least one must be set).
+  uint64_t max_samples = 0;
+  double max_seconds = 0;
+  double pixel_error = 0;           ///< stop when the estimated pixel error is at most this
+  uint32_t resolution = 1024 * 1024;  ///< pixels of the estimator's camera image
+  double window_p = 0.9, window_k = 0.5;  ///< equation 5
+  /// Batches drawn from every distribution in equal shares (calibration passes): the first
+  /// one, then one every `recalibrate_every` samples.
+  uint64_t recalibrate_every = 2'000'000;
+  uint32_t mutation_buffer = 1 << 18;  ///< mutation candidates kept (fewest mutations first)
+  /// Share of each batch kept for the view space-direction distribution whatever its
+  /// weight: the pixel error estimator needs its rays, and it guarantees progress everywhere.
+  double min_share = 0.05;
+  EmptySpaceMode empty_space = EmptySpaceMode::kAuto;
+  bool show_progress = true;
+};
+
+/// One point of the convergence curve, after a batch.
+struct AgvsPoint {
+  double seconds = 0;
+  uint64_t samples = 0, rays = 0;
+  double mean_pvs = 0;     ///< mean PVS size over the cells
+  double pixel_error = 0;  ///< estimated (NaN before the first window is full)
+};
+
+struct AgvsStats {
+  uint64_t samples = 0, rays = 0, batches = 0;
+  uint64_t dist_samples[4] = {0, 0, 0, 0};
+  uint64_t dist_rays[4] = {0, 0, 0, 0};
+  uint64_t dist_contribution[4] = {0, 0, 0, 0};
+  double dist_probability[4] = {0, 0, 0, 0};  ///< of the last batch
+  uint64_t mutation_candidates = 0;           ///< in the buffer now
+  double seconds = 0;
+  std::string stop_reason;
+  EmptySpaceDecision empty_space;
+  std::vector<AgvsPoint> curve;
+};
+
+/// The global visibility solver. Construct, then run(); run() again resumes with more budget.
+class AgvsSolver {
+ public:
+  /// The scene, caster and cells must outlive the solver.
+  AgvsSolver(const Scene& scene, const RayCaster& caster, const CellLocator& cells, const AgvsConfig& config);
+  ~AgvsSolver();
+  /// Samples batch by batch until a termination criterion of the config holds.
+  void run();
+  /// Sets new termination criteria (for resuming).
+  void set_limits(uint64_t max_samples, double max_seconds, double pixel_error);
+  const GlobalPvs& pvs() const;
+  const AgvsStats& stats() const;
+  /// The current pixel error estimate (NaN before the first full window).
+  double pixel_error() const;
+  double mean_pvs() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace viewcells

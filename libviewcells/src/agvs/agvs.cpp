@@ -1,0 +1,587 @@
+#include "viewcells/agvs/agvs.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <numeric>
+#include <optional>
+#include <set>
+
+#include "viewcells/core/error.h"
+#include "viewcells/core/progress.h"
+#include "viewcells/core/rng.h"
+
+namespace viewcells {
+
+// ------------------------------------------------------------------------------ cells, PVS
+
+CellLocator::CellLocator(Subdivision bsp, std::vector<int32_t> leaf_cell, uint32_t cell_count)
+    : bsp_(std::move(bsp)), leaf_cell_(std::move(leaf_cell)), cell_count_(cell_count) {
+  if (bsp_.nodes.empty() || leaf_cell_.size() != bsp_.nodes.size()) throw Error("the view cells need a BSP");
+  if (cell_count_ == 0) throw Error("there are no view cells");
+  for (size_t n = 0; n < bsp_.nodes.size(); ++n)
+    if (bsp_.nodes[n].plane < 0 && (leaf_cell_[n] < 0 || leaf_cell_[n] >= static_cast<int32_t>(cell_count_)))
+      throw Error("BSP leaf " + std::to_string(n) + " has no view cell");
+  bounds_.assign(cell_count_, Box3{});
+  volume_.assign(cell_count_, 0.0);
+  clip_to_leaves(bsp_, ConvexPolyhedron::box(bsp_.view_box, 0), [&](int32_t n, const ConvexPolyhedron& part) {
+    bounds_[leaf_cell_[n]].extend(part.bounds());
+    volume_[leaf_cell_[n]] += part.volume();
+  });
+  for (uint32_t c = 0; c < cell_count_; ++c)
+    if (!(volume_[c] > 0)) throw Error("view cell " + std::to_string(c) + " has no volume");
+}
+
+int32_t CellLocator::cell_at(const Vec3& p) const {
+  const int32_t leaf = bsp_.locate(p);
+  return leaf < 0 ? -1 : leaf_cell_[leaf];
+}
+
+void CellLocator::cells_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
+                                   std::vector<std::tuple<int32_t, double, double>>& stack,
+                                   std::vector<int32_t>& leaves) const {
+  leaves.clear();
+  bsp_.leaves_of_segment(a, b, leaves, stack);
+  out.clear();
+  for (int32_t l : leaves) out.push_back(leaf_cell_[l]);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+GlobalPvs::GlobalPvs(uint32_t cells, uint32_t objects)
+    : cells_(cells), objects_(objects), words_((objects + 63) / 64), bits_(size_t(cells) * words_, 0), sizes_(cells, 0) {}
+
+bool GlobalPvs::insert(uint32_t cell, uint32_t object) {
+  uint64_t& w = bits_[size_t(cell) * words_ + object / 64];
+  const uint64_t bit = uint64_t{1} << (object % 64);
+  if (w & bit) return false;
+  w |= bit;
+  ++sizes_[cell];
+  ++entries_;
+  return true;
+}
+
+std::vector<uint32_t> GlobalPvs::list(uint32_t cell) const {
+  std::vector<uint32_t> out;
+  out.reserve(sizes_[cell]);
+  for (size_t w = 0; w < words_; ++w)
+    for (uint64_t bits = bits_[size_t(cell) * words_ + w]; bits; bits &= bits - 1)
+      out.push_back(static_cast<uint32_t>(w * 64 + __builtin_ctzll(bits)));
+  return out;
+}
+
+uint32_t contribute(GlobalPvs& pvs, const std::vector<int32_t>& cells, uint32_t object_a, uint32_t object_b,
+                    bool contributed[2], int32_t origin_cell, bool* at_origin) {
+  const uint32_t objs[2] = {object_a, object_b};
+  uint32_t gain = 0;
+  for (int32_t cell : cells)
+    for (int e = 0; e < 2; ++e) {
+      if (objs[e] == kNoObject || (e == 1 && objs[1] == objs[0])) continue;
+      if (!pvs.insert(static_cast<uint32_t>(cell), objs[e])) continue;
+      ++gain;
+      if (contributed) contributed[e] = true;
+      if (at_origin && cell == origin_cell) *at_origin = true;
+    }
+  return gain;
+}
+
+AgvsMethod parse_agvs_method(const std::string& name) {
+  if (name == "agvs") return AgvsMethod::kAgvs;
+  if (name == "sgvs") return AgvsMethod::kSgvs;
+  if (name == "ref") return AgvsMethod::kRef;
+  throw Error("unknown PVS method '" + name + "' (expected agvs, sgvs or ref)");
+}
+
+const char* to_string(AgvsMethod m) {
+  switch (m) {
+    case AgvsMethod::kAgvs: return "agvs";
+    case AgvsMethod::kSgvs: return "sgvs";
+    case AgvsMethod::kRef: return "ref";
+  }
+  return "?";
+}
+
+const char* to_string(AgvsDistribution d) {
+  switch (d) {
+    case AgvsDistribution::kViewSpaceDirection: return "view space-direction";
+    case AgvsDistribution::kObjectDirection: return "object-direction";
+    case AgvsDistribution::kTwoPoint: return "two-point";
+    case AgvsDistribution::kTwoPointMutation: return "two-point mutation";
+    case AgvsDistribution::kCount: break;
+  }
+  return "?";
+}
+
+// ------------------------------------------------------------------------------ the solver
+
+namespace {
+
+constexpr int kDists = static_cast<int>(AgvsDistribution::kCount);
+constexpr int kVsd = 0, kOd = 1, kTp = 2, kTpm = 3;
+
+/// Radical inverse of i in base b: the Halton sequence's coordinate.
+double radical_inverse(uint64_t i, uint32_t b) {
+  double inv = 1.0 / b, f = inv, r = 0;
+  while (i > 0) {
+    r += f * static_cast<double>(i % b);
+    i /= b;
+    f *= inv;
+  }
+  return r;
+}
+
+/// Halton point `i` of a stream: coordinates in bases 2, 3, 5, ..., each rotated by a seeded
+/// offset (Cranley-Patterson), so that seeds give different but equally even sequences.
+struct Halton {
+  static constexpr uint32_t kBases[7] = {2, 3, 5, 7, 11, 13, 17};
+  double offset[7];
+  Halton(uint64_t seed, uint64_t stream) {
+    Rng rng(seed, stream);
+    for (double& o : offset) o = rng.uniform();
+  }
+  double at(uint64_t i, int dim) const {
+    const double x = radical_inverse(i + 1, kBases[dim]) + offset[dim];
+    return x - std::floor(x);
+  }
+};
+
+Vec3 sphere_direction(double u1, double u2) {
+  const double phi = 2 * std::numbers::pi * u1, cos_theta = 1 - 2 * u2;
+  const double sin_theta = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
+  return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta};
+}
+
+/// A unit frame (u, v) perpendicular to the unit vector n.
+void frame(const Vec3& n, Vec3& u, Vec3& v) {
+  u = normalize(std::abs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
+  v = cross(n, u);
+}
+
+struct Candidate {
+  Vec3 origin, term;           ///< the segment's other end, and the end where the object was seen
+  double r_origin = 0, r_term = 0;  ///< radii of what lies at each end (object or view cell)
+};
+
+}  // namespace
+
+struct AgvsSolver::Impl {
+  const Scene& scene;
+  const CellLocator& cells;
+  AgvsConfig config;
+  SegmentCaster caster;
+  GlobalPvs pvs;
+  AgvsStats stats;
+  // Surface sampling: rendered objects, and each one's triangles by cumulative area.
+  std::vector<uint32_t> objects;
+  std::vector<std::vector<std::pair<double, uint32_t>>> triangles_of;
+  std::vector<double> object_radius;
+  Halton halton[kDists];
+  uint64_t halton_index[kDists] = {0, 0, 0, 0};
+  // Mutation candidates, fewest mutations first (ties: oldest first).
+  std::map<uint64_t, Candidate> candidates;
+  std::set<std::pair<uint32_t, uint64_t>> by_count;
+  std::map<uint64_t, uint32_t> count_of;
+  uint64_t next_candidate = 0;
+  // The mixture: contribution and rays of each distribution in the last batch.
+  double weight[kDists] = {0, 0, 0, 0};
+  double recent_contribution[kDists] = {0, 0, 0, 0}, recent_rays[kDists] = {0, 0, 0, 0};
+  uint64_t last_calibration = 0;
+  bool calibrated = false;
+  // The pixel error estimator's window: per batch, view space-direction rays and those that
+  // added an entry to the cell containing their origin.
+  std::deque<std::pair<uint64_t, uint64_t>> window;
+  double error = std::numeric_limits<double>::quiet_NaN();
+  double eps;  ///< offset of ray origins from surfaces
+
+  Impl(const Scene& s, const RayCaster& rc, const CellLocator& c, const AgvsConfig& cfg)
+      : scene(s),
+        cells(c),
+        config(cfg),
+        caster(s, rc, c.view_box(), cfg.empty_space),
+        pvs(c.cell_count(), static_cast<uint32_t>(s.object_count())),
+        halton{Halton(cfg.seed, 11), Halton(cfg.seed, 12), Halton(cfg.seed, 13), Halton(cfg.seed, 14)} {
+    stats.empty_space = caster.empty_space();
+    eps = 1e-6 * std::max(s.bounds.diagonal(), c.view_box().diagonal());
+    triangles_of.resize(s.object_count());
+    for (uint32_t t = 0; t < s.triangles.size(); ++t) {
+      const double area = 0.5 * length(s.triangle_normal(t));
+      auto& list = triangles_of[s.triangle_object[t]];
+      list.emplace_back((list.empty() ? 0.0 : list.back().first) + area, t);
+    }
+    for (uint32_t o = 0; o < s.object_count(); ++o)
+      if (s.objects[o].rendered && !triangles_of[o].empty() && triangles_of[o].back().first > 0) objects.push_back(o);
+    if (objects.empty()) throw Error("the scene has no rendered object to sample");
+    for (const ObjectInfo& o : s.objects) object_radius.push_back(0.5 * o.bounds.diagonal());
+  }
+
+  /// A point on a random rendered object from Halton coordinates (u0 object, u1 triangle,
+  /// u2, u3 barycentric) and the triangle's unit normal.
+  Vec3 object_point(double u0, double u1, double u2, double u3, Vec3& normal) const {
+    const uint32_t o = objects[std::min<size_t>(static_cast<size_t>(u0 * objects.size()), objects.size() - 1)];
+    const auto& list = triangles_of[o];
+    const double target = u1 * list.back().first;
+    const auto it = std::lower_bound(list.begin(), list.end(), std::make_pair(target, 0u));
+    const uint32_t t = (it == list.end() ? list.back() : *it).second;
+    const auto& tri = scene.triangles[t];
+    const double su = std::sqrt(u2);
+    const Vec3 p = scene.vertices[tri[0]] * (1 - su) + scene.vertices[tri[1]] * (su * (1 - u3)) +
+                   scene.vertices[tri[2]] * (su * u3);
+    normal = normalize(scene.triangle_normal(t));
+    return p;
+  }
+
+  Vec3 view_point(double u0, double u1, double u2) const {
+    const Box3& b = cells.view_box();
+    const Vec3 e = b.extent();
+    return {b.lo.x + e.x * u0, b.lo.y + e.y * u1, b.lo.z + e.z * u2};
+  }
+
+  /// Draws one sample of distribution d into (point, dir); false when it cannot (no candidate).
+  bool draw(int d, Rng& rng, Vec3& point, Vec3& dir) {
+    const Halton& h = halton[d];
+    switch (d) {
+      case kVsd: {
+        const uint64_t i = halton_index[d]++;
+        point = view_point(h.at(i, 0), h.at(i, 1), h.at(i, 2));
+        dir = sphere_direction(h.at(i, 3), h.at(i, 4));
+        return true;
+      }
+      case kOd: {
+        const uint64_t i = halton_index[d]++;
+        Vec3 n;
+        const Vec3 x = object_point(h.at(i, 0), h.at(i, 1), h.at(i, 2), h.at(i, 3), n);
+        // Cosine-weighted about the normal: phi = 2 pi u, theta = acos(sqrt(v)).
+        const double phi = 2 * std::numbers::pi * h.at(i, 4), cos_theta = std::sqrt(h.at(i, 5));
+        const double sin_theta = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
+        Vec3 u, v;
+        frame(n, u, v);
+        dir = n * cos_theta + (u * std::cos(phi) + v * std::sin(phi)) * sin_theta;
+        point = x + dir * eps;  // the backward ray comes back to x
+        return true;
+      }
+      case kTp: {
+        const uint64_t i = halton_index[d]++;
+        Vec3 n;
+        const Vec3 o = object_point(h.at(i, 0), h.at(i, 1), h.at(i, 2), h.at(i, 3), n);
+        point = view_point(h.at(i, 4), h.at(i, 5), h.at(i, 6));
+        const Vec3 to = o - point;
+        if (!(length(to) > eps)) return false;
+        dir = normalize(to);
+        return true;
+      }
+      case kTpm: {
+        if (by_count.empty()) return false;
+        // The candidate mutated least so far (the oldest among equals).
+        const auto first = *by_count.begin();
+        by_count.erase(by_count.begin());
+        const uint64_t id = first.second;
+        by_count.insert({first.first + 1, id});
+        count_of[id] = first.first + 1;
+        const Candidate& c = candidates.at(id);
+        const Vec3 axis = c.term - c.origin;
+        if (!(length(axis) > 0)) return false;
+        Vec3 u, v;
+        frame(normalize(axis), u, v);
+        auto gauss2 = [&](double sigma) {
+          // Box-Muller: two independent normals.
+          const double r = sigma * std::sqrt(-2 * std::log(std::max(1e-300, 1 - rng.uniform())));
+          const double a = 2 * std::numbers::pi * rng.uniform();
+          return u * (r * std::cos(a)) + v * (r * std::sin(a));
+        };
+        const Vec3 o2 = c.origin + gauss2(c.r_origin), t2 = c.term + gauss2(c.r_term);
+        const Vec3 d2 = t2 - o2;
+        if (!(length(d2) > eps)) return false;
+        point = (o2 + t2) * 0.5;  // the middle: away from local occlusion at either end
+        dir = normalize(d2);
+        if (!cells.view_box().contains(point)) return false;
+        return true;
+      }
+    }
+    return false;
+  }
+
+  void add_candidate(const Candidate& c) {
+    const uint64_t id = next_candidate++;
+    candidates.emplace(id, c);
+    by_count.insert({0u, id});
+    count_of[id] = 0;
+    if (candidates.size() > config.mutation_buffer) {  // drop the most mutated (the newest among equals)
+      const auto last = std::prev(by_count.end());
+      candidates.erase(last->second);
+      count_of.erase(last->second);
+      by_count.erase(last);
+    }
+  }
+
+  /// Radius of what lies at a segment end: its object, or else the view cell there.
+  double end_radius(uint32_t object, const Vec3& p) const {
+    if (object != kNoObject) return object_radius[object];
+    const int32_t c = cells.cell_at(p);
+    return c >= 0 ? 0.5 * cells.cell_bounds(c).diagonal() : 0.0;
+  }
+
+  /// The shares of the next batch's samples.
+  void shares(double share[kDists]) {
+    std::fill(share, share + kDists, 0.0);
+    if (config.method != AgvsMethod::kAgvs) {
+      share[kVsd] = 1;
+      return;
+    }
+    const bool can_mutate = !by_count.empty();
+    const bool calibrate = !calibrated || stats.samples - last_calibration >= config.recalibrate_every;
+    // A distribution not tried yet (the mutation, before its first candidates) gets the
+    // best weight: it is then measured like the others.
+    const double best = *std::max_element(weight, weight + kDists);
+    double total = 0;
+    for (int d = 0; d < kDists; ++d) {
+      const bool usable = d != kTpm || can_mutate;
+      const double w = recent_rays[d] > 0 ? weight[d] : best;
+      share[d] = usable ? (calibrate ? 1.0 : w) : 0.0;
+      total += share[d];
+    }
+    if (!(total > 0)) {  // nothing contributed in the last batch: spread evenly
+      for (int d = 0; d < kDists; ++d) share[d] = (d != kTpm || can_mutate) ? 1.0 : 0.0;
+      total = std::accumulate(share, share + kDists, 0.0);
+    }
+    for (int d = 0; d < kDists; ++d) share[d] /= total;
+    if (share[kVsd] < config.min_share) {  // keep the estimator's rays coming
+      const double rest = 1 - share[kVsd];
+      for (int d = 1; d < kDists; ++d) share[d] *= (1 - config.min_share) / rest;
+      share[kVsd] = config.min_share;
+    }
+    if (calibrate) {
+      calibrated = true;
+      last_calibration = stats.samples;
+    }
+  }
+
+  void batch(uint64_t index, uint32_t n) {
+    double share[kDists];
+    shares(share);
+    Rng rng(config.seed, 1000 + index);
+    // Samples grouped by distribution, so that each distribution's rays are counted exactly.
+    std::vector<Vec3> points, dirs;
+    std::vector<int32_t> ref_cell;  // REF: the cell each sample belongs to
+    uint32_t begin[kDists + 1], want[kDists];
+    uint32_t assigned = 0;
+    for (int d = 0; d < kDists; ++d) assigned += want[d] = static_cast<uint32_t>(std::floor(share[d] * n));
+    want[kVsd] += n - assigned;  // what rounding left over
+    for (int d = 0; d < kDists; ++d) {
+      begin[d] = static_cast<uint32_t>(points.size());
+      for (uint32_t k = 0; k < want[d]; ++k) {
+        Vec3 p, dir;
+        if (config.method == AgvsMethod::kRef) {
+          // A random cell, a uniform point in it (rejection in its bounds), a random direction.
+          const uint32_t c = static_cast<uint32_t>(rng.below(cells.cell_count()));
+          const Box3& b = cells.cell_bounds(c);
+          for (int tries = 0; tries < 1000; ++tries) {
+            p = {rng.uniform(b.lo.x, b.hi.x), rng.uniform(b.lo.y, b.hi.y), rng.uniform(b.lo.z, b.hi.z)};
+            if (cells.cell_at(p) == static_cast<int32_t>(c)) break;
+          }
+          dir = sphere_direction(rng.uniform(), rng.uniform());
+          ref_cell.push_back(static_cast<int32_t>(c));
+        } else if (!draw(d, rng, p, dir)) {
+          continue;
+        }
+        points.push_back(p);
+        dirs.push_back(dir);
+      }
+    }
+    begin[kDists] = static_cast<uint32_t>(points.size());
+    const size_t count = points.size();
+
+    // Cast in fixed chunks within each distribution, in parallel; outputs in sample order.
+    constexpr uint32_t kChunk = 1024;
+    struct Chunk {
+      uint32_t first = 0, size = 0;
+      int dist = 0;
+      SegmentSet segs;
+      std::vector<uint32_t> sample_of;
+      uint64_t rays = 0;
+    };
+    std::vector<Chunk> chunks;
+    for (int d = 0; d < kDists; ++d)
+      for (uint32_t f = begin[d]; f < begin[d + 1]; f += kChunk) {
+        Chunk c;
+        c.first = f;
+        c.size = std::min(kChunk, begin[d + 1] - f);
+        c.dist = d;
+        chunks.push_back(std::move(c));
+      }
+    tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
+      Chunk& c = chunks[k];
+      c.rays = caster.cast(std::span<const Vec3>(points.data() + c.first, c.size),
+                           std::span<const Vec3>(dirs.data() + c.first, c.size), c.segs, c.sample_of);
+    });
+    // The cells of every segment, in parallel.
+    std::vector<std::vector<int32_t>> seg_cells;
+    std::vector<size_t> chunk_start(chunks.size() + 1, 0);
+    for (size_t k = 0; k < chunks.size(); ++k) chunk_start[k + 1] = chunk_start[k] + chunks[k].segs.size();
+    seg_cells.resize(chunk_start.back());
+    if (config.method != AgvsMethod::kRef) {
+      tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
+        std::vector<std::tuple<int32_t, double, double>> stack;
+        std::vector<int32_t> leaves;
+        const SegmentSet& s = chunks[k].segs;
+        for (size_t i = 0; i < s.size(); ++i) cells.cells_of_segment(s.a(i), s.b(i), seg_cells[chunk_start[k] + i], stack, leaves);
+      });
+    }
+    // Apply in sample order (serial: contributions depend on what came before).
+    uint64_t dist_contribution[kDists] = {0, 0, 0, 0}, dist_rays[kDists] = {0, 0, 0, 0};
+    uint64_t vsd_rays = 0, vsd_contributing = 0;
+    std::vector<uint32_t> sample_new_at_origin(count, 0);
+    std::vector<int32_t> origin_cell(count, -2);
+    for (size_t k = 0; k < chunks.size(); ++k) {
+      const Chunk& c = chunks[k];
+      dist_rays[c.dist] += c.rays;
+      for (size_t i = 0; i < c.segs.size(); ++i) {
+        const uint32_t sample = c.first + c.sample_of[i];
+        const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
+        bool contributed[2] = {false, false};
+        uint64_t gain = 0;
+        if (config.method == AgvsMethod::kRef) {
+          // Per cell: the object hit forward from the sample's point, for its cell only, when
+          // the point is on this segment (not inside a solid, whose re-casts start elsewhere).
+          const Vec3 a = c.segs.a(i), ab = c.segs.b(i) - a;
+          const double t = dot(points[sample] - a, ab);
+          const uint32_t o = objs[1];
+          if (o != kNoObject && t >= 0 && t <= dot(ab, ab) &&
+              pvs.insert(static_cast<uint32_t>(ref_cell[sample]), o)) {
+            ++gain;
+            sample_new_at_origin[sample] = 1;
+          }
+        } else {
+          if (c.dist == kVsd && origin_cell[sample] == -2) origin_cell[sample] = cells.cell_at(points[sample]);
+          bool at_origin = false;
+          gain = contribute(pvs, seg_cells[chunk_start[k] + i], objs[0], objs[1], contributed, origin_cell[sample],
+                            &at_origin);
+          if (at_origin) sample_new_at_origin[sample] = 1;
+        }
+        dist_contribution[c.dist] += gain;
+        if (gain > 0 && config.method == AgvsMethod::kAgvs) {
+          // A mutation candidate per end whose object contributed.
+          const Vec3 a = c.segs.a(i), b = c.segs.b(i);
+          for (int e = 0; e < 2; ++e) {
+            if (!contributed[e]) continue;
+            const Vec3& term = e ? b : a;
+            const Vec3& origin = e ? a : b;
+            add_candidate({origin, term, end_radius(objs[1 - e], origin), end_radius(objs[e], term)});
+          }
+        }
+      }
+    }
+    // The estimator counts view space-direction samples (all of them for SGVS and REF).
+    for (uint32_t s = begin[kVsd]; s < begin[kVsd + 1]; ++s) {
+      ++vsd_rays;
+      vsd_contributing += sample_new_at_origin[s];
+    }
+    // Weights for the next batch: contribution per ray, over the recent batches (each batch
+    // counts half as much as the one after it: small contributions are noisy).
+    for (int d = 0; d < kDists; ++d) {
+      recent_contribution[d] = 0.5 * recent_contribution[d] + static_cast<double>(dist_contribution[d]);
+      recent_rays[d] = 0.5 * recent_rays[d] + static_cast<double>(dist_rays[d]);
+      weight[d] = recent_rays[d] > 0 ? recent_contribution[d] / recent_rays[d] : 0.0;
+      stats.dist_samples[d] += begin[d + 1] - begin[d];
+      stats.dist_rays[d] += dist_rays[d];
+      stats.dist_contribution[d] += dist_contribution[d];
+      stats.dist_probability[d] = share[d];
+      stats.rays += dist_rays[d];
+    }
+    stats.samples += count;
+    stats.batches += 1;
+    stats.mutation_candidates = candidates.size();
+    update_estimate(vsd_rays, vsd_contributing);
+  }
+
+  /// Equation 5: the window holds the most recent batches whose view space-direction rays
+  /// number at least (1 - e) / (k^2 e (1 - P)), e the contributing share over them.
+  void update_estimate(uint64_t rays, uint64_t contributing) {
+    window.emplace_front(rays, contributing);
+    uint64_t n = 0, nc = 0;
+    size_t used = 0;
+    error = std::numeric_limits<double>::quiet_NaN();
+    for (const auto& [r, c] : window) {
+      n += r;
+      nc += c;
+      ++used;
+      if (n == 0) continue;
+      // With no contributing ray yet, e is at most about 1 / n.
+      const double e = nc ? static_cast<double>(nc) / static_cast<double>(n) : 1.0 / static_cast<double>(n);
+      const double need = (1 - e) / (config.window_k * config.window_k * e * (1 - config.window_p));
+      if (static_cast<double>(n) >= need) {
+        error = config.resolution * static_cast<double>(nc) / static_cast<double>(n);
+        break;
+      }
+    }
+    window.resize(std::min(window.size(), std::max<size_t>(used, 1)));
+    // Keep what a smaller error would need: the whole history up to a bound.
+    if (std::isnan(error) && window.size() > 100000) window.pop_back();
+  }
+
+  double mean_pvs() const { return static_cast<double>(pvs.entries()) / cells.cell_count(); }
+};
+
+AgvsSolver::AgvsSolver(const Scene& scene, const RayCaster& caster, const CellLocator& cells, const AgvsConfig& config) {
+  if (config.batch_size == 0) throw Error("the batch size must be positive");
+  if (!(config.window_p > 0 && config.window_p < 1) || !(config.window_k > 0))
+    throw Error("the pixel error window needs 0 < P < 1 and k > 0");
+  if (scene.object_count() == 0) throw Error("cannot sample an empty scene");
+  impl_ = std::make_unique<Impl>(scene, caster, cells, config);
+}
+
+AgvsSolver::~AgvsSolver() = default;
+
+void AgvsSolver::set_limits(uint64_t max_samples, double max_seconds, double pixel_error) {
+  impl_->config.max_samples = max_samples;
+  impl_->config.max_seconds = max_seconds;
+  impl_->config.pixel_error = pixel_error;
+}
+
+void AgvsSolver::run() {
+  Impl& m = *impl_;
+  const AgvsConfig& c = m.config;
+  if (!c.max_samples && !(c.max_seconds > 0) && !(c.pixel_error > 0))
+    throw Error("the PVS computation needs a limit: samples, seconds or a pixel error");
+  const auto start = std::chrono::steady_clock::now();
+  const double before = m.stats.seconds;
+  const bool show = c.show_progress && c.max_samples;
+  std::optional<Progress> progress;
+  if (show) progress.emplace("pvs", c.max_samples);
+  const uint64_t first = m.stats.samples;
+  while (true) {
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (c.max_samples && m.stats.samples - first >= c.max_samples) {
+      m.stats.stop_reason = "reached " + std::to_string(c.max_samples) + " samples";
+      break;
+    }
+    if (c.max_seconds > 0 && seconds >= c.max_seconds) {
+      m.stats.stop_reason = "reached the time limit";
+      break;
+    }
+    if (c.pixel_error > 0 && !std::isnan(m.error) && m.error <= c.pixel_error) {
+      m.stats.stop_reason = "estimated pixel error at most " + std::to_string(c.pixel_error);
+      break;
+    }
+    const uint64_t done = m.stats.samples;
+    // The last batch is cut to the sample limit, so that runs end (and resume) exactly there.
+    const uint64_t left = c.max_samples ? c.max_samples - (m.stats.samples - first) : c.batch_size;
+    m.batch(m.stats.batches, static_cast<uint32_t>(std::min<uint64_t>(c.batch_size, left)));
+    if (show) progress->advance(m.stats.samples - done);
+    m.stats.seconds = before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    m.stats.curve.push_back({m.stats.seconds, m.stats.samples, m.stats.rays, m.mean_pvs(), m.error});
+  }
+  if (show) progress->finish();
+}
+
+const GlobalPvs& AgvsSolver::pvs() const { return impl_->pvs; }
+const AgvsStats& AgvsSolver::stats() const { return impl_->stats; }
+double AgvsSolver::pixel_error() const { return impl_->error; }
+double AgvsSolver::mean_pvs() const { return impl_->mean_pvs(); }
+
+}  // namespace viewcells

@@ -1,0 +1,141 @@
+// Adaptive global visibility sampling: where a sample's contribution goes, that PVSs only
+// grow, resuming, and independence of the thread count.
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "support/test_scenes.h"
+#include "viewcells/agvs/agvs.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/parallel.h"
+#include "viewcells/scene/generators.h"
+
+namespace viewcells {
+namespace {
+
+/// A kd-tree of `n` cells over the office's bounds, each leaf its own view cell.
+CellLocator office_cells(const Scene& scene, uint32_t n) {
+  const SegmentSet segs = test::sample_scene(scene, 20000, 3);
+  SubdivisionConfig sc;
+  sc.strategy = SplitStrategy::kKdCycling;
+  sc.max_cells = n;
+  sc.show_progress = false;
+  Subdivision s = subdivide(scene, segs, CostModel{}, sc);
+  std::vector<int32_t> leaf_cell(s.nodes.size(), -1);
+  const std::vector<int32_t> leaves = s.leaves();
+  for (size_t i = 0; i < leaves.size(); ++i) leaf_cell[leaves[i]] = static_cast<int32_t>(i);
+  return CellLocator(std::move(s), std::move(leaf_cell), static_cast<uint32_t>(leaves.size()));
+}
+
+AgvsConfig quiet(AgvsMethod method, uint64_t samples) {
+  AgvsConfig c;
+  c.method = method;
+  c.max_samples = samples;
+  c.batch_size = 5000;
+  c.show_progress = false;
+  return c;
+}
+
+TEST(Agvs, ContributionGoesToEveryPiercedCellAndNoOther) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 2});
+  const CellLocator cells = office_cells(scene, 32);
+  const Box3 box = cells.view_box();
+  std::vector<std::tuple<int32_t, double, double>> stack;
+  std::vector<int32_t> leaves, pierced;
+  const Vec3 e = box.extent();
+  const Vec3 a = box.lo + e * 0.1, b = box.lo + Vec3{0.9 * e.x, 0.7 * e.y, 0.8 * e.z};
+  cells.cells_of_segment(a, b, pierced, stack, leaves);
+  // The same cells as walking the segment in small steps.
+  std::set<int32_t> walked;
+  for (int k = 0; k <= 20000; ++k) walked.insert(cells.cell_at(a + (b - a) * (k / 20000.0)));
+  EXPECT_EQ(std::set<int32_t>(pierced.begin(), pierced.end()), walked);
+  ASSERT_GE(pierced.size(), 3u);
+  GlobalPvs pvs(cells.cell_count(), static_cast<uint32_t>(scene.object_count()));
+  bool contributed[2] = {false, false};
+  EXPECT_EQ(contribute(pvs, pierced, 3, 5, contributed), 2 * pierced.size());
+  EXPECT_TRUE(contributed[0] && contributed[1]);
+  for (uint32_t c = 0; c < cells.cell_count(); ++c) {
+    const bool in = walked.count(static_cast<int32_t>(c)) > 0;
+    EXPECT_EQ(pvs.list(c), in ? std::vector<uint32_t>({3, 5}) : std::vector<uint32_t>()) << "cell " << c;
+  }
+  EXPECT_EQ(contribute(pvs, pierced, 3, 5), 0u) << "nothing new the second time";
+  EXPECT_EQ(contribute(pvs, pierced, 5, kNoObject), 0u);
+  EXPECT_EQ(contribute(pvs, {pierced[0]}, 7, 7), 1u) << "one object seen at both ends counts once";
+}
+
+TEST(Agvs, PvsOnlyGrowsAndResumes) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 2, 1});
+  const CellLocator cells = office_cells(scene, 40);
+  const auto caster = make_embree_caster(scene);
+  AgvsSolver solver(scene, *caster, cells, quiet(AgvsMethod::kAgvs, 20000));
+  solver.run();
+  const GlobalPvs first = solver.pvs();
+  EXPECT_GT(first.entries(), 0u);
+  solver.set_limits(30000, 0, 0);
+  solver.run();
+  const GlobalPvs& second = solver.pvs();
+  EXPECT_EQ(solver.stats().samples, 50000u);
+  EXPECT_GE(second.entries(), first.entries());
+  for (uint32_t c = 0; c < cells.cell_count(); ++c)
+    for (uint32_t o : first.list(c)) EXPECT_TRUE(second.contains(c, o));
+  double before = 0;
+  for (const AgvsPoint& p : solver.stats().curve) {
+    EXPECT_GE(p.mean_pvs, before);
+    before = p.mean_pvs;
+  }
+  // Every distribution was drawn from, the mutation once candidates existed.
+  for (int d = 0; d < 4; ++d) EXPECT_GT(solver.stats().dist_samples[d], 0u) << to_string(AgvsDistribution(d));
+}
+
+TEST(Agvs, IdenticalForOneAndTwoThreads) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 2, 4});
+  const CellLocator cells = office_cells(scene, 30);
+  const auto caster = make_embree_caster(scene);
+  for (AgvsMethod m : {AgvsMethod::kAgvs, AgvsMethod::kSgvs, AgvsMethod::kRef}) {
+    GlobalPvs one, two;
+    {
+      ThreadLimit limit(1);
+      AgvsSolver s(scene, *caster, cells, quiet(m, 30000));
+      s.run();
+      one = s.pvs();
+    }
+    {
+      ThreadLimit limit(2);
+      AgvsSolver s(scene, *caster, cells, quiet(m, 30000));
+      s.run();
+      two = s.pvs();
+    }
+    EXPECT_TRUE(one == two) << to_string(m);
+    EXPECT_GT(one.entries(), 0u);
+  }
+}
+
+TEST(Agvs, GlobalSamplingSeesMoreThanPerCellSampling) {
+  // The same number of samples: a global sample serves every cell its segment pierces.
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 2, 1});
+  const CellLocator cells = office_cells(scene, 60);
+  const auto caster = make_embree_caster(scene);
+  double mean[3];
+  for (AgvsMethod m : {AgvsMethod::kAgvs, AgvsMethod::kSgvs, AgvsMethod::kRef}) {
+    AgvsSolver s(scene, *caster, cells, quiet(m, 100000));
+    s.run();
+    mean[static_cast<int>(m)] = s.mean_pvs();
+  }
+  EXPECT_GT(mean[1], mean[2]) << "SGVS over REF";
+  EXPECT_GT(mean[0], mean[1]) << "AGVS over SGVS";
+}
+
+TEST(Agvs, BadInput) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
+  const CellLocator cells = office_cells(scene, 8);
+  const auto caster = make_embree_caster(scene);
+  AgvsSolver s(scene, *caster, cells, quiet(AgvsMethod::kAgvs, 0));
+  EXPECT_THROW(s.run(), Error) << "no limit";
+  EXPECT_THROW(parse_agvs_method("fast"), Error);
+  AgvsConfig bad = quiet(AgvsMethod::kAgvs, 10);
+  bad.window_p = 1.5;
+  EXPECT_THROW(AgvsSolver(scene, *caster, cells, bad), Error);
+}
+
+}  // namespace
+}  // namespace viewcells
