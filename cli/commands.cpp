@@ -865,6 +865,8 @@ struct PvsArgs {
   uint64_t samples = 0, seed = 1;
   uint32_t batch = 20000;
   bool fast = false;
+  uint32_t measure_cameras = 0;
+  uint32_t measure_size = 1024;
 };
 
 int run_pvs(const PvsArgs& a, const Common& c);
@@ -1032,6 +1034,15 @@ int run_pvs(const PvsArgs& a, const Common& c) {
   for (uint32_t i = 0; i < back.pvs.cell_count; ++i)
     if (back.pvs.cell_pvs(i) != lists[i]) throw Error(a.output, 0, "read-back check failed for cell " + std::to_string(i));
   const double err = solver.pixel_error();
+  std::optional<PixelErrorMeasure> measured;
+  if (a.measure_cameras) {
+    Stopwatch ms;
+    measured = measure_pixel_error(scene, *caster, cells, solver.pvs(), a.measure_cameras, a.measure_size,
+                                   a.measure_size, 90.0, a.seed + 17, st.empty_space.enabled, config.resolution);
+    c.log("viewcells: measured pixel error " + fmt(measured->pixels, 2) + " of " + std::to_string(config.resolution) +
+          " pixels (" + std::to_string(measured->cameras) + " cameras of " + std::to_string(a.measure_size) + "x" +
+          std::to_string(a.measure_size) + ", " + fmt(ms.seconds(), 1) + " s)");
+  }
   c.log("viewcells: " + std::to_string(st.samples) + " samples (" + std::to_string(st.rays) + " rays) in " +
         fmt(st.seconds, 2) + " s; mean PVS " + fmt(solver.mean_pvs(), 1) + " objects; estimated pixel error " +
         (std::isnan(err) ? std::string("not yet known") : fmt(err, 2)) + " (" + st.stop_reason + "); -> " + a.output);
@@ -1070,6 +1081,10 @@ int run_pvs(const PvsArgs& a, const Common& c) {
         {"mean_pvs_size", solver.mean_pvs()},
         {"pvs_entries", solver.pvs().entries()},
         {"estimated_pixel_error", std::isnan(err) ? json(nullptr) : json(err)},
+        {"measured_pixel_error",
+         measured ? json{{"pixels", measured->pixels}, {"share", measured->share}, {"cameras", measured->cameras},
+                         {"camera_size", a.measure_size}, {"fov_degrees", 90}}
+                  : json(nullptr)},
         {"stop_reason", st.stop_reason},
         {"distributions", dists},
         {"curve", curve}};
@@ -1324,6 +1339,12 @@ int run(int argc, char** argv) {
   pv->add_option("--seed", pva.seed, "Random seed")->capture_default_str();
   pv->add_option("--batch", pva.batch, "Samples per batch")->capture_default_str()->check(CLI::PositiveNumber);
   pv->add_flag("--fast", pva.fast, "Embree without robust mode");
+  pv->add_option("--measure-cameras", pva.measure_cameras,
+                 "Also measure the pixel error: render this many random cameras by ray casting and count the "
+                 "pixels whose object is missing from the PVS");
+  pv->add_option("--measure-size", pva.measure_size, "Width and height of the measuring cameras, in pixels")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
   pv->add_option("-o,--output", pva.output, "The .pvs file to write")->required();
   pv->add_option("--report", pva.report, "JSON report: samples, rays, mean PVS size, estimated pixel error, curve");
 

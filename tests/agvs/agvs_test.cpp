@@ -125,6 +125,21 @@ TEST(Agvs, GlobalSamplingSeesMoreThanPerCellSampling) {
   EXPECT_GT(mean[0], mean[1]) << "AGVS over SGVS";
 }
 
+TEST(Agvs, MeasuredPixelError) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
+  const CellLocator cells = office_cells(scene, 16);
+  const auto caster = make_embree_caster(scene);
+  GlobalPvs empty(cells.cell_count(), static_cast<uint32_t>(scene.object_count())), full = empty;
+  for (uint32_t c = 0; c < cells.cell_count(); ++c)
+    for (uint32_t o = 0; o < scene.object_count(); ++o) full.insert(c, o);
+  // Inside a closed office every pixel shows something: all wrong with no PVS, none with all.
+  const PixelErrorMeasure none = measure_pixel_error(scene, *caster, cells, empty, 5, 64, 64, 90, 1, true);
+  EXPECT_EQ(none.cameras, 5u);
+  EXPECT_GT(none.share, 0.9);
+  EXPECT_NEAR(none.pixels, none.share * 1024 * 1024, 1e-6);
+  EXPECT_EQ(measure_pixel_error(scene, *caster, cells, full, 5, 64, 64, 90, 1, true).pixels, 0.0);
+}
+
 TEST(Agvs, BadInput) {
   const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
   const CellLocator cells = office_cells(scene, 8);

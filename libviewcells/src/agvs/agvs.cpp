@@ -1,5 +1,6 @@
 #include "viewcells/agvs/agvs.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -461,7 +462,13 @@ struct AgvsSolver::Impl {
           bool at_origin = false;
           gain = contribute(pvs, seg_cells[chunk_start[k] + i], objs[0], objs[1], contributed, origin_cell[sample],
                             &at_origin);
-          if (at_origin) sample_new_at_origin[sample] = 1;
+          // The estimator's ray: the sample's own segment through its point (a camera there);
+          // re-cast segments of points inside solids are not what a camera would see.
+          if (at_origin && c.dist == kVsd) {
+            const Vec3 a = c.segs.a(i), ab = c.segs.b(i) - a;
+            const double t = dot(points[sample] - a, ab);
+            if (t >= 0 && t <= dot(ab, ab)) sample_new_at_origin[sample] = 1;
+          }
         }
         dist_contribution[c.dist] += gain;
         if (gain > 0 && config.method == AgvsMethod::kAgvs) {
@@ -526,6 +533,56 @@ struct AgvsSolver::Impl {
 
   double mean_pvs() const { return static_cast<double>(pvs.entries()) / cells.cell_count(); }
 };
+
+PixelErrorMeasure measure_pixel_error(const Scene& scene, const RayCaster& caster, const CellLocator& cells,
+                                      const GlobalPvs& pvs, uint32_t cameras, uint32_t width, uint32_t height,
+                                      double fov_degrees, uint64_t seed, bool skip_inside_solids,
+                                      uint32_t resolution) {
+  if (cameras == 0 || width == 0 || height == 0) throw Error("the pixel error needs cameras and pixels");
+  if (!(fov_degrees > 0 && fov_degrees < 180)) throw Error("the field of view must be between 0 and 180 degrees");
+  Rng rng(seed, 77);
+  const Box3& box = cells.view_box();
+  const double f = std::tan(0.5 * fov_degrees * std::numbers::pi / 180.0);
+  uint64_t wrong = 0, pixels = 0;
+  std::vector<Ray> rays(size_t(width) * height);
+  std::vector<Hit> hits(rays.size());
+  PixelErrorMeasure out;
+  for (uint32_t cam = 0; cam < cameras; ++cam) {
+    Vec3 eye;
+    int32_t cell = -1;
+    for (int tries = 0;; ++tries) {
+      if (tries > 100000) throw Error("no camera position found outside the solids");
+      eye = {rng.uniform(box.lo.x, box.hi.x), rng.uniform(box.lo.y, box.hi.y), rng.uniform(box.lo.z, box.hi.z)};
+      cell = cells.cell_at(eye);
+      if (cell < 0) continue;
+      if (!skip_inside_solids) break;
+      const Hit probe = caster.intersect(Ray{eye, sphere_direction(rng.uniform(), rng.uniform())});
+      if (!probe.hit() || probe.front) break;  // a back face first: the eye is inside a solid
+    }
+    const Vec3 forward = sphere_direction(rng.uniform(), rng.uniform());
+    Vec3 right, up;
+    frame(forward, right, up);
+    const double roll = 2 * std::numbers::pi * rng.uniform();  // random orientation about the view axis
+    const Vec3 r2 = right * std::cos(roll) + up * std::sin(roll), u2 = cross(r2, forward) * -1.0;
+    const double aspect = static_cast<double>(height) / width;
+    for (uint32_t y = 0; y < height; ++y)
+      for (uint32_t x = 0; x < width; ++x) {
+        const double sx = (2 * (x + 0.5) / width - 1) * f, sy = (2 * (y + 0.5) / height - 1) * f * aspect;
+        rays[size_t(y) * width + x] = Ray{eye, normalize(forward + r2 * sx + u2 * sy)};
+      }
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+      caster.intersect(std::span<const Ray>(rays.data() + r.begin(), r.size()),
+                       std::span<Hit>(hits.data() + r.begin(), r.size()));
+    });
+    for (const Hit& h : hits)
+      if (h.hit() && scene.objects[h.object].rendered && !pvs.contains(static_cast<uint32_t>(cell), h.object)) ++wrong;
+    pixels += rays.size();
+    ++out.cameras;
+  }
+  out.share = static_cast<double>(wrong) / static_cast<double>(pixels);
+  out.pixels = out.share * resolution;
+  return out;
+}
 
 AgvsSolver::AgvsSolver(const Scene& scene, const RayCaster& caster, const CellLocator& cells, const AgvsConfig& config) {
   if (config.batch_size == 0) throw Error("the batch size must be positive");
