@@ -1081,6 +1081,7 @@ int run_pvs(const PvsArgs& a, const Common& c) {
         {"mean_pvs_size", solver.mean_pvs()},
         {"pvs_entries", solver.pvs().entries()},
         {"estimated_pixel_error", std::isnan(err) ? json(nullptr) : json(err)},
+        {"estimator_window_samples", st.window_samples},
         {"measured_pixel_error",
          measured ? json{{"pixels", measured->pixels}, {"share", measured->share}, {"cameras", measured->cameras},
                          {"camera_size", a.measure_size}, {"fov_degrees", 90}}

@@ -523,6 +523,7 @@ struct AgvsSolver::Impl {
       const double need = (1 - e) / (config.window_k * config.window_k * e * (1 - config.window_p));
       if (static_cast<double>(n) >= need) {
         error = config.resolution * static_cast<double>(nc) / static_cast<double>(n);
+        stats.window_samples = n;
         break;
       }
     }

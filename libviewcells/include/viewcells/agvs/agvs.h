@@ -138,6 +138,10 @@ struct AgvsStats {
   uint64_t dist_contribution[4] = {0, 0, 0, 0};
   double dist_probability[4] = {0, 0, 0, 0};  ///< of the last batch
   uint64_t mutation_candidates = 0;           ///< in the buffer now
+  /// View space-direction samples in the estimator's window (equation 5). The window reaches
+  /// back until it holds enough samples for its own error; while the error falls fast it
+  /// takes in older batches of higher error, so the estimate errs high (a safe stop).
+  uint64_t window_samples = 0;
   double seconds = 0;
   std::string stop_reason;
   EmptySpaceDecision empty_space;
