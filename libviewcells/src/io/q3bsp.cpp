@@ -383,6 +383,23 @@ RawMesh q3_world_mesh(const Q3Map& map, const Q3MeshOptions& options, Q3MeshStat
   return mesh;
 }
 
+double q3_far_plane(const Q3Map& map) {
+  // The worldspawn is the first entity.
+  const size_t end = map.entities.find('}');
+  const std::string world = map.entities.substr(0, end);
+  const std::string key = "\"_farplanedist\"";
+  const size_t k = world.find(key);
+  if (k == std::string::npos) return 0;
+  const size_t a = world.find('"', k + key.size()), b = a == std::string::npos ? a : world.find('"', a + 1);
+  if (b == std::string::npos) return 0;
+  try {
+    const double d = std::stod(world.substr(a + 1, b - a - 1));
+    return std::isfinite(d) && d > 0 ? d : 0;
+  } catch (const std::exception&) {
+    return 0;
+  }
+}
+
 std::vector<Vec3> q3_spawn_points(const Q3Map& map) {
   std::vector<Vec3> out;
   std::string classname, origin;

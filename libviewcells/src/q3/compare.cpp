@@ -69,7 +69,16 @@ std::string classify(const Q3Map& map, const Subdivision& q3, const SegmentSet& 
     return "void";
   }
   const int32_t seen_in = map.leaves[map.leaf_at(p1)].cluster;
-  return seen_in == cluster || map.cluster_sees(cluster, seen_in) ? "unlisted" : "rejected";
+  if (seen_in == cluster || map.cluster_sees(cluster, seen_in)) return "unlisted";
+  // Farther from the cluster than the map's far plane: q3map2 culled it on purpose.
+  const double far = q3_far_plane(map);
+  if (far > 0) {
+    double nearest = 2;
+    for (const auto& [n, t0, t1] : pieces)
+      if (map.leaves[q3_leaf_of_node(map, n)].cluster == cluster) nearest = std::min(nearest, t0);
+    if (nearest <= 1 && nearest * length(q1 - p1) > far) return "far";
+  }
+  return "rejected";
 }
 
 }  // namespace

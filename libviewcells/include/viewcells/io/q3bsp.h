@@ -127,6 +127,10 @@ struct Q3MeshOptions {
 /// "solid brushes" of the brush hulls.
 RawMesh q3_world_mesh(const Q3Map& map, const Q3MeshOptions& options = {}, Q3MeshStats* stats = nullptr);
 
+/// The worldspawn's "_farplanedist" (q3map2 leaves clusters beyond it out of the PVS; the
+/// engine fogs them out), or 0 when the map has none.
+double q3_far_plane(const Q3Map& map);
+
 /// Spawn points (origin of info_player_deathmatch / info_player_start entities).
 std::vector<Vec3> q3_spawn_points(const Q3Map& map);
 

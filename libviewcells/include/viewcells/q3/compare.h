@@ -28,6 +28,8 @@ struct Q3Excluded {
   /// The segment stays in non-solid space:
   ///  - "unlisted": the object is seen in a cluster q3map2 admits, but the map does not list
   ///    its surface in that cluster's leaves;
+  ///  - "far": the object lies beyond the map's "_farplanedist" from the cluster, and q3map2
+  ///    culls far clusters on purpose (the engine fogs them out);
   ///  - "rejected": a line of sight that q3map2's PVS rejects (a q3map2 omission).
   std::string cause;
 };
