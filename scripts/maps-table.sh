@@ -64,15 +64,17 @@ for info_path in sorted(glob.glob(f"{out}/*.info.json")):
         sampling_s=t["construction_sampling_seconds"] + t["evaluation_sampling_seconds"],
         wall_s=float(open(f"{out}/{name}/wall_seconds").read())))
 
+CAUSES = ("crack", "invisible", "void", "unlisted", "far", "rejected")
+
 def num(x, d=0):
     return "n/a" if x is None else f"{x:,.{d}f}"
 
 with open("docs/results/q3-maps.csv", "w", newline="") as f:
     w = csv.writer(f)
-    keys = [k for k in rows[0] if k != "causes"] + ["leak", "unlisted", "rejected"] if rows else []
-    w.writerow(keys)
+    keys = [k for k in rows[0] if k != "causes"] if rows else []
+    w.writerow(keys + list(CAUSES))
     for r in rows:
-        w.writerow([r[k] for k in keys if k in r] + [r["causes"].get(c, 0) for c in ("leak", "unlisted", "rejected")])
+        w.writerow([r[k] for k in keys] + [r["causes"].get(c, 0) for c in CAUSES])
 
 lines = []
 lines.append(f"Every OpenArena map with vis data ({len(rows)} maps; {len(skipped)} without vis data skipped"
@@ -80,17 +82,18 @@ lines.append(f"Every OpenArena map with vis data ({len(rows)} maps; {len(skipped
              f"{samples:,} construction samples, {eval_samples:,} evaluation samples (another seed), both with origins "
              "in the map's non-solid space; AV-S to 3x the map's cluster count, merged (AV-M); cell weights are "
              "volumes of non-solid space; r(o) = max(100, triangles); the sky closes the map but costs nothing; "
-             "water, fog, slime, lava and translucent surfaces are left out (they neither occlude nor count); "
-             "objects are the map's surfaces.\n")
+             "solid brushes stop rays as hulls half a unit inside their sides; water, fog, slime, lava and "
+             "translucent surfaces are rendered and seen through; objects are the map's surfaces.\n")
 lines.append("| map | triangles | clusters | q3map2 cost | AV-M cost at clusters | AV-M / q3map2 | AV-M cells to match q3map2 "
-             "| PVS ours / q3map2 | seen but excluded (leak / unlisted / rejected) | q3map2 rows (B) | ours compressed (B) "
+             "| PVS ours / q3map2 | seen but excluded (crack / invisible / void / unlisted / far / rejected) "
+             "| q3map2 rows (B) | ours compressed (B) "
              "| build (s) |")
 lines.append("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
 for r in rows:
     c = r["causes"]
     lines.append(f"| {r['map']} | {r['triangles']:,} | {r['clusters']:,} | {num(r['q3_cost'])} | {num(r['avm_cost'])} | "
                  f"{num(r['ratio'], 3)} | {num(r['cells_to_match'])} | {r['pvs_ratio']:.3f} | "
-                 f"{r['excluded']:,} ({c.get('leak', 0):,} / {c.get('unlisted', 0):,} / {c.get('rejected', 0):,}) | "
+                 f"{r['excluded']:,} ({' / '.join(f'{c.get(k, 0):,}' for k in CAUSES)}) | "
                  f"{r['q3_bytes']:,} | {r['ours_bytes']:,} | {r['build_s']:.1f} |")
 lines.append("")
 ratios = [r["ratio"] for r in rows if r["ratio"] is not None]
@@ -101,16 +104,21 @@ if ratios:
                  + f": AV-M / q3map2 median {statistics.median(ratios):.3f}, range {min(ratios):.3f} to {max(ratios):.3f}. "
                  f"Fewest AV-M cells that match q3map2's cost, as a share of its clusters: median "
                  f"{statistics.median([r['cells_to_match'] / r['clusters'] for r in rows if r['cells_to_match']]):.3f}.\n")
-    share = [r["cells_to_match"] / r["clusters"] for r in rows if r["cells_to_match"]]
-tot = {k: sum(r["causes"].get(k, 0) for r in rows) for k in ("leak", "unlisted", "rejected")}
+tot = {k: sum(r["causes"].get(k, 0) for r in rows) for k in CAUSES}
+worst = lambda k: ", ".join(f"{r['map']} {r['causes'][k]:,}" for r in sorted(rows, key=lambda r: -r["causes"].get(k, 0))[:3]
+                            if r["causes"].get(k, 0))
 lines.append(f"PVS agreement: our samples see a median {statistics.median([r['pvs_ratio'] for r in rows]):.3f} of what "
              f"q3map2's cluster PVS admits (q3map2's is conservative: portal flow through structural brushes, whole "
              f"clusters, every surface of every leaf; ours is sampled). Objects we see from a cluster that q3map2 "
              f"excludes, {sum(r['excluded'] for r in rows):,} (cluster, object) pairs over all maps, each with the "
-             f"first evaluation segment that saw it: {tot['leak']:,} leak (the segment crosses the map's solid "
-             f"space), {tot['unlisted']:,} unlisted (seen inside a cluster q3map2 admits, but the map does not list "
-             f"the surface in that cluster's leaves), {tot['rejected']:,} rejected (a line of sight through "
-             f"non-solid space that q3map2's PVS rejects). The pairs are in out/maps/MAP/excluded.csv.\n")
+             f"first evaluation segment that saw it and its cause (docs/quake3.md): {tot['crack']:,} crack (through "
+             f"a drawn brush side: cracks between triangles; {worst('crack')}), {tot['invisible']:,} invisible "
+             f"(through a brush side that is not drawn; {worst('invisible')}), {tot['void']:,} void (through solid "
+             f"space no brush fills; {worst('void')}), {tot['unlisted']:,} unlisted (seen inside a cluster q3map2 "
+             f"admits, but the surface is not listed in that cluster's leaves; {worst('unlisted')}), {tot['far']:,} "
+             f"far (beyond the map's _farplanedist; {worst('far')}), {tot['rejected']:,} rejected (a line of sight "
+             f"through non-solid space that q3map2's PVS rejects; {worst('rejected')}). The pairs are in "
+             f"out/maps/MAP/excluded.csv.\n")
 qb = sum(r["q3_bytes"] for r in rows)
 ql = sum(r["q3_leaf_bytes"] for r in rows)
 ob = sum(r["ours_bytes"] for r in rows)

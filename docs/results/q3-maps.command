@@ -1,0 +1,1 @@
+scripts/maps-table.sh 500000 2000000
