@@ -107,7 +107,9 @@ void expect_invariants(const Scene& scene, const SegmentSet& segs, const Subdivi
     EXPECT_EQ(s.nodes[leaf].plane, -1);
     const auto& ids = s.segments[leaf];
     // The midpoint lies in that leaf, so the segment does (unless only grazing it).
-    if (length_in_leaf(s, segs, leaf, i) > tol) EXPECT_NE(std::find(ids.begin(), ids.end(), i), ids.end());
+    if (length_in_leaf(s, segs, leaf, i) > tol) {
+      EXPECT_NE(std::find(ids.begin(), ids.end(), i), ids.end());
+    }
   }
 }
 
@@ -193,8 +195,9 @@ TEST(Subdivision, ViewpointDensityConcentratesCellsInTheBand) {
   expect_invariants(scene, segs, banded);
   // Weights: children add up; the root's weight is the band's volume plus 1% of the rest.
   for (const BspNode& n : banded.nodes)
-    if (n.plane >= 0)
+    if (n.plane >= 0) {
       EXPECT_NEAR((banded.nodes[n.child[0]].weight + banded.nodes[n.child[1]].weight) / n.weight, 1.0, 1e-9);
+    }
   const Box3 b = banded.view_box;
   const double band = (b.hi.x - b.lo.x) * (b.hi.y - b.lo.y) * 1.0;
   EXPECT_NEAR(banded.nodes[0].weight, band + 0.01 * (b.volume() - band), 1e-9 * b.volume());
@@ -454,8 +457,9 @@ TEST(SubdivisionFile, RoundTripAndReplay) {
   // Every leaf's PVS holds the objects of its segments.
   for (int32_t l : s.leaves())
     for (uint32_t i : s.segments[l])
-      if (segs.object_a[i] != kNoObject)
+      if (segs.object_a[i] != kNoObject) {
         EXPECT_TRUE(std::binary_search(back.leaf_pvs[l].begin(), back.leaf_pvs[l].end(), segs.object_a[i]));
+      }
   // Views of the cells can be written.
   write_cells_ply(test::temp_path("cells.ply"), r);
   write_slice_png(test::temp_path("slice.png"), r, 1.5, 256, &scene);

@@ -71,7 +71,9 @@ TEST(Pvs, CompressionIsLosslessAndSmaller) {
         for (uint32_t o : f.pvs.stored[n])
           EXPECT_FALSE(std::binary_search(f.pvs.stored[p].begin(), f.pvs.stored[p].end(), o));
     EXPECT_LE(f.pvs.stored_entries(), before);
-    if (count >= 64) EXPECT_LT(f.pvs.stored_entries(), 0.7 * before) << "siblings share most of their PVS";
+    if (count >= 64) {
+      EXPECT_LT(f.pvs.stored_entries(), 0.7 * before) << "siblings share most of their PVS";
+    }
   }
 }
 

@@ -112,7 +112,9 @@ TEST(RayCaster, NoLeaksThroughEdgesAndVertices) {
     const Hit e = embree->intersect(ray), o = oracle->intersect(ray);
     leaks_embree += !e.hit();
     leaks_oracle += !o.hit();
-    if (e.hit() && o.hit()) EXPECT_NEAR(e.t, o.t, 1e-3);
+    if (e.hit() && o.hit()) {
+      EXPECT_NEAR(e.t, o.t, 1e-3);
+    }
   }
   EXPECT_GT(rays, 1000);
   EXPECT_GT(edge_rays, 300);
