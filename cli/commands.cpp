@@ -867,6 +867,7 @@ struct PvsArgs {
   bool fast = false;
   uint32_t measure_cameras = 0;
   uint32_t measure_size = 1024;
+  std::string save, resume;
 };
 
 int run_pvs(const PvsArgs& a, const Common& c);
@@ -1023,7 +1024,21 @@ int run_pvs(const PvsArgs& a, const Common& c) {
         (a.seconds > 0 ? std::to_string(a.seconds) + " s " : std::string()) +
         (a.samples ? std::to_string(a.samples) + " samples" : std::string()));
   AgvsSolver solver(scene, *caster, cells, config);
+  // A saved state belongs to this scene and these view cells.
+  ByteWriter cells_id;
+  cells_id.put(file.scene_fingerprint);
+  cells_id.put_array(pf.leaf_cell);
+  cells_id.put_array(pf.cell_mht_node);
+  const uint64_t identity = fnv1a64(cells_id.data());
+  if (!a.resume.empty()) {
+    solver.load(a.resume, identity);
+    c.log("viewcells: resumed from " + a.resume + " after " + std::to_string(solver.stats().samples) + " samples");
+  }
   solver.run();
+  if (!a.save.empty()) {
+    solver.save(a.save, identity);
+    c.log("viewcells: state -> " + a.save + " (continue with --resume)");
+  }
   const AgvsStats& st = solver.stats();
   // The sampled PVSs replace the construction ones, compressed through the hierarchy.
   std::vector<std::vector<uint32_t>> lists(cells.cell_count());
@@ -1334,7 +1349,8 @@ int run(int argc, char** argv) {
   pv->add_option("--pixel-error", pva.pixel_error,
                  "Stop when the estimated pixel error (pixels of a 1024x1024 image that differ) is at most this");
   pv->add_option("--time", pva.seconds, "Stop after this many seconds");
-  pv->add_option("--samples", pva.samples, "Stop after this many samples");
+  pv->add_option("--samples", pva.samples,
+                 "Stop after this many samples (checked between batches: a run may pass it by less than a batch)");
   pv->add_option("--method", pva.method, "agvs (adaptive mixture), sgvs (view space-direction only) or ref (per cell)")
       ->capture_default_str();
   pv->add_option("--seed", pva.seed, "Random seed")->capture_default_str();
@@ -1343,6 +1359,10 @@ int run(int argc, char** argv) {
   pv->add_option("--measure-cameras", pva.measure_cameras,
                  "Also measure the pixel error: render this many random cameras by ray casting and count the "
                  "pixels whose object is missing from the PVS");
+  pv->add_option("--save", pva.save, "Write the solver's state here at the end, to continue later with --resume");
+  pv->add_option("--resume", pva.resume,
+                 "Continue from a state written by --save (same scene, cells, method, seed and batch); --samples "
+                 "and --time count from the start of the computation, the saved part included");
   pv->add_option("--measure-size", pva.measure_size, "Width and height of the measuring cameras, in pixels")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

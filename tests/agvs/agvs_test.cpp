@@ -2,6 +2,8 @@
 // grow, resuming, and independence of the thread count.
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
 #include <set>
 
 #include "support/test_scenes.h"
@@ -71,7 +73,7 @@ TEST(Agvs, PvsOnlyGrowsAndResumes) {
   solver.run();
   const GlobalPvs first = solver.pvs();
   EXPECT_GT(first.entries(), 0u);
-  solver.set_limits(30000, 0, 0);
+  solver.set_limits(50000, 0, 0);  // totals
   solver.run();
   const GlobalPvs& second = solver.pvs();
   EXPECT_EQ(solver.stats().samples, 50000u);
@@ -138,6 +140,51 @@ TEST(Agvs, MeasuredPixelError) {
   EXPECT_GT(none.share, 0.9);
   EXPECT_NEAR(none.pixels, none.share * 1024 * 1024, 1e-6);
   EXPECT_EQ(measure_pixel_error(scene, *caster, cells, full, 5, 64, 64, 90, 1, true).pixels, 0.0);
+}
+
+TEST(Agvs, SavedStateResumesExactly) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 2, 5});
+  const CellLocator cells = office_cells(scene, 30);
+  const auto caster = make_embree_caster(scene);
+  const std::string path = test::temp_path("state.vagvs");
+  AgvsSolver whole(scene, *caster, cells, quiet(AgvsMethod::kAgvs, 40000));
+  whole.run();
+  {
+    AgvsSolver first(scene, *caster, cells, quiet(AgvsMethod::kAgvs, 20000));
+    first.run();
+    first.save(path, 42);
+  }
+  {
+    AgvsSolver mem(scene, *caster, cells, quiet(AgvsMethod::kAgvs, 20000));
+    mem.run();
+    mem.set_limits(40000, 0, 0);
+    mem.run();
+    EXPECT_TRUE(mem.pvs() == whole.pvs()) << "in-memory resume";
+  }
+  AgvsSolver second(scene, *caster, cells, quiet(AgvsMethod::kAgvs, 40000));
+  EXPECT_THROW(second.load(path, 43), Error) << "another scene or other cells";
+  EXPECT_EQ(second.stats().samples, 0u) << "a refused load changes nothing";
+  second.load(path, 42);
+  EXPECT_EQ(second.stats().samples, 20000u);
+  {
+    second.save(path + "2", 42);
+    std::ifstream a(path, std::ios::binary), b(path + "2", std::ios::binary);
+    std::string x(std::istreambuf_iterator<char>(a), {}), y(std::istreambuf_iterator<char>(b), {});
+    EXPECT_EQ(x, y) << "save, load, save: the same bytes";
+  }
+  second.run();
+  EXPECT_TRUE(second.pvs() == whole.pvs()) << "resuming continues exactly where the run stopped";
+  EXPECT_EQ(second.stats().rays, whole.stats().rays);
+  AgvsSolver other(scene, *caster, cells, quiet(AgvsMethod::kSgvs, 10));
+  EXPECT_THROW(other.load(path, 42), Error) << "another method";
+  // A damaged file is refused.
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  test::write_file(path, bytes.substr(0, bytes.size() / 2));
+  EXPECT_THROW(second.load(path, 42), Error);
 }
 
 TEST(Agvs, BadInput) {

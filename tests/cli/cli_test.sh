@@ -172,6 +172,11 @@ assert sum(d['samples'] for d in r['distributions']) == 40000
 " && ok || bad "pvs report"
 expect_ok "$VC" query agvs.pvs 2 2 1.5
 grep -q "^cell [0-9]* of 16" out.txt && ok || bad "query on a pvs from AGVS"
+expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 20000 --save half.vagvs -o half.pvs -q
+expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 40000 --resume half.vagvs -o resumed.pvs -q
+cmp -s resumed.pvs agvs.pvs && ok || bad "20000 samples resumed to 40000 differ from 40000 in one run"
+expect_error "another scene or other view cells" "$VC" pvs office.vcells --scene office.obj --cells 8 --samples 10 \
+  --resume half.vagvs -o x.pvs
 expect_error "give when to stop" "$VC" pvs office.vcells --scene office.obj -o x.pvs
 expect_error "fingerprints differ" "$VC" pvs office.vcells --scene city.obj --samples 10 -o x.pvs
 expect_error "unknown PVS method" "$VC" pvs office.vcells --scene office.obj --samples 10 --method fast -o x.pvs

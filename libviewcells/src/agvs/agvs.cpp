@@ -15,6 +15,7 @@
 #include <set>
 
 #include "viewcells/core/error.h"
+#include "viewcells/io/binary_file.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/core/rng.h"
 
@@ -369,13 +370,18 @@ struct AgvsSolver::Impl {
     // Samples grouped by distribution, so that each distribution's rays are counted exactly.
     std::vector<Vec3> points, dirs;
     std::vector<int32_t> ref_cell;  // REF: the cell each sample belongs to
-    uint32_t begin[kDists + 1], want[kDists];
+    uint32_t first_of[kDists], end_of[kDists], want[kDists];
     uint32_t assigned = 0;
     for (int d = 0; d < kDists; ++d) assigned += want[d] = static_cast<uint32_t>(std::floor(share[d] * n));
     want[kVsd] += n - assigned;  // what rounding left over
-    for (int d = 0; d < kDists; ++d) {
-      begin[d] = static_cast<uint32_t>(points.size());
-      for (uint32_t k = 0; k < want[d]; ++k) {
+    // The view space-direction samples last: they also replace the draws that failed (no
+    // mutation candidate left, a degenerate two-point pair), so every batch has n samples.
+    constexpr int kOrder[kDists] = {kTpm, kOd, kTp, kVsd};
+    uint32_t failed = 0;
+    for (int d : kOrder) {
+      first_of[d] = static_cast<uint32_t>(points.size());
+      const uint32_t target = want[d] + (d == kVsd ? failed : 0);
+      for (uint32_t k = 0; k < target; ++k) {
         Vec3 p, dir;
         if (config.method == AgvsMethod::kRef) {
           // A random cell, a uniform point in it (rejection in its bounds), a random direction.
@@ -388,13 +394,14 @@ struct AgvsSolver::Impl {
           dir = sphere_direction(rng.uniform(), rng.uniform());
           ref_cell.push_back(static_cast<int32_t>(c));
         } else if (!draw(d, rng, p, dir)) {
+          ++failed;
           continue;
         }
         points.push_back(p);
         dirs.push_back(dir);
       }
+      end_of[d] = static_cast<uint32_t>(points.size());
     }
-    begin[kDists] = static_cast<uint32_t>(points.size());
     const size_t count = points.size();
 
     // Cast in fixed chunks within each distribution, in parallel; outputs in sample order.
@@ -407,11 +414,11 @@ struct AgvsSolver::Impl {
       uint64_t rays = 0;
     };
     std::vector<Chunk> chunks;
-    for (int d = 0; d < kDists; ++d)
-      for (uint32_t f = begin[d]; f < begin[d + 1]; f += kChunk) {
+    for (int d : kOrder)
+      for (uint32_t f = first_of[d]; f < end_of[d]; f += kChunk) {
         Chunk c;
         c.first = f;
-        c.size = std::min(kChunk, begin[d + 1] - f);
+        c.size = std::min(kChunk, end_of[d] - f);
         c.dist = d;
         chunks.push_back(std::move(c));
       }
@@ -484,7 +491,7 @@ struct AgvsSolver::Impl {
       }
     }
     // The estimator counts view space-direction samples (all of them for SGVS and REF).
-    for (uint32_t s = begin[kVsd]; s < begin[kVsd + 1]; ++s) {
+    for (uint32_t s = first_of[kVsd]; s < end_of[kVsd]; ++s) {
       ++vsd_rays;
       vsd_contributing += sample_new_at_origin[s];
     }
@@ -494,7 +501,7 @@ struct AgvsSolver::Impl {
       recent_contribution[d] = 0.5 * recent_contribution[d] + static_cast<double>(dist_contribution[d]);
       recent_rays[d] = 0.5 * recent_rays[d] + static_cast<double>(dist_rays[d]);
       weight[d] = recent_rays[d] > 0 ? recent_contribution[d] / recent_rays[d] : 0.0;
-      stats.dist_samples[d] += begin[d + 1] - begin[d];
+      stats.dist_samples[d] += end_of[d] - first_of[d];
       stats.dist_rays[d] += dist_rays[d];
       stats.dist_contribution[d] += dist_contribution[d];
       stats.dist_probability[d] = share[d];
@@ -608,13 +615,15 @@ void AgvsSolver::run() {
     throw Error("the PVS computation needs a limit: samples, seconds or a pixel error");
   const auto start = std::chrono::steady_clock::now();
   const double before = m.stats.seconds;
-  const bool show = c.show_progress && c.max_samples;
+  // The limits count from the start of the computation (a resumed state included) and are
+  // checked between batches, so that where a run stops never changes the batches: a run
+  // resumed from a state continues exactly as an uninterrupted one.
+  const bool show = c.show_progress && c.max_samples > m.stats.samples;
   std::optional<Progress> progress;
-  if (show) progress.emplace("pvs", c.max_samples);
-  const uint64_t first = m.stats.samples;
+  if (show) progress.emplace("pvs", c.max_samples - m.stats.samples);
   while (true) {
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    if (c.max_samples && m.stats.samples - first >= c.max_samples) {
+    const double seconds = before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (c.max_samples && m.stats.samples >= c.max_samples) {
       m.stats.stop_reason = "reached " + std::to_string(c.max_samples) + " samples";
       break;
     }
@@ -627,14 +636,143 @@ void AgvsSolver::run() {
       break;
     }
     const uint64_t done = m.stats.samples;
-    // The last batch is cut to the sample limit, so that runs end (and resume) exactly there.
-    const uint64_t left = c.max_samples ? c.max_samples - (m.stats.samples - first) : c.batch_size;
-    m.batch(m.stats.batches, static_cast<uint32_t>(std::min<uint64_t>(c.batch_size, left)));
+    m.batch(m.stats.batches, c.batch_size);
     if (show) progress->advance(m.stats.samples - done);
     m.stats.seconds = before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     m.stats.curve.push_back({m.stats.seconds, m.stats.samples, m.stats.rays, m.mean_pvs(), m.error});
   }
   if (show) progress->finish();
+}
+
+namespace {
+constexpr char kStateMagic[5] = "VAGS";
+constexpr uint32_t kStateVersion = 1;
+}  // namespace
+
+void GlobalPvs::save(ByteWriter& w) const {
+  w.put(cells_);
+  w.put(objects_);
+  w.put_array(bits_);
+}
+
+GlobalPvs GlobalPvs::load(ByteReader& r, uint32_t cells, uint32_t objects) {
+  const uint32_t file_cells = r.get<uint32_t>();
+  const uint32_t file_objects = r.get<uint32_t>();
+  if (file_cells != cells || file_objects != objects) r.fail("the PVS table does not match the cells and objects");
+  GlobalPvs p(cells, objects);
+  std::vector<uint64_t> bits;
+  r.get_array(bits, p.bits_.size());
+  if (bits.size() != p.bits_.size()) r.fail("PVS rows of the wrong size");
+  p.bits_ = std::move(bits);
+  for (uint32_t c = 0; c < p.cells_; ++c) {
+    uint32_t n = 0;
+    for (size_t w = 0; w < p.words_; ++w) n += static_cast<uint32_t>(__builtin_popcountll(p.bits_[c * p.words_ + w]));
+    if (p.words_ && p.objects_ % 64 && (p.bits_[c * p.words_ + p.words_ - 1] >> (p.objects_ % 64)))
+      r.fail("PVS names objects that do not exist");
+    p.sizes_[c] = n;
+    p.entries_ += n;
+  }
+  return p;
+}
+
+void AgvsSolver::save(const std::string& path, uint64_t identity) const {
+  const Impl& m = *impl_;
+  ByteWriter w;
+  w.put(identity);
+  w.put(static_cast<int32_t>(m.config.method));
+  w.put(m.config.seed);
+  w.put(m.config.batch_size);
+  m.pvs.save(w);
+  const AgvsStats& s = m.stats;
+  w.put(s.samples), w.put(s.rays), w.put(s.batches), w.put(s.seconds), w.put(s.window_samples);
+  for (int d = 0; d < kDists; ++d) {
+    w.put(s.dist_samples[d]), w.put(s.dist_rays[d]), w.put(s.dist_contribution[d]), w.put(s.dist_probability[d]);
+    w.put(m.halton_index[d]), w.put(m.weight[d]), w.put(m.recent_contribution[d]), w.put(m.recent_rays[d]);
+  }
+  w.put(m.last_calibration);
+  w.put(static_cast<uint8_t>(m.calibrated));
+  w.put(m.error);
+  w.put(m.next_candidate);
+  w.put<uint64_t>(m.candidates.size());
+  for (const auto& [id, c] : m.candidates) {
+    w.put(id), w.put(m.count_of.at(id));
+    w.put(c.origin), w.put(c.term), w.put(c.r_origin), w.put(c.r_term);
+  }
+  w.put<uint64_t>(m.window.size());
+  for (const auto& [n, nc] : m.window) w.put(n), w.put(nc);
+  w.put<uint64_t>(s.curve.size());
+  for (const AgvsPoint& p : s.curve) w.put(p);
+  write_container(path, kStateMagic, kStateVersion, w.data());
+}
+
+void AgvsSolver::load(const std::string& path, uint64_t identity) {
+  Impl& m = *impl_;
+  uint32_t version = 0;
+  const std::string payload = read_container(path, kStateMagic, kStateVersion, version);
+  ByteReader r(payload, path);
+  if (r.get<uint64_t>() != identity) throw Error(path, 0, "this state belongs to another scene or other view cells");
+  const int32_t method = r.get<int32_t>();
+  const uint64_t seed = r.get<uint64_t>();
+  const uint32_t batch = r.get<uint32_t>();
+  if (method != static_cast<int32_t>(m.config.method) || seed != m.config.seed || batch != m.config.batch_size)
+    throw Error(path, 0, "this state was computed with another method, seed or batch size");
+  // Read everything into locals first: a corrupt file leaves the solver as it was.
+  GlobalPvs pvs = GlobalPvs::load(r, m.pvs.cell_count(), m.pvs.object_count());
+  AgvsStats s = m.stats;
+  s.samples = r.get<uint64_t>(), s.rays = r.get<uint64_t>(), s.batches = r.get<uint64_t>();
+  s.seconds = r.get<double>(), s.window_samples = r.get<uint64_t>();
+  uint64_t halton[kDists];
+  double weight[kDists], recent_c[kDists], recent_r[kDists];
+  for (int d = 0; d < kDists; ++d) {
+    s.dist_samples[d] = r.get<uint64_t>(), s.dist_rays[d] = r.get<uint64_t>();
+    s.dist_contribution[d] = r.get<uint64_t>(), s.dist_probability[d] = r.get<double>();
+    halton[d] = r.get<uint64_t>(), weight[d] = r.get<double>(), recent_c[d] = r.get<double>(), recent_r[d] = r.get<double>();
+  }
+  const uint64_t last_calibration = r.get<uint64_t>();
+  const bool calibrated = r.get<uint8_t>() != 0;
+  const double error = r.get<double>();
+  const uint64_t next_candidate = r.get<uint64_t>();
+  const uint64_t candidates = r.get<uint64_t>();
+  if (candidates > m.config.mutation_buffer || candidates > payload.size()) r.fail("too many mutation candidates");
+  std::map<uint64_t, Candidate> cand;
+  std::map<uint64_t, uint32_t> count_of;
+  std::set<std::pair<uint32_t, uint64_t>> by_count;
+  for (uint64_t k = 0; k < candidates; ++k) {
+    const uint64_t id = r.get<uint64_t>();
+    const uint32_t count = r.get<uint32_t>();
+    Candidate c;
+    c.origin = r.get<Vec3>(), c.term = r.get<Vec3>(), c.r_origin = r.get<double>(), c.r_term = r.get<double>();
+    if (id >= next_candidate || !cand.emplace(id, c).second) r.fail("mutation candidate ids are inconsistent");
+    count_of[id] = count;
+    by_count.insert({count, id});
+  }
+  const uint64_t windows = r.get<uint64_t>();
+  if (windows > payload.size()) r.fail("estimator window too long");
+  std::deque<std::pair<uint64_t, uint64_t>> window;
+  for (uint64_t k = 0; k < windows; ++k) {
+    const uint64_t n = r.get<uint64_t>(), nc = r.get<uint64_t>();
+    window.emplace_back(n, nc);
+  }
+  const uint64_t points = r.get<uint64_t>();
+  if (points > payload.size()) r.fail("curve too long");
+  s.curve.clear();
+  for (uint64_t k = 0; k < points; ++k) s.curve.push_back(r.get<AgvsPoint>());
+  if (!r.at_end()) r.fail("trailing bytes");
+  s.mutation_candidates = cand.size();
+  // Commit.
+  m.pvs = std::move(pvs);
+  m.stats = std::move(s);
+  for (int d = 0; d < kDists; ++d)
+    m.halton_index[d] = halton[d], m.weight[d] = weight[d], m.recent_contribution[d] = recent_c[d],
+    m.recent_rays[d] = recent_r[d];
+  m.last_calibration = last_calibration;
+  m.calibrated = calibrated;
+  m.error = error;
+  m.next_candidate = next_candidate;
+  m.candidates = std::move(cand);
+  m.count_of = std::move(count_of);
+  m.by_count = std::move(by_count);
+  m.window = std::move(window);
 }
 
 const GlobalPvs& AgvsSolver::pvs() const { return impl_->pvs; }

@@ -26,6 +26,9 @@
 
 namespace viewcells {
 
+class ByteWriter;
+class ByteReader;
+
 /// View cells for global visibility: a BSP whose leaves map to cells (a PvsFile's, or any
 /// subdivision's leaves with a leaf -> cell map). Point location, the cells a segment
 /// pierces, and each cell's bounds and volume (from the BSP's convex cells).
@@ -68,6 +71,9 @@ class GlobalPvs {
   uint64_t entries() const { return entries_; }
   std::vector<uint32_t> list(uint32_t cell) const;  ///< sorted object ids
   bool operator==(const GlobalPvs& o) const { return cells_ == o.cells_ && objects_ == o.objects_ && bits_ == o.bits_; }
+  void save(ByteWriter& w) const;
+  /// Reads what save() wrote; Error unless it has `cells` rows over `objects` objects.
+  static GlobalPvs load(ByteReader& r, uint32_t cells, uint32_t objects);
 
  private:
   uint32_t cells_ = 0, objects_ = 0;
@@ -106,7 +112,9 @@ struct AgvsConfig {
   AgvsMethod method = AgvsMethod::kAgvs;
   uint64_t seed = 1;
   uint32_t batch_size = 20000;  ///< samples per batch: the window of the mixture's weights
-  // Termination: the first criterion met (0: not used; at least one must be set).
+  // Termination: the first criterion met (0: not used; at least one must be set). Counted
+  // from the start of the computation, a resumed state included, and checked between batches
+  // (a run may pass max_samples by less than a batch).
   uint64_t max_samples = 0;
   double max_seconds = 0;
   double pixel_error = 0;           ///< stop when the estimated pixel error is at most this
@@ -156,8 +164,15 @@ class AgvsSolver {
   ~AgvsSolver();
   /// Samples batch by batch until a termination criterion of the config holds.
   void run();
-  /// Sets new termination criteria (for resuming).
+  /// Sets new termination criteria (totals, as in AgvsConfig; for resuming).
   void set_limits(uint64_t max_samples, double max_seconds, double pixel_error);
+  /// Writes the whole state (PVSs, sampling and mixture state, statistics) to a versioned,
+  /// checksummed file; `identity` names the scene and view cells it belongs to.
+  void save(const std::string& path, uint64_t identity) const;
+  /// Restores a state written by save() for the same scene, cells (identity) and method and
+  /// seed; sampling then continues exactly as if it had not stopped. Error on any mismatch or
+  /// corruption, and then the solver is unchanged.
+  void load(const std::string& path, uint64_t identity);
   const GlobalPvs& pvs() const;
   const AgvsStats& stats() const;
   /// The current pixel error estimate (NaN before the first full window).
