@@ -1063,7 +1063,7 @@ int run_pvs(const PvsArgs& a, const Common& c) {
         (std::isnan(err) ? std::string("not yet known") : fmt(err, 2)) + " (" + st.stop_reason + "); -> " + a.output);
   if (!a.report.empty()) {
     json dists = json::array();
-    for (int d = 0; d < 4; ++d)
+    for (int d = 0; d < AgvsStats::kDistributions; ++d)
       dists.push_back({{"distribution", to_string(static_cast<AgvsDistribution>(d))},
                        {"samples", st.dist_samples[d]},
                        {"rays", st.dist_rays[d]},
@@ -1086,7 +1086,9 @@ int run_pvs(const PvsArgs& a, const Common& c) {
           {"window_p", config.window_p}, {"window_k", config.window_k}}},
         {"effects",
          {{"empty_space_detection", {{"enabled", st.empty_space.enabled}, {"reason", st.empty_space.reason}}},
-          {"silhouette_mutation", {{"enabled", false}, {"reason", "not implemented yet"}}},
+          {"silhouette_mutation",
+           {{"enabled", config.method == AgvsMethod::kAgvs},
+            {"reason", config.method == AgvsMethod::kAgvs ? "part of the AGVS mixture" : "AGVS only"}}},
           {"visibility_filter", {{"enabled", false}, {"reason", "not implemented yet"}}}}},
         {"samples", st.samples},
         {"rays", st.rays},

@@ -76,7 +76,9 @@ TEST(Agvs, PvsOnlyGrowsAndResumes) {
   solver.set_limits(50000, 0, 0);  // totals
   solver.run();
   const GlobalPvs& second = solver.pvs();
-  EXPECT_EQ(solver.stats().samples, 50000u);
+  // Limits are checked between batches; a silhouette search may add a second sample.
+  EXPECT_GE(solver.stats().samples, 50000u);
+  EXPECT_LT(solver.stats().samples, 50000u + 2 * 5000u);
   EXPECT_GE(second.entries(), first.entries());
   for (uint32_t c = 0; c < cells.cell_count(); ++c)
     for (uint32_t o : first.list(c)) EXPECT_TRUE(second.contains(c, o));
@@ -86,7 +88,8 @@ TEST(Agvs, PvsOnlyGrowsAndResumes) {
     before = p.mean_pvs;
   }
   // Every distribution was drawn from, the mutation once candidates existed.
-  for (int d = 0; d < 4; ++d) EXPECT_GT(solver.stats().dist_samples[d], 0u) << to_string(AgvsDistribution(d));
+  for (int d = 0; d < AgvsStats::kDistributions; ++d)
+    EXPECT_GT(solver.stats().dist_samples[d], 0u) << to_string(AgvsDistribution(d));
 }
 
 TEST(Agvs, IdenticalForOneAndTwoThreads) {
@@ -149,9 +152,11 @@ TEST(Agvs, SavedStateResumesExactly) {
   const std::string path = test::temp_path("state.vagvs");
   AgvsSolver whole(scene, *caster, cells, quiet(AgvsMethod::kAgvs, 40000));
   whole.run();
+  uint64_t first_samples = 0;
   {
     AgvsSolver first(scene, *caster, cells, quiet(AgvsMethod::kAgvs, 20000));
     first.run();
+    first_samples = first.stats().samples;
     first.save(path, 42);
   }
   {
@@ -165,7 +170,7 @@ TEST(Agvs, SavedStateResumesExactly) {
   EXPECT_THROW(second.load(path, 43), Error) << "another scene or other cells";
   EXPECT_EQ(second.stats().samples, 0u) << "a refused load changes nothing";
   second.load(path, 42);
-  EXPECT_EQ(second.stats().samples, 20000u);
+  EXPECT_EQ(second.stats().samples, first_samples);
   {
     second.save(path + "2", 42);
     std::ifstream a(path, std::ios::binary), b(path + "2", std::ios::binary);

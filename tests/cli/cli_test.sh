@@ -166,9 +166,10 @@ expect_error "cut.pvs" "$VC" query cut.pvs 2 2 1.5
 expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 40000 -o agvs.pvs --report agvs.json -q
 python3 -c "
 import json; r=json.load(open('agvs.json'))
-assert r['cells'] == 16 and r['samples'] == 40000 and r['mean_pvs_size'] > 0, r
+assert r['cells'] == 16 and 40000 <= r['samples'] < 80000 and r['mean_pvs_size'] > 0, r
 assert 'estimated_pixel_error' in r and r['samples_per_second'] > 0 and len(r['curve']) > 0
-assert sum(d['samples'] for d in r['distributions']) == 40000
+assert sum(d['samples'] for d in r['distributions']) == r['samples']
+assert r['effects']['silhouette_mutation']['enabled']
 " && ok || bad "pvs report"
 expect_ok "$VC" query agvs.pvs 2 2 1.5
 grep -q "^cell [0-9]* of 16" out.txt && ok || bad "query on a pvs from AGVS"

@@ -115,6 +115,7 @@ const char* to_string(AgvsDistribution d) {
     case AgvsDistribution::kObjectDirection: return "object-direction";
     case AgvsDistribution::kTwoPoint: return "two-point";
     case AgvsDistribution::kTwoPointMutation: return "two-point mutation";
+    case AgvsDistribution::kSilhouetteMutation: return "silhouette mutation";
     case AgvsDistribution::kCount: break;
   }
   return "?";
@@ -125,7 +126,7 @@ const char* to_string(AgvsDistribution d) {
 namespace {
 
 constexpr int kDists = static_cast<int>(AgvsDistribution::kCount);
-constexpr int kVsd = 0, kOd = 1, kTp = 2, kTpm = 3;
+constexpr int kVsd = 0, kOd = 1, kTp = 2, kTpm = 3, kSil = 4;
 
 /// Radical inverse of i in base b: the Halton sequence's coordinate.
 double radical_inverse(uint64_t i, uint32_t b) {
@@ -168,6 +169,64 @@ void frame(const Vec3& n, Vec3& u, Vec3& v) {
 struct Candidate {
   Vec3 origin, term;           ///< the segment's other end, and the end where the object was seen
   double r_origin = 0, r_term = 0;  ///< radii of what lies at each end (object or view cell)
+  uint32_t object = kNoObject;      ///< the object seen at `term`
+};
+
+/// A mutation strategy's candidates, the least mutated first (ties: the oldest); when full,
+/// the most mutated (the newest among equals) is dropped.
+struct CandidateBuffer {
+  std::map<uint64_t, Candidate> candidates;
+  std::set<std::pair<uint32_t, uint64_t>> by_count;
+  std::map<uint64_t, uint32_t> count_of;
+  uint64_t next_id = 0;
+
+  bool empty() const { return by_count.empty(); }
+  size_t size() const { return candidates.size(); }
+  void add(const Candidate& c, size_t cap) {
+    const uint64_t id = next_id++;
+    candidates.emplace(id, c);
+    by_count.insert({0u, id});
+    count_of[id] = 0;
+    if (candidates.size() > cap) {
+      const auto last = std::prev(by_count.end());
+      candidates.erase(last->second);
+      count_of.erase(last->second);
+      by_count.erase(last);
+    }
+  }
+  /// The least mutated candidate; its count goes up by one.
+  const Candidate& take() {
+    const auto first = *by_count.begin();
+    by_count.erase(by_count.begin());
+    by_count.insert({first.first + 1, first.second});
+    count_of[first.second] = first.first + 1;
+    return candidates.at(first.second);
+  }
+  void save(ByteWriter& w) const {
+    w.put(next_id);
+    w.put<uint64_t>(candidates.size());
+    for (const auto& [id, c] : candidates) {
+      w.put(id), w.put(count_of.at(id));
+      w.put(c.origin), w.put(c.term), w.put(c.r_origin), w.put(c.r_term), w.put(c.object);
+    }
+  }
+  static CandidateBuffer load(ByteReader& r, size_t cap, size_t payload) {
+    CandidateBuffer b;
+    b.next_id = r.get<uint64_t>();
+    const uint64_t n = r.get<uint64_t>();
+    if (n > cap || n > payload) r.fail("too many mutation candidates");
+    for (uint64_t k = 0; k < n; ++k) {
+      const uint64_t id = r.get<uint64_t>();
+      const uint32_t count = r.get<uint32_t>();
+      Candidate c;
+      c.origin = r.get<Vec3>(), c.term = r.get<Vec3>(), c.r_origin = r.get<double>(), c.r_term = r.get<double>();
+      c.object = r.get<uint32_t>();
+      if (id >= b.next_id || !b.candidates.emplace(id, c).second) r.fail("mutation candidate ids are inconsistent");
+      b.count_of[id] = count;
+      b.by_count.insert({count, id});
+    }
+    return b;
+  }
 };
 
 }  // namespace
@@ -176,6 +235,7 @@ struct AgvsSolver::Impl {
   const Scene& scene;
   const CellLocator& cells;
   AgvsConfig config;
+  const RayCaster& caster_ref;
   SegmentCaster caster;
   GlobalPvs pvs;
   AgvsStats stats;
@@ -184,15 +244,13 @@ struct AgvsSolver::Impl {
   std::vector<std::vector<std::pair<double, uint32_t>>> triangles_of;
   std::vector<double> object_radius;
   Halton halton[kDists];
-  uint64_t halton_index[kDists] = {0, 0, 0, 0};
-  // Mutation candidates, fewest mutations first (ties: oldest first).
-  std::map<uint64_t, Candidate> candidates;
-  std::set<std::pair<uint32_t, uint64_t>> by_count;
-  std::map<uint64_t, uint32_t> count_of;
-  uint64_t next_candidate = 0;
+  uint64_t halton_index[kDists] = {};
+  // Mutation candidates of the two mutation strategies.
+  CandidateBuffer two_point, silhouette;
+  uint64_t discovery_rays = 0;  ///< silhouette searches' rays in the current batch
   // The mixture: contribution and rays of each distribution in the last batch.
-  double weight[kDists] = {0, 0, 0, 0};
-  double recent_contribution[kDists] = {0, 0, 0, 0}, recent_rays[kDists] = {0, 0, 0, 0};
+  double weight[kDists] = {};
+  double recent_contribution[kDists] = {}, recent_rays[kDists] = {};
   uint64_t last_calibration = 0;
   bool calibrated = false;
   // The pixel error estimator's window: per batch, view space-direction rays and those that
@@ -205,9 +263,11 @@ struct AgvsSolver::Impl {
       : scene(s),
         cells(c),
         config(cfg),
+        caster_ref(rc),
         caster(s, rc, c.view_box(), cfg.empty_space),
         pvs(c.cell_count(), static_cast<uint32_t>(s.object_count())),
-        halton{Halton(cfg.seed, 11), Halton(cfg.seed, 12), Halton(cfg.seed, 13), Halton(cfg.seed, 14)} {
+        halton{Halton(cfg.seed, 11), Halton(cfg.seed, 12), Halton(cfg.seed, 13), Halton(cfg.seed, 14),
+               Halton(cfg.seed, 15)} {
     stats.empty_space = caster.empty_space();
     eps = 1e-6 * std::max(s.bounds.diagonal(), c.view_box().diagonal());
     triangles_of.resize(s.object_count());
@@ -278,14 +338,8 @@ struct AgvsSolver::Impl {
         return true;
       }
       case kTpm: {
-        if (by_count.empty()) return false;
-        // The candidate mutated least so far (the oldest among equals).
-        const auto first = *by_count.begin();
-        by_count.erase(by_count.begin());
-        const uint64_t id = first.second;
-        by_count.insert({first.first + 1, id});
-        count_of[id] = first.first + 1;
-        const Candidate& c = candidates.at(id);
+        if (two_point.empty()) return false;
+        const Candidate& c = two_point.take();
         const Vec3 axis = c.term - c.origin;
         if (!(length(axis) > 0)) return false;
         Vec3 u, v;
@@ -309,16 +363,66 @@ struct AgvsSolver::Impl {
   }
 
   void add_candidate(const Candidate& c) {
-    const uint64_t id = next_candidate++;
-    candidates.emplace(id, c);
-    by_count.insert({0u, id});
-    count_of[id] = 0;
-    if (candidates.size() > config.mutation_buffer) {  // drop the most mutated (the newest among equals)
-      const auto last = std::prev(by_count.end());
-      candidates.erase(last->second);
-      count_of.erase(last->second);
-      by_count.erase(last);
+    two_point.add(c, config.mutation_buffer);
+    silhouette.add(c, config.mutation_buffer);
+  }
+
+  /// Silhouette mutation (paper 4.4, after Wonka et al.'s adaptive border sampling): from the
+  /// candidate's other end, discovery rays towards points moved off the seen object along a
+  /// random direction of the plane through its end, perpendicular to the segment; the nearest
+  /// one that misses the object (binary search) passes its silhouette. If that ray then hits
+  /// something more than k r(o) beyond the moved point (a depth discontinuity), a second
+  /// search runs along the jump. Returns the samples' points and directions (one or two).
+  int silhouette_samples(Rng& rng, Vec3 points_out[2], Vec3 dirs_out[2]) {
+    if (silhouette.empty()) return 0;
+    const Candidate c = silhouette.take();
+    const double r = c.r_term;
+    if (c.object == kNoObject || !(r > 0)) return 0;
+    auto search = [&](const Vec3& from, const Vec3& at, uint32_t object, Vec3& found) {
+      const Vec3 axis = at - from;
+      if (!(length(axis) > eps)) return false;
+      Vec3 u, v;
+      frame(normalize(axis), u, v);
+      const double a = 2 * std::numbers::pi * rng.uniform();
+      const Vec3 d = u * std::cos(a) + v * std::sin(a);
+      auto hits_object = [&](double lambda) {
+        const Vec3 target = at + d * (lambda * r);
+        const Hit h = caster_ref.intersect(Ray{from, target - from, 0.0, 1.0 + 1e-6});
+        ++discovery_rays;
+        return h.hit() && h.object == object;
+      };
+      if (hits_object(1.0)) return false;  // the object reaches past r along d: no silhouette here
+      double lo = 0, hi = 1;
+      for (int step = 0; step < 6; ++step) {
+        const double mid = 0.5 * (lo + hi);
+        (hits_object(mid) ? lo : hi) = mid;
+      }
+      found = at + d * (hi * r);
+      return true;
+    };
+    Vec3 moved;
+    if (!search(c.origin, c.term, c.object, moved)) return 0;
+    int n = 0;
+    const Vec3 dir = moved - c.origin;
+    if (!(length(dir) > eps)) return 0;
+    points_out[n] = (c.origin + moved) * 0.5;
+    dirs_out[n++] = normalize(dir);
+    // Depth discontinuity: where does the silhouette ray really end?
+    const Hit h = caster_ref.intersect(Ray{c.origin, normalize(dir)});
+    ++discovery_rays;
+    constexpr double kDepthJump = 3.0;  // the paper's k
+    if (h.hit()) {
+      const Vec3 end = c.origin + normalize(dir) * h.t;
+      Vec3 moved2;
+      if (length(end - moved) > kDepthJump * r && search(moved, end, h.object, moved2)) {
+        const Vec3 d2 = moved2 - moved;
+        if (length(d2) > eps) {
+          points_out[n] = (moved + moved2) * 0.5;
+          dirs_out[n++] = normalize(d2);
+        }
+      }
     }
+    return n;
   }
 
   /// Radius of what lies at a segment end: its object, or else the view cell there.
@@ -335,20 +439,21 @@ struct AgvsSolver::Impl {
       share[kVsd] = 1;
       return;
     }
-    const bool can_mutate = !by_count.empty();
+    auto usable = [&](int d) {
+      return (d != kTpm || !two_point.empty()) && (d != kSil || !silhouette.empty());
+    };
     const bool calibrate = !calibrated || stats.samples - last_calibration >= config.recalibrate_every;
     // A distribution not tried yet (the mutation, before its first candidates) gets the
     // best weight: it is then measured like the others.
     const double best = *std::max_element(weight, weight + kDists);
     double total = 0;
     for (int d = 0; d < kDists; ++d) {
-      const bool usable = d != kTpm || can_mutate;
       const double w = recent_rays[d] > 0 ? weight[d] : best;
-      share[d] = usable ? (calibrate ? 1.0 : w) : 0.0;
+      share[d] = usable(d) ? (calibrate ? 1.0 : w) : 0.0;
       total += share[d];
     }
     if (!(total > 0)) {  // nothing contributed in the last batch: spread evenly
-      for (int d = 0; d < kDists; ++d) share[d] = (d != kTpm || can_mutate) ? 1.0 : 0.0;
+      for (int d = 0; d < kDists; ++d) share[d] = usable(d) ? 1.0 : 0.0;
       total = std::accumulate(share, share + kDists, 0.0);
     }
     for (int d = 0; d < kDists; ++d) share[d] /= total;
@@ -376,7 +481,8 @@ struct AgvsSolver::Impl {
     want[kVsd] += n - assigned;  // what rounding left over
     // The view space-direction samples last: they also replace the draws that failed (no
     // mutation candidate left, a degenerate two-point pair), so every batch has n samples.
-    constexpr int kOrder[kDists] = {kTpm, kOd, kTp, kVsd};
+    constexpr int kOrder[kDists] = {kSil, kTpm, kOd, kTp, kVsd};
+    discovery_rays = 0;
     uint32_t failed = 0;
     for (int d : kOrder) {
       first_of[d] = static_cast<uint32_t>(points.size());
@@ -393,6 +499,15 @@ struct AgvsSolver::Impl {
           }
           dir = sphere_direction(rng.uniform(), rng.uniform());
           ref_cell.push_back(static_cast<int32_t>(c));
+        } else if (d == kSil) {
+          Vec3 sp[2], sd[2];
+          const int got = silhouette_samples(rng, sp, sd);
+          if (got == 0) ++failed;
+          for (int j = 0; j < got; ++j) {
+            points.push_back(sp[j]);
+            dirs.push_back(sd[j]);
+          }
+          continue;
         } else if (!draw(d, rng, p, dir)) {
           ++failed;
           continue;
@@ -441,7 +556,8 @@ struct AgvsSolver::Impl {
       });
     }
     // Apply in sample order (serial: contributions depend on what came before).
-    uint64_t dist_contribution[kDists] = {0, 0, 0, 0}, dist_rays[kDists] = {0, 0, 0, 0};
+    uint64_t dist_contribution[kDists] = {}, dist_rays[kDists] = {};
+    dist_rays[kSil] += discovery_rays;
     uint64_t vsd_rays = 0, vsd_contributing = 0;
     std::vector<uint32_t> sample_new_at_origin(count, 0);
     std::vector<int32_t> origin_cell(count, -2);
@@ -485,7 +601,7 @@ struct AgvsSolver::Impl {
             if (!contributed[e]) continue;
             const Vec3& term = e ? b : a;
             const Vec3& origin = e ? a : b;
-            add_candidate({origin, term, end_radius(objs[1 - e], origin), end_radius(objs[e], term)});
+            add_candidate({origin, term, end_radius(objs[1 - e], origin), end_radius(objs[e], term), objs[e]});
           }
         }
       }
@@ -509,7 +625,7 @@ struct AgvsSolver::Impl {
     }
     stats.samples += count;
     stats.batches += 1;
-    stats.mutation_candidates = candidates.size();
+    stats.mutation_candidates = two_point.size();
     update_estimate(vsd_rays, vsd_contributing);
   }
 
@@ -646,7 +762,7 @@ void AgvsSolver::run() {
 
 namespace {
 constexpr char kStateMagic[5] = "VAGS";
-constexpr uint32_t kStateVersion = 1;
+constexpr uint32_t kStateVersion = 2;
 }  // namespace
 
 void GlobalPvs::save(ByteWriter& w) const {
@@ -692,12 +808,8 @@ void AgvsSolver::save(const std::string& path, uint64_t identity) const {
   w.put(m.last_calibration);
   w.put(static_cast<uint8_t>(m.calibrated));
   w.put(m.error);
-  w.put(m.next_candidate);
-  w.put<uint64_t>(m.candidates.size());
-  for (const auto& [id, c] : m.candidates) {
-    w.put(id), w.put(m.count_of.at(id));
-    w.put(c.origin), w.put(c.term), w.put(c.r_origin), w.put(c.r_term);
-  }
+  m.two_point.save(w);
+  m.silhouette.save(w);
   w.put<uint64_t>(m.window.size());
   for (const auto& [n, nc] : m.window) w.put(n), w.put(nc);
   w.put<uint64_t>(s.curve.size());
@@ -731,21 +843,8 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   const uint64_t last_calibration = r.get<uint64_t>();
   const bool calibrated = r.get<uint8_t>() != 0;
   const double error = r.get<double>();
-  const uint64_t next_candidate = r.get<uint64_t>();
-  const uint64_t candidates = r.get<uint64_t>();
-  if (candidates > m.config.mutation_buffer || candidates > payload.size()) r.fail("too many mutation candidates");
-  std::map<uint64_t, Candidate> cand;
-  std::map<uint64_t, uint32_t> count_of;
-  std::set<std::pair<uint32_t, uint64_t>> by_count;
-  for (uint64_t k = 0; k < candidates; ++k) {
-    const uint64_t id = r.get<uint64_t>();
-    const uint32_t count = r.get<uint32_t>();
-    Candidate c;
-    c.origin = r.get<Vec3>(), c.term = r.get<Vec3>(), c.r_origin = r.get<double>(), c.r_term = r.get<double>();
-    if (id >= next_candidate || !cand.emplace(id, c).second) r.fail("mutation candidate ids are inconsistent");
-    count_of[id] = count;
-    by_count.insert({count, id});
-  }
+  CandidateBuffer two_point = CandidateBuffer::load(r, m.config.mutation_buffer, payload.size());
+  CandidateBuffer silhouette = CandidateBuffer::load(r, m.config.mutation_buffer, payload.size());
   const uint64_t windows = r.get<uint64_t>();
   if (windows > payload.size()) r.fail("estimator window too long");
   std::deque<std::pair<uint64_t, uint64_t>> window;
@@ -758,7 +857,7 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   s.curve.clear();
   for (uint64_t k = 0; k < points; ++k) s.curve.push_back(r.get<AgvsPoint>());
   if (!r.at_end()) r.fail("trailing bytes");
-  s.mutation_candidates = cand.size();
+  s.mutation_candidates = two_point.size();
   // Commit.
   m.pvs = std::move(pvs);
   m.stats = std::move(s);
@@ -768,10 +867,8 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   m.last_calibration = last_calibration;
   m.calibrated = calibrated;
   m.error = error;
-  m.next_candidate = next_candidate;
-  m.candidates = std::move(cand);
-  m.count_of = std::move(count_of);
-  m.by_count = std::move(by_count);
+  m.two_point = std::move(two_point);
+  m.silhouette = std::move(silhouette);
   m.window = std::move(window);
 }
 

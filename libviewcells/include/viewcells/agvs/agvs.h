@@ -12,8 +12,7 @@
 /// the ray, not the second (the paper measures time): rays dominate the cost, and wall-clock
 /// weights would make results depend on the machine and the thread count.
 ///
-/// Not yet here: the silhouette mutation, the visibility filter, dynamic edits and resuming
-/// from a file.
+/// Not yet here: the visibility filter and dynamic edits.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -104,6 +103,7 @@ enum class AgvsDistribution : int {
   kObjectDirection,         ///< point on an object, cosine-weighted direction about its normal
   kTwoPoint,                ///< from a point in view space towards a point on an object
   kTwoPointMutation,        ///< both ends of a contributing segment moved by Gaussians
+  kSilhouetteMutation,      ///< towards the silhouette of a newly seen object, and past a depth jump
   kCount
 };
 const char* to_string(AgvsDistribution d);
@@ -141,10 +141,11 @@ struct AgvsPoint {
 
 struct AgvsStats {
   uint64_t samples = 0, rays = 0, batches = 0;
-  uint64_t dist_samples[4] = {0, 0, 0, 0};
-  uint64_t dist_rays[4] = {0, 0, 0, 0};
-  uint64_t dist_contribution[4] = {0, 0, 0, 0};
-  double dist_probability[4] = {0, 0, 0, 0};  ///< of the last batch
+  static constexpr int kDistributions = static_cast<int>(AgvsDistribution::kCount);
+  uint64_t dist_samples[kDistributions] = {};
+  uint64_t dist_rays[kDistributions] = {};  ///< silhouette: its discovery rays included
+  uint64_t dist_contribution[kDistributions] = {};
+  double dist_probability[kDistributions] = {};  ///< of the last batch
   uint64_t mutation_candidates = 0;           ///< in the buffer now
   /// View space-direction samples in the estimator's window (equation 5). The window reaches
   /// back until it holds enough samples for its own error; while the error falls fast it
