@@ -378,7 +378,7 @@ struct AgvsSolver::Impl {
     const Candidate c = silhouette.take();
     const double r = c.r_term;
     if (c.object == kNoObject || !(r > 0)) return 0;
-    auto search = [&](const Vec3& from, const Vec3& at, uint32_t object, Vec3& found) {
+    auto search = [&](const Vec3& from, const Vec3& at, uint32_t object, double radius, Vec3& found) {
       const Vec3 axis = at - from;
       if (!(length(axis) > eps)) return false;
       Vec3 u, v;
@@ -386,8 +386,9 @@ struct AgvsSolver::Impl {
       const double a = 2 * std::numbers::pi * rng.uniform();
       const Vec3 d = u * std::cos(a) + v * std::sin(a);
       auto hits_object = [&](double lambda) {
-        const Vec3 target = at + d * (lambda * r);
-        const Hit h = caster_ref.intersect(Ray{from, target - from, 0.0, 1.0 + 1e-6});
+        const Vec3 target = at + d * (lambda * radius);
+        // From just off `from`, which may lie on a surface itself.
+        const Hit h = caster_ref.intersect(Ray{from, target - from, 1e-6, 1.0 + 1e-6});
         ++discovery_rays;
         return h.hit() && h.object == object;
       };
@@ -397,24 +398,24 @@ struct AgvsSolver::Impl {
         const double mid = 0.5 * (lo + hi);
         (hits_object(mid) ? lo : hi) = mid;
       }
-      found = at + d * (hi * r);
+      found = at + d * (hi * radius);
       return true;
     };
     Vec3 moved;
-    if (!search(c.origin, c.term, c.object, moved)) return 0;
+    if (!search(c.origin, c.term, c.object, r, moved)) return 0;
     int n = 0;
     const Vec3 dir = moved - c.origin;
     if (!(length(dir) > eps)) return 0;
     points_out[n] = (c.origin + moved) * 0.5;
     dirs_out[n++] = normalize(dir);
     // Depth discontinuity: where does the silhouette ray really end?
-    const Hit h = caster_ref.intersect(Ray{c.origin, normalize(dir)});
+    const Hit h = caster_ref.intersect(Ray{c.origin, normalize(dir), eps});
     ++discovery_rays;
     constexpr double kDepthJump = 3.0;  // the paper's k
     if (h.hit()) {
       const Vec3 end = c.origin + normalize(dir) * h.t;
       Vec3 moved2;
-      if (length(end - moved) > kDepthJump * r && search(moved, end, h.object, moved2)) {
+      if (length(end - moved) > kDepthJump * r && search(moved, end, h.object, object_radius[h.object], moved2)) {
         const Vec3 d2 = moved2 - moved;
         if (length(d2) > eps) {
           points_out[n] = (moved + moved2) * 0.5;
