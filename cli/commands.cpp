@@ -140,6 +140,12 @@ json scene_summary(const Scene& s) {
           {"non_axis_aligned_area_share", s.non_axis_aligned_share()}};
 }
 
+bool is_q3_map(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return ext == ".bsp";
+}
+
 int run_info(const InfoArgs& a, const Common& c) {
   const Scene scene = load_scene(a.scene, parse_grouping(a.objects));
   const json summary = scene_summary(scene);
@@ -156,8 +162,7 @@ int run_info(const InfoArgs& a, const Common& c) {
             << "non-axis-aligned:   " << fmt(100.0 * scene.non_axis_aligned_share(), 2) << "% of "
             << fmt(scene.surface_area, 1) << " surface area\n";
   json map_json;
-  const std::filesystem::path ext = std::filesystem::path(a.scene).extension();
-  if (ext == ".bsp" || ext == ".BSP") {
+  if (is_q3_map(a.scene)) {
     // What the Quake 3 map itself holds besides the geometry.
     const Q3Map map = read_q3bsp(a.scene);
     Q3MeshStats st;
@@ -256,12 +261,6 @@ struct Sampled {
   double load_s = 0, bvh_s = 0;
   std::string view_space = "the whole view box";  ///< where sample origins are drawn, in words
 };
-
-bool is_q3_map(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  return ext == ".bsp";
-}
 
 /// A Quake 3 map's view space is its non-solid space: sample origins are drawn there, and the
 /// view box defaults to the bounds of its non-solid leaves.
@@ -986,6 +985,24 @@ struct CompressArgs {
   CutArgs cut;
 };
 
+/// The .pvs file of the view cells `set` of a built hierarchy (PVSs: the sampled ones).
+PvsFile pvs_file_for(const SubdivisionFile& file, const ViewCellSet& set) {
+  PvsFile pf = make_pvs_file(file.subdivision, file.leaf_pvs, *file.history, set.cells);
+  pf.object_count = file.object_count;
+  pf.object_names = file.object_names;
+  pf.scene_fingerprint = file.scene_fingerprint;
+  pf.rule = set.rule;
+  return pf;
+}
+
+/// Writes the .pvs file, then reads it back: every cell's PVS must come back as `lists`.
+void write_pvs_checked(const std::string& path, const PvsFile& pf, const std::vector<std::vector<uint32_t>>& lists) {
+  write_pvs(path, pf);
+  const PvsFile back = read_pvs(path);
+  for (uint32_t i = 0; i < back.pvs.cell_count; ++i)
+    if (back.pvs.cell_pvs(i) != lists[i]) throw Error(path, 0, "read-back check failed for cell " + std::to_string(i));
+}
+
 int run_pvs(const PvsArgs& a, const Common& c) {
   ThreadLimit threads(c.threads);
   AgvsConfig config;
@@ -1010,11 +1027,8 @@ int run_pvs(const PvsArgs& a, const Common& c) {
   EmbreeConfig ec;
   ec.robust = !a.fast;
   const auto caster = make_embree_caster(scene, ec);
-  PvsFile pf = make_pvs_file(file.subdivision, file.leaf_pvs, h, set.cells);
-  pf.object_count = file.object_count;
-  pf.object_names = file.object_names;
-  pf.scene_fingerprint = file.scene_fingerprint;
-  pf.rule = set.rule + "; PVS by " + a.method;
+  PvsFile pf = pvs_file_for(file, set);
+  pf.rule += "; PVS by " + a.method;
   const CellLocator cells(pf.bsp, pf.leaf_cell, pf.pvs.cell_count);
   const double setup_s = sw.seconds();
   c.log("viewcells: " + std::to_string(cells.cell_count()) + " view cells (" + set.rule + "), PVS by " + a.method +
@@ -1044,10 +1058,7 @@ int run_pvs(const PvsArgs& a, const Common& c) {
   std::vector<std::vector<uint32_t>> lists(cells.cell_count());
   for (uint32_t i = 0; i < cells.cell_count(); ++i) lists[i] = solver.pvs().list(i);
   pf.pvs = compress_pvs(h, set.cells, lists);
-  write_pvs(a.output, pf);
-  const PvsFile back = read_pvs(a.output);
-  for (uint32_t i = 0; i < back.pvs.cell_count; ++i)
-    if (back.pvs.cell_pvs(i) != lists[i]) throw Error(a.output, 0, "read-back check failed for cell " + std::to_string(i));
+  write_pvs_checked(a.output, pf, lists);
   const double err = solver.pixel_error();
   std::optional<PixelErrorMeasure> measured;
   if (a.measure_cameras) {
@@ -1117,11 +1128,7 @@ int run_compress(const CompressArgs& a, const Common& c) {
   const MergeHistory& h = *file.history;
   const ViewCellSet set = choose_cells(h, a.cut, true);
   Stopwatch sw;
-  PvsFile pf = make_pvs_file(file.subdivision, file.leaf_pvs, h, set.cells);
-  pf.object_count = file.object_count;
-  pf.object_names = file.object_names;
-  pf.scene_fingerprint = file.scene_fingerprint;
-  pf.rule = set.rule;
+  PvsFile pf = pvs_file_for(file, set);
   const double compress_s = sw.seconds();
   // Sizes before (every cell lists its whole PVS) and after (each node keeps its part).
   std::vector<std::vector<uint32_t>> flat(pf.pvs.cell_count);
@@ -1132,11 +1139,7 @@ int run_compress(const CompressArgs& a, const Common& c) {
   }
   const uint64_t after = pf.pvs.stored_entries();
   const uint64_t varint_before = varint_bytes(flat), varint_after = varint_bytes(pf.pvs.stored);
-  write_pvs(a.output, pf);
-  // Check what was written: read back, every cell's PVS must come back exactly.
-  const PvsFile back = read_pvs(a.output);
-  for (uint32_t i = 0; i < back.pvs.cell_count; ++i)
-    if (back.pvs.cell_pvs(i) != flat[i]) throw Error(a.output, 0, "read-back check failed for cell " + std::to_string(i));
+  write_pvs_checked(a.output, pf, flat);
   const uint64_t file_bytes = std::filesystem::file_size(a.output);
   c.log("viewcells: " + std::to_string(pf.pvs.cell_count) + " view cells (" + set.rule + "): " +
         std::to_string(before) + " PVS entries -> " + std::to_string(after) + " kept in " +

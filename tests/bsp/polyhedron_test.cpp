@@ -29,7 +29,9 @@ TEST(Plane, SidesAreExact) {
   for (int i = 0; i < 1000; ++i) {
     const Vec3 p{rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(-5, 5)};
     const double d = g.distance(p);
-    if (std::abs(d) > 1e-9) EXPECT_EQ(g.side(p), d > 0 ? 1 : -1);
+    if (std::abs(d) > 1e-9) {
+      EXPECT_EQ(g.side(p), d > 0 ? 1 : -1);
+    }
   }
 }
 

@@ -141,7 +141,9 @@ TEST(Q3OaDm2, ClustersCoverTheNonSolidLeaves) {
   EXPECT_GT(sky, 0u);
   const std::vector<double> costs = per_object_costs(scene, model);
   for (uint32_t o = 0; o < scene.object_count(); ++o) {
-    if (!scene.objects[o].rendered) EXPECT_EQ(costs[o], 0.0) << scene.objects[o].name;
+    if (!scene.objects[o].rendered) {
+      EXPECT_EQ(costs[o], 0.0) << scene.objects[o].name;
+    }
   }
 }
 

@@ -307,8 +307,12 @@ TEST(Sampler, SeeThroughObjectsAreSeenButStopNoRay) {
     const bool inside = p.y > 2.01 && p.y < 7.99 && p.z > 2.01 && p.z < 7.99;
     const bool outside = p.y < 1.99 || p.y > 8.01 || p.z < 1.99 || p.z > 8.01;
     const bool companion = with_glass.count({a.x, a.y, a.z, b.x, b.y, b.z}) > 0;
-    if (inside) EXPECT_TRUE(companion) << "crosses the glass at " << p.y << " " << p.z;
-    if (outside) EXPECT_FALSE(companion);
+    if (inside) {
+      EXPECT_TRUE(companion) << "crosses the glass at " << p.y << " " << p.z;
+    }
+    if (outside) {
+      EXPECT_FALSE(companion);
+    }
     crossing += inside;
   }
   EXPECT_GT(crossing, 500u);

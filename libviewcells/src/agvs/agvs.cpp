@@ -160,12 +160,6 @@ Vec3 sphere_direction(double u1, double u2) {
   return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta};
 }
 
-/// A unit frame (u, v) perpendicular to the unit vector n.
-void frame(const Vec3& n, Vec3& u, Vec3& v) {
-  u = normalize(std::abs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
-  v = cross(n, u);
-}
-
 struct Candidate {
   Vec3 origin, term;           ///< the segment's other end, and the end where the object was seen
   double r_origin = 0, r_term = 0;  ///< radii of what lies at each end (object or view cell)
@@ -322,7 +316,7 @@ struct AgvsSolver::Impl {
         const double phi = 2 * std::numbers::pi * h.at(i, 4), cos_theta = std::sqrt(h.at(i, 5));
         const double sin_theta = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
         Vec3 u, v;
-        frame(n, u, v);
+        orthonormal_basis(n, u, v);
         dir = n * cos_theta + (u * std::cos(phi) + v * std::sin(phi)) * sin_theta;
         point = x + dir * eps;  // the backward ray comes back to x
         return true;
@@ -343,7 +337,7 @@ struct AgvsSolver::Impl {
         const Vec3 axis = c.term - c.origin;
         if (!(length(axis) > 0)) return false;
         Vec3 u, v;
-        frame(normalize(axis), u, v);
+        orthonormal_basis(normalize(axis), u, v);
         auto gauss2 = [&](double sigma) {
           // Box-Muller: two independent normals.
           const double r = sigma * std::sqrt(-2 * std::log(std::max(1e-300, 1 - rng.uniform())));
@@ -382,7 +376,7 @@ struct AgvsSolver::Impl {
       const Vec3 axis = at - from;
       if (!(length(axis) > eps)) return false;
       Vec3 u, v;
-      frame(normalize(axis), u, v);
+      orthonormal_basis(normalize(axis), u, v);
       const double a = 2 * std::numbers::pi * rng.uniform();
       const Vec3 d = u * std::cos(a) + v * std::sin(a);
       auto hits_object = [&](double lambda) {
@@ -686,7 +680,7 @@ PixelErrorMeasure measure_pixel_error(const Scene& scene, const RayCaster& caste
     }
     const Vec3 forward = sphere_direction(rng.uniform(), rng.uniform());
     Vec3 right, up;
-    frame(forward, right, up);
+    orthonormal_basis(forward, right, up);
     const double roll = 2 * std::numbers::pi * rng.uniform();  // random orientation about the view axis
     const Vec3 r2 = right * std::cos(roll) + up * std::sin(roll), u2 = cross(r2, forward) * -1.0;
     const double aspect = static_cast<double>(height) / width;

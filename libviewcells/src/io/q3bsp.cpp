@@ -105,6 +105,17 @@ bool Q3Map::opaque_brush(const Q3Brush& b) const {
   return (contents & kQ3ContentsSolid) && !(contents & kQ3ContentsTranslucent);
 }
 
+namespace {
+
+/// Whether i indexes one of n items.
+bool is_index(int32_t i, size_t n) { return i >= 0 && static_cast<size_t>(i) < n; }
+/// Whether the items [first, first + count) all exist among n.
+bool in_range(int32_t first, int32_t count, size_t n) {
+  return first >= 0 && count >= 0 && static_cast<size_t>(first) + static_cast<size_t>(count) <= n;
+}
+
+}  // namespace
+
 Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
   Reader r(bytes, name);
   if (bytes.size() < 8 || bytes.compare(0, 4, "IBSP") != 0) r.fail("not a Quake 3 BSP file (no IBSP header)");
@@ -152,7 +163,7 @@ Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
     n.plane = r.i32(at);
     n.children[0] = r.i32(at + 4);
     n.children[1] = r.i32(at + 8);
-    if (n.plane < 0 || static_cast<size_t>(n.plane) >= m.planes.size()) r.fail("node " + std::to_string(i) + " names a missing plane");
+    if (!is_index(n.plane, m.planes.size())) r.fail("node " + std::to_string(i) + " names a missing plane");
     for (int32_t c : n.children)
       if ((c >= 0 && (static_cast<size_t>(c) >= nn || static_cast<size_t>(c) <= i)) ||
           (c < 0 && static_cast<size_t>(-(c + 1)) >= m.leaves.size()))
@@ -179,10 +190,10 @@ Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
     s.patch_width = r.i32(at + 96);
     s.patch_height = r.i32(at + 100);
     const std::string which = "surface " + std::to_string(i);
-    if (s.shader < 0 || static_cast<size_t>(s.shader) >= m.shaders.size()) r.fail(which + " names a missing shader");
-    if (s.first_vertex < 0 || s.vertex_count < 0 || static_cast<size_t>(s.first_vertex) + s.vertex_count > vn)
+    if (!is_index(s.shader, m.shaders.size())) r.fail(which + " names a missing shader");
+    if (!in_range(s.first_vertex, s.vertex_count, vn))
       r.fail(which + " has vertices outside the drawverts lump");
-    if (s.first_index < 0 || s.index_count < 0 || static_cast<size_t>(s.first_index) + s.index_count > in)
+    if (!in_range(s.first_index, s.index_count, in))
       r.fail(which + " has indices outside the drawindexes lump");
     if (s.type == Q3SurfaceType::kPlanar || s.type == Q3SurfaceType::kTriangleSoup) {
       if (s.index_count % 3 != 0) r.fail(which + " has a partial triangle");
@@ -203,42 +214,38 @@ Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
   m.world_surface_count = r.i32(mo + 28);
   m.world_first_brush = r.i32(mo + 32);
   m.world_brush_count = r.i32(mo + 36);
-  if (m.world_first_surface < 0 || m.world_surface_count < 0 ||
-      static_cast<size_t>(m.world_first_surface) + m.world_surface_count > fn)
+  if (!in_range(m.world_first_surface, m.world_surface_count, fn))
     r.fail("the world model's surfaces lie outside the surfaces lump");
   for (const Q3Leaf& l : m.leaves)
-    if (l.first_surface < 0 || l.surface_count < 0 || static_cast<size_t>(l.first_surface) + l.surface_count > lsn)
+    if (!in_range(l.first_surface, l.surface_count, lsn))
       r.fail("a leaf's surfaces lie outside the leafsurfaces lump");
   for (int32_t s : m.leaf_surfaces)
-    if (s < 0 || static_cast<size_t>(s) >= fn) r.fail("a leaf names a missing surface");
+    if (!is_index(s, fn)) r.fail("a leaf names a missing surface");
 
   // Brushes: what made a leaf solid (for explaining rays that cross solid space).
   auto [bso, bsn] = r.lump(9, 8);
   for (size_t i = 0; i < bsn; ++i) {
     Q3BrushSide side{r.i32(bso + 8 * i), r.i32(bso + 8 * i + 4)};
-    if (side.plane < 0 || static_cast<size_t>(side.plane) >= m.planes.size() || side.shader < 0 ||
-        static_cast<size_t>(side.shader) >= m.shaders.size())
+    if (!is_index(side.plane, m.planes.size()) || !is_index(side.shader, m.shaders.size()))
       r.fail("brush side " + std::to_string(i) + " names a missing plane or shader");
     m.brush_sides.push_back(side);
   }
   auto [bo, bn] = r.lump(8, 12);
   for (size_t i = 0; i < bn; ++i) {
     Q3Brush b{r.i32(bo + 12 * i), r.i32(bo + 12 * i + 4), r.i32(bo + 12 * i + 8)};
-    if (b.first_side < 0 || b.side_count < 0 || static_cast<size_t>(b.first_side) + b.side_count > bsn ||
-        b.shader < 0 || static_cast<size_t>(b.shader) >= m.shaders.size())
+    if (!in_range(b.first_side, b.side_count, bsn) || !is_index(b.shader, m.shaders.size()))
       r.fail("brush " + std::to_string(i) + " has sides outside the brushsides lump or a missing shader");
     m.brushes.push_back(b);
   }
   auto [lbo, lbn] = r.lump(6, 4);
   for (size_t i = 0; i < lbn; ++i) {
     m.leaf_brushes.push_back(r.i32(lbo + 4 * i));
-    if (m.leaf_brushes.back() < 0 || static_cast<size_t>(m.leaf_brushes.back()) >= bn) r.fail("a leaf names a missing brush");
+    if (!is_index(m.leaf_brushes.back(), bn)) r.fail("a leaf names a missing brush");
   }
-  if (m.world_first_brush < 0 || m.world_brush_count < 0 ||
-      static_cast<size_t>(m.world_first_brush) + m.world_brush_count > bn)
+  if (!in_range(m.world_first_brush, m.world_brush_count, bn))
     r.fail("the world model's brushes lie outside the brushes lump");
   for (const Q3Leaf& l : m.leaves)
-    if (l.first_brush < 0 || l.brush_count < 0 || static_cast<size_t>(l.first_brush) + l.brush_count > lbn)
+    if (!in_range(l.first_brush, l.brush_count, lbn))
       r.fail("a leaf's brushes lie outside the leafbrushes lump");
 
   auto [viso, vislen] = r.lump(16, 1);
@@ -278,12 +285,9 @@ bool add_brush_hull(const Q3Map& map, const Q3Brush& b, double inset, uint32_t g
     const Vec3 n = normalize(pi.normal);
     const double d = pi.dist / length(pi.normal) - inset;
     // A huge square on the plane, counter-clockwise seen from its front (outside the brush).
-    int least = 0;
-    for (int k = 1; k < 3; ++k)
-      if (std::abs(n[k]) < std::abs(n[least])) least = k;
-    Vec3 e;
-    e[least] = 1;
-    const Vec3 u = normalize(cross(n, e)), v = cross(n, u), c = n * d;
+    Vec3 u, v;
+    orthonormal_basis(n, u, v);
+    const Vec3 c = n * d;
     poly = {c - u * kHuge - v * kHuge, c + u * kHuge - v * kHuge, c + u * kHuge + v * kHuge, c - u * kHuge + v * kHuge};
     for (int32_t j = 0; j < b.side_count && !poly.empty(); ++j) {
       if (j == i) continue;

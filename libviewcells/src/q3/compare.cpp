@@ -20,8 +20,9 @@ namespace {
 uint64_t pair_key(int32_t cluster, uint32_t object) { return (uint64_t(uint32_t(cluster)) << 32) | object; }
 
 /// Why segment i, seen from `cluster`, shows `object` although q3map2 does not admit it.
+/// `far_plane` is the map's q3_far_plane().
 std::string classify(const Q3Map& map, const Subdivision& q3, const SegmentSet& eval, size_t i, int32_t cluster,
-                     uint32_t object) {
+                     uint32_t object, double far_plane) {
   // From the end that sees the object towards the other one.
   const bool at_a = eval.object_a[i] == object;
   const Vec3 p = at_a ? eval.a(i) : eval.b(i), q = at_a ? eval.b(i) : eval.a(i);
@@ -71,12 +72,11 @@ std::string classify(const Q3Map& map, const Subdivision& q3, const SegmentSet& 
   const int32_t seen_in = map.leaves[map.leaf_at(p1)].cluster;
   if (seen_in == cluster || map.cluster_sees(cluster, seen_in)) return "unlisted";
   // Farther from the cluster than the map's far plane: q3map2 culled it on purpose.
-  const double far = q3_far_plane(map);
-  if (far > 0) {
+  if (far_plane > 0) {
     double nearest = 2;
     for (const auto& [n, t0, t1] : pieces)
       if (map.leaves[q3_leaf_of_node(map, n)].cluster == cluster) nearest = std::min(nearest, t0);
-    if (nearest <= 1 && nearest * length(q1 - p1) > far) return "far";
+    if (nearest <= 1 && nearest * length(q1 - p1) > far_plane) return "far";
   }
   return "rejected";
 }
@@ -162,13 +162,14 @@ Q3Comparison compare_with_q3map2(const Scene& scene, const Q3Map& map, const Ray
     });
     for (const Found& f : found)
       for (const auto& [key, i] : f) witness[key] = std::min(witness[key], i);
+    const double far_plane = q3_far_plane(map);
     for (const auto& [key, i] : witness) {
       Q3Excluded e;
       e.cluster = static_cast<int32_t>(key >> 32);
       e.object = static_cast<uint32_t>(key & 0xffffffffu);
       e.segment = i;
       if (i == std::numeric_limits<size_t>::max()) throw Error("internal: an excluded object without its segment");
-      e.cause = classify(map, q3, eval, i, e.cluster, e.object);
+      e.cause = classify(map, q3, eval, i, e.cluster, e.object, far_plane);
       ++out.excluded_by_cause[e.cause];
       out.excluded.push_back(std::move(e));
     }

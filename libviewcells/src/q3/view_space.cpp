@@ -43,12 +43,8 @@ Plane to_plane(const Q3Plane& q, bool& flipped) {
     }
   }
   const Vec3 n = normalize(q.normal);
-  int least = 0;
-  for (int k = 1; k < 3; ++k)
-    if (std::abs(n[k]) < std::abs(n[least])) least = k;
-  Vec3 e;
-  e[least] = 1;
-  const Vec3 u = normalize(cross(n, e)), v = cross(n, u);  // u x v = n
+  Vec3 u, v;
+  orthonormal_basis(n, u, v);
   const Vec3 a = n * (q.dist / length(q.normal));
   constexpr double kSpan = 1024;  // map units: keeps the defining points well apart
   return Plane::through(a, a + u * kSpan, a + v * kSpan);

@@ -34,6 +34,14 @@ constexpr Vec3 cross(const Vec3& a, const Vec3& b) {
 }
 inline double length(const Vec3& v) { return std::sqrt(dot(v, v)); }
 inline Vec3 normalize(const Vec3& v) { return v / length(v); }
+/// Unit vectors u, v perpendicular to the unit vector n with u x v = n (built from the axis
+/// n is least aligned with, so they are well conditioned for any n).
+inline void orthonormal_basis(const Vec3& n, Vec3& u, Vec3& v) {
+  const double ax = std::abs(n.x), ay = std::abs(n.y), az = std::abs(n.z);
+  const Vec3 e = ax <= ay && ax <= az ? Vec3{1, 0, 0} : (ay <= az ? Vec3{0, 1, 0} : Vec3{0, 0, 1});
+  u = normalize(cross(n, e));
+  v = cross(n, u);
+}
 constexpr Vec3 min(const Vec3& a, const Vec3& b) {
   return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)};
 }
