@@ -95,6 +95,7 @@ struct GenerateArgs {
   std::string kind;
   uint64_t seed = 1;
   int size = 1;
+  bool sealed = false;
   std::string output;
 };
 
@@ -103,10 +104,11 @@ int run_generate(const GenerateArgs& a, const Common& c) {
   config.kind = parse_generator_kind(a.kind);
   config.seed = a.seed;
   config.size = a.size;
+  config.sealed = a.sealed;
   Stopwatch sw;
   const Scene scene = generate_scene(config);
   write_obj(scene, a.output);
-  c.log("viewcells: generated " + std::string(to_string(config.kind)) + " (size " + std::to_string(a.size) +
+  c.log("viewcells: generated " + std::string(to_string(config.kind)) + (a.sealed ? ", sealed" : "") + " (size " + std::to_string(a.size) +
         ", seed " + std::to_string(a.seed) + "): " + std::to_string(scene.object_count()) + " objects, " +
         std::to_string(scene.triangle_count()) + " triangles -> " + a.output + " in " + fmt(sw.seconds(), 2) + " s");
   return 0;
@@ -866,7 +868,10 @@ struct PvsArgs {
   bool fast = false;
   uint32_t measure_cameras = 0;
   uint32_t measure_size = 1024;
-  std::string save, resume;
+  std::string save, resume, edited_from;
+  bool filter = false;
+  double filter_k = 1.0;
+  uint32_t filter_neighbours = 0;
 };
 
 int run_pvs(const PvsArgs& a, const Common& c);
@@ -1015,20 +1020,40 @@ int run_pvs(const PvsArgs& a, const Common& c) {
   config.show_progress = !c.quiet;
   if (!a.samples && !(a.seconds > 0) && !(a.pixel_error > 0))
     throw Error("give when to stop: --pixel-error, --time or --samples");
+  config.filter_statistics = a.filter || a.filter_neighbours > 0;
+  if (!(a.filter_k >= 0) || !std::isfinite(a.filter_k)) throw Error("--filter-k must be a finite number >= 0");
+  if (a.filter_k != 1.0 && !a.filter) throw Error("--filter-k sets the object space filter's factor: add --filter");
+  if (!a.edited_from.empty() && a.resume.empty())
+    throw Error("--edited-from needs --resume: the state computed on that scene, to carry over to --scene");
   SubdivisionFile file = read_merged(a.input);
   const MergeHistory& h = *file.history;
   CutArgs cut;
   cut.count = a.cells;
   const ViewCellSet set = choose_cells(h, cut, true);
   Stopwatch sw;
-  const Scene scene = load_scene(a.scene, parse_grouping(a.objects));
-  if (scene.fingerprint() != file.scene_fingerprint)
-    throw Error(a.scene, 0, "is not the scene " + a.input + " was built from (fingerprints differ)");
+  const ObjectGrouping grouping = parse_grouping(a.objects);
+  const Scene scene = load_scene(a.scene, grouping);
+  // Dynamic edits: the hierarchy and the state belong to the scene before the edit.
+  std::optional<Scene> before;
+  if (!a.edited_from.empty()) {
+    before.emplace(load_scene(a.edited_from, grouping));
+    if (before->fingerprint() != file.scene_fingerprint)
+      throw Error(a.edited_from, 0, "is not the scene " + a.input + " was built from (fingerprints differ)");
+  } else if (scene.fingerprint() != file.scene_fingerprint) {
+    throw Error(a.scene, 0,
+                "is not the scene " + a.input + " was built from (fingerprints differ; after editing the scene, "
+                "give the original with --edited-from)");
+  }
   EmbreeConfig ec;
   ec.robust = !a.fast;
   const auto caster = make_embree_caster(scene, ec);
   PvsFile pf = pvs_file_for(file, set);
   pf.rule += "; PVS by " + a.method;
+  // The PVSs name the objects of the scene sampled (the edited one, after an edit).
+  pf.object_count = static_cast<uint32_t>(scene.object_count());
+  pf.object_names.clear();
+  for (const ObjectInfo& o : scene.objects) pf.object_names.push_back(o.name);
+  pf.scene_fingerprint = scene.fingerprint();
   const CellLocator cells(pf.bsp, pf.leaf_cell, pf.pvs.cell_count);
   const double setup_s = sw.seconds();
   c.log("viewcells: " + std::to_string(cells.cell_count()) + " view cells (" + set.rule + "), PVS by " + a.method +
@@ -1037,41 +1062,94 @@ int run_pvs(const PvsArgs& a, const Common& c) {
                            : std::string()) +
         (a.seconds > 0 ? std::to_string(a.seconds) + " s " : std::string()) +
         (a.samples ? std::to_string(a.samples) + " samples" : std::string()));
-  AgvsSolver solver(scene, *caster, cells, config);
-  // A saved state belongs to this scene and these view cells.
-  ByteWriter cells_id;
-  cells_id.put(file.scene_fingerprint);
-  cells_id.put_array(pf.leaf_cell);
-  cells_id.put_array(pf.cell_mht_node);
-  const uint64_t identity = fnv1a64(cells_id.data());
-  if (!a.resume.empty()) {
-    solver.load(a.resume, identity);
-    c.log("viewcells: resumed from " + a.resume + " after " + std::to_string(solver.stats().samples) + " samples");
+  // A saved state belongs to a scene and these view cells.
+  auto identity_of = [&](uint64_t scene_fingerprint) {
+    ByteWriter cells_id;
+    cells_id.put(scene_fingerprint);
+    cells_id.put_array(pf.leaf_cell);
+    cells_id.put_array(pf.cell_mht_node);
+    return fnv1a64(cells_id.data());
+  };
+  const uint64_t identity = identity_of(scene.fingerprint());
+  std::unique_ptr<RayCaster> caster_before;
+  std::optional<AgvsSolver> solver;
+  std::optional<AgvsEditStats> edit;
+  if (before && AgvsSolver::state_identity(a.resume) != identity) {
+    // The state describes the scene before the edit: load it there, then edit.
+    caster_before = make_embree_caster(*before, ec);
+    solver.emplace(*before, *caster_before, cells, config);
+    solver->load(a.resume, identity_of(before->fingerprint()));
+    c.log("viewcells: resumed from " + a.resume + " after " + std::to_string(solver->stats().samples) +
+          " samples on " + a.edited_from);
+    edit = solver->edit(scene, *caster, match_objects(*before, scene));
+    c.log("viewcells: edit: " + std::to_string(edit->deleted) + " objects deleted (" +
+          std::to_string(edit->removed_deleted) + " PVS entries), " + std::to_string(edit->inserted) +
+          " inserted (" + std::to_string(edit->removed_penumbra) + " entries in their penumbrae removed, " +
+          std::to_string(edit->cells_cleared) + " cells they touch emptied)");
+  } else {
+    solver.emplace(scene, *caster, cells, config);
+    if (!a.resume.empty()) {
+      solver->load(a.resume, identity);
+      c.log("viewcells: resumed from " + a.resume + " after " + std::to_string(solver->stats().samples) +
+            " samples");
+    }
   }
-  solver.run();
+  solver->run();
   if (!a.save.empty()) {
-    solver.save(a.save, identity);
+    solver->save(a.save, identity);
     c.log("viewcells: state -> " + a.save + " (continue with --resume)");
   }
-  const AgvsStats& st = solver.stats();
-  // The sampled PVSs replace the construction ones, compressed through the hierarchy.
+  const AgvsStats& st = solver->stats();
+  // The sampled PVSs (filtered, when asked) replace the construction ones, compressed through
+  // the hierarchy.
+  const bool filtering = config.filter_statistics;
+  VisibilityFilter filter;
+  filter.object_space = a.filter;
+  filter.k = a.filter_k;
+  filter.view_neighbours = a.filter_neighbours;
   std::vector<std::vector<uint32_t>> lists(cells.cell_count());
-  for (uint32_t i = 0; i < cells.cell_count(); ++i) lists[i] = solver.pvs().list(i);
+  if (filtering) {
+    lists = solver->filtered_pvs(filter);
+  } else {
+    for (uint32_t i = 0; i < cells.cell_count(); ++i) lists[i] = solver->pvs().list(i);
+  }
+  GlobalPvs written(cells.cell_count(), pf.object_count);
+  for (uint32_t i = 0; i < cells.cell_count(); ++i)
+    for (uint32_t o : lists[i]) written.insert(i, o);
+  const double mean_written = static_cast<double>(written.entries()) / cells.cell_count();
+  if (filtering)
+    c.log("viewcells: visibility filter (" + std::string(a.filter ? "object space, k = " + fmt(a.filter_k, 2) : "") +
+          (a.filter && a.filter_neighbours ? ", " : "") +
+          (a.filter_neighbours ? "view space, " + std::to_string(a.filter_neighbours) + " neighbours" : "") +
+          "): mean PVS " + fmt(solver->mean_pvs(), 1) + " -> " + fmt(mean_written, 1) + " objects");
   pf.pvs = compress_pvs(h, set.cells, lists);
   write_pvs_checked(a.output, pf, lists);
-  const double err = solver.pixel_error();
-  std::optional<PixelErrorMeasure> measured;
+  const double err = solver->pixel_error(), bound = solver->pixel_error_bound();
+  std::optional<PixelErrorMeasure> measured, measured_unfiltered;
   if (a.measure_cameras) {
     Stopwatch ms;
-    measured = measure_pixel_error(scene, *caster, cells, solver.pvs(), a.measure_cameras, a.measure_size,
-                                   a.measure_size, 90.0, a.seed + 17, st.empty_space.enabled, config.resolution);
-    c.log("viewcells: measured pixel error " + fmt(measured->pixels, 2) + " of " + std::to_string(config.resolution) +
-          " pixels (" + std::to_string(measured->cameras) + " cameras of " + std::to_string(a.measure_size) + "x" +
-          std::to_string(a.measure_size) + ", " + fmt(ms.seconds(), 1) + " s)");
+    auto measure = [&](const GlobalPvs& pvs) {
+      return measure_pixel_error(scene, *caster, cells, pvs, a.measure_cameras, a.measure_size, a.measure_size, 90.0,
+                                 a.seed + 17, st.empty_space.enabled, config.resolution);
+    };
+    measured = measure(written);
+    if (filtering) measured_unfiltered = measure(solver->pvs());
+    c.log("viewcells: measured pixel error " + fmt(measured->pixels, 2) +
+          (filtering ? " (unfiltered " + fmt(measured_unfiltered->pixels, 2) + ")" : std::string()) + " of " +
+          std::to_string(config.resolution) + " pixels (" + std::to_string(measured->cameras) + " cameras of " +
+          std::to_string(a.measure_size) + "x" + std::to_string(a.measure_size) + ", " + fmt(ms.seconds(), 1) +
+          " s)");
   }
+  auto measure_json = [&](const std::optional<PixelErrorMeasure>& m) {
+    return m ? json{{"pixels", m->pixels}, {"share", m->share}, {"cameras", m->cameras},
+                    {"camera_size", a.measure_size}, {"fov_degrees", 90}}
+             : json(nullptr);
+  };
   c.log("viewcells: " + std::to_string(st.samples) + " samples (" + std::to_string(st.rays) + " rays) in " +
-        fmt(st.seconds, 2) + " s; mean PVS " + fmt(solver.mean_pvs(), 1) + " objects; estimated pixel error " +
-        (std::isnan(err) ? std::string("not yet known") : fmt(err, 2)) + " (" + st.stop_reason + "); -> " + a.output);
+        fmt(st.seconds, 2) + " s; mean PVS " + fmt(solver->mean_pvs(), 1) + " objects; estimated pixel error " +
+        (!std::isnan(err)     ? fmt(err, 2)
+         : !std::isnan(bound) ? "below " + fmt(bound, 2) + " (no wrong camera ray seen)"
+                              : std::string("not yet known")) + " (" + st.stop_reason + "); -> " + a.output);
   if (!a.report.empty()) {
     json dists = json::array();
     for (int d = 0; d < AgvsStats::kDistributions; ++d)
@@ -1083,7 +1161,8 @@ int run_pvs(const PvsArgs& a, const Common& c) {
     json curve = json::array();
     for (const AgvsPoint& p : st.curve)
       curve.push_back({{"seconds", p.seconds}, {"samples", p.samples}, {"rays", p.rays}, {"mean_pvs_size", p.mean_pvs},
-                       {"pixel_error", std::isnan(p.pixel_error) ? json(nullptr) : json(p.pixel_error)}});
+                       {"pixel_error", std::isnan(p.pixel_error) ? json(nullptr) : json(p.pixel_error)},
+                       {"pixel_error_bound", std::isnan(p.pixel_error_bound) ? json(nullptr) : json(p.pixel_error_bound)}});
     const json report = {
         {"command", "pvs"},
         {"input", a.input},
@@ -1100,20 +1179,37 @@ int run_pvs(const PvsArgs& a, const Common& c) {
           {"silhouette_mutation",
            {{"enabled", config.method == AgvsMethod::kAgvs},
             {"reason", config.method == AgvsMethod::kAgvs ? "part of the AGVS mixture" : "AGVS only"}}},
-          {"visibility_filter", {{"enabled", false}, {"reason", "not implemented yet"}}}}},
+          {"visibility_filter",
+           {{"enabled", filtering},
+            {"reason", filtering ? "asked for (--filter / --filter-neighbours): the written PVSs are extended by "
+                                   "objects likely visible given the sampling density"
+                                 : "not asked for: the written PVSs are the sampled ones"}}}}},
+        {"filter", filtering ? json{{"object_space", a.filter},
+                                    {"k", a.filter_k},
+                                    {"view_neighbours", a.filter_neighbours},
+                                    {"mean_pvs_size_unfiltered", solver->mean_pvs()},
+                                    {"mean_pvs_size_filtered", mean_written},
+                                    {"measured_pixel_error_unfiltered", measure_json(measured_unfiltered)}}
+                             : json(nullptr)},
+        {"edit", edit ? json{{"edited_from", a.edited_from},
+                             {"deleted_objects", edit->deleted},
+                             {"inserted_objects", edit->inserted},
+                             {"entries_of_deleted_objects", edit->removed_deleted},
+                             {"entries_in_penumbrae", edit->removed_penumbra},
+                             {"cells_emptied", edit->cells_cleared}}
+                      : json(nullptr)},
         {"samples", st.samples},
         {"rays", st.rays},
         {"seconds", st.seconds},
         {"setup_seconds", setup_s},
         {"samples_per_second", st.seconds > 0 ? st.samples / st.seconds : 0.0},
-        {"mean_pvs_size", solver.mean_pvs()},
-        {"pvs_entries", solver.pvs().entries()},
+        {"mean_pvs_size", solver->mean_pvs()},
+        {"mean_pvs_size_written", mean_written},
+        {"pvs_entries", solver->pvs().entries()},
         {"estimated_pixel_error", std::isnan(err) ? json(nullptr) : json(err)},
-        {"estimator_window_samples", st.window_samples},
-        {"measured_pixel_error",
-         measured ? json{{"pixels", measured->pixels}, {"share", measured->share}, {"cameras", measured->cameras},
-                         {"camera_size", a.measure_size}, {"fov_degrees", 90}}
-                  : json(nullptr)},
+        {"pixel_error_bound", std::isnan(bound) ? json(nullptr) : json(bound)},
+        {"estimator_window_rays", st.window_rays},
+        {"measured_pixel_error", measure_json(measured)},
         {"stop_reason", st.stop_reason},
         {"distributions", dists},
         {"curve", curve}};
@@ -1232,6 +1328,8 @@ int run(int argc, char** argv) {
   g->add_option("--size", gen.size,
                 "Scale >= 1: office rooms and floors, city blocks per side (city 20 ~ 1M triangles)")
       ->capture_default_str();
+  g->add_flag("--sealed", gen.sealed,
+              "Overlap boxes placed face to face by 1 mm instead of leaving 1 mm gaps (no slits between rooms)");
   g->add_option("-o,--output", gen.output, "Output .obj file")->required();
 
   InfoArgs info;
@@ -1368,6 +1466,18 @@ int run(int argc, char** argv) {
   pv->add_option("--resume", pva.resume,
                  "Continue from a state written by --save (same scene, cells, method, seed and batch); --samples "
                  "and --time count from the start of the computation, the saved part included");
+  pv->add_flag("--filter", pva.filter,
+              "Write PVSs extended by the object space visibility filter: objects near the PVS's objects, within "
+              "a distance that shrinks as the sampling gets denser (sampling itself goes on unfiltered)");
+  pv->add_option("--filter-k", pva.filter_k, "The filter's factor k: larger is more conservative")
+      ->capture_default_str();
+  pv->add_option("--filter-neighbours", pva.filter_neighbours,
+                 "View space filter: merge each cell's PVS with those of this many neighbouring cells with the most "
+                 "similar PVSs");
+  pv->add_option("--edited-from", pva.edited_from,
+                 "Dynamic edit: --scene is an edited version of this scene (the one the hierarchy and the --resume "
+                 "state were computed on). Objects are matched by name and geometry; deleted ones leave the PVSs, "
+                 "and what inserted ones may hide is removed before sampling resumes");
   pv->add_option("--measure-size", pva.measure_size, "Width and height of the measuring cameras, in pixels")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

@@ -1,5 +1,6 @@
 // Adaptive global visibility sampling: where a sample's contribution goes, that PVSs only
-// grow, resuming, and independence of the thread count.
+// grow, resuming, independence of the thread count, the penumbra of dynamic edits, edits
+// followed by resumed sampling, and the visibility filter.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -8,6 +9,7 @@
 
 #include "support/test_scenes.h"
 #include "viewcells/agvs/agvs.h"
+#include "viewcells/agvs/penumbra.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/scene/generators.h"
@@ -202,6 +204,212 @@ TEST(Agvs, BadInput) {
   AgvsConfig bad = quiet(AgvsMethod::kAgvs, 10);
   bad.window_p = 1.5;
   EXPECT_THROW(AgvsSolver(scene, *caster, cells, bad), Error);
+}
+
+/// A copy of the scene with a closed, outward box appended as a new object.
+Scene with_box(const Scene& scene, const Box3& b, const std::string& name) {
+  Scene out = scene;
+  const uint32_t base = static_cast<uint32_t>(out.vertices.size());
+  for (int k = 0; k < 8; ++k)
+    out.vertices.push_back({k & 1 ? b.hi.x : b.lo.x, k & 2 ? b.hi.y : b.lo.y, k & 4 ? b.hi.z : b.lo.z});
+  // Quads (counter-clockwise from outside) of the faces -x, +x, -y, +y, -z, +z.
+  const uint32_t quads[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  const uint32_t id = static_cast<uint32_t>(out.objects.size());
+  for (const auto& q : quads) {
+    out.triangles.push_back({base + q[0], base + q[1], base + q[2]});
+    out.triangles.push_back({base + q[0], base + q[2], base + q[3]});
+    out.triangle_object.push_back(id);
+    out.triangle_object.push_back(id);
+  }
+  ObjectInfo info;
+  info.name = name;
+  out.objects.push_back(info);
+  out.finalize();
+  return out;
+}
+
+TEST(Penumbra, MatchesTheShadowOfAPlate) {
+  // A plate at x = 5 (|y|, |z| <= 1) seen from the cell [-1, 1]^3. At depth x = 10 its
+  // penumbra reaches |y| <= 1 + 2 t with t = 5 / (5 - 1): 3.5.
+  const std::vector<Vec3> plate = {{5, -1, -1}, {5, 1, -1}, {5, 1, 1}, {5, -1, 1}};
+  const Box3 cell({-1, -1, -1}, {1, 1, 1});
+  const ConvexRegion p = penumbra(plate, cell, 100);
+  ASSERT_FALSE(p.is_everything());
+  auto at = [](double x, double y0, double y1) { return Box3({x - 0.01, y0, -0.05}, {x + 0.01, y1, 0.05}); };
+  EXPECT_TRUE(p.may_intersect(at(10, -0.1, 0.1))) << "right behind the plate";
+  EXPECT_TRUE(p.may_intersect(at(10, 3.4, 3.45))) << "inside the penumbra's edge";
+  EXPECT_FALSE(p.may_intersect(at(10, 3.55, 3.8))) << "just outside it";
+  EXPECT_FALSE(p.may_intersect(at(3, -0.1, 0.1))) << "between the cell and the plate";
+  EXPECT_FALSE(p.may_intersect(at(10, 40, 50)));
+  EXPECT_TRUE(p.may_intersect(at(5, -0.1, 0.1))) << "the plate itself";
+  // An occluder touching the cell may hide anything from some point of it.
+  const std::vector<Vec3> touching = {{1, -1, -1}, {1, 1, -1}, {1, 1, 1}, {1, -1, 1}};
+  EXPECT_TRUE(penumbra(touching, cell, 100).is_everything());
+  // The same at 1e5 and rotated coordinates: a region made of hull planes, no tolerance loss.
+  std::vector<Vec3> far_plate;
+  for (const Vec3& v : plate) far_plate.push_back(v + Vec3{1e5, 1e5, 1e5});
+  const Box3 far_cell(cell.lo + Vec3{1e5, 1e5, 1e5}, cell.hi + Vec3{1e5, 1e5, 1e5});
+  const ConvexRegion q = penumbra(far_plate, far_cell, 100);
+  const Vec3 o{1e5, 1e5, 1e5};
+  EXPECT_TRUE(q.may_intersect(Box3(at(10, 3.4, 3.45).lo + o, at(10, 3.4, 3.45).hi + o)));
+  EXPECT_FALSE(q.may_intersect(Box3(at(10, 3.55, 3.8).lo + o, at(10, 3.55, 3.8).hi + o)));
+}
+
+TEST(Agvs, DeletingAndInsertingAnObjectRestoresAConsistentSolution) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 3, 2});
+  const CellLocator cells = office_cells(scene, 40);
+  const auto caster = make_embree_caster(scene);
+  // A wall across the whole building at mid x: afterwards nothing on one side of it is
+  // visible from the other.
+  const Box3 vb = cells.view_box();
+  const double mid = 0.5 * (vb.lo.x + vb.hi.x);
+  const Box3 wall({mid - 0.05, scene.bounds.lo.y - 1, scene.bounds.lo.z - 1},
+                  {mid + 0.05, scene.bounds.hi.y + 1, scene.bounds.hi.z + 1});
+  const Scene walled = with_box(scene, wall, "inserted_wall");
+  const auto walled_caster = make_embree_caster(walled);
+  const uint32_t n = static_cast<uint32_t>(scene.object_count()), wall_id = n;
+  // Entries (cell left of the wall, object right of it), or the other way round.
+  auto across = [&](const GlobalPvs& pvs) {
+    uint64_t count = 0;
+    for (uint32_t c = 0; c < cells.cell_count(); ++c) {
+      const Box3& cb = cells.cell_bounds(c);
+      for (uint32_t o : pvs.list(c)) {
+        if (o >= n) continue;
+        const Box3& ob = scene.objects[o].bounds;
+        count += (cb.hi.x < wall.lo.x && ob.lo.x > wall.hi.x) || (cb.lo.x > wall.hi.x && ob.hi.x < wall.lo.x);
+      }
+    }
+    return count;
+  };
+  AgvsSolver solver(scene, *caster, cells, quiet(AgvsMethod::kAgvs, 60000));
+  solver.run();
+  const GlobalPvs before = solver.pvs();
+  const uint64_t across_before = across(before);
+  ASSERT_GT(across_before, 20u) << "the corridor must see across the middle";
+
+  // Insert the wall: every entry it may hide goes, the rest stays.
+  std::vector<uint32_t> same(n);
+  for (uint32_t o = 0; o < n; ++o) same[o] = o;
+  const AgvsEditStats ins = solver.edit(walled, *walled_caster, same);
+  EXPECT_EQ(ins.inserted, 1u);
+  EXPECT_EQ(ins.deleted, 0u);
+  EXPECT_GT(ins.removed_penumbra, across_before);
+  EXPECT_EQ(solver.pvs().object_count(), n + 1);
+  EXPECT_EQ(across(solver.pvs()), 0u) << "the penumbra covers what lies behind the wall";
+  EXPECT_GT(solver.pvs().entries(), before.entries() / 4) << "entries in front of the wall stay";
+  for (uint32_t c = 0; c < cells.cell_count(); ++c)
+    for (uint32_t o : solver.pvs().list(c)) EXPECT_TRUE(before.contains(c, o)) << "an edit adds nothing";
+  EXPECT_TRUE(std::isnan(solver.pixel_error())) << "the estimator restarts";
+
+  // Resumed sampling finds the wall and what is still visible, and nothing behind the wall.
+  solver.set_limits(120000, 0, 0);
+  solver.run();
+  EXPECT_EQ(across(solver.pvs()), 0u);
+  uint32_t cells_seeing_wall = 0;
+  for (uint32_t c = 0; c < cells.cell_count(); ++c) cells_seeing_wall += solver.pvs().contains(c, wall_id);
+  EXPECT_GT(cells_seeing_wall, cells.cell_count() / 4);
+  // Consistent with a solution computed on the walled scene from scratch with as many samples.
+  AgvsSolver fresh(walled, *walled_caster, cells, quiet(AgvsMethod::kAgvs, 120000));
+  fresh.run();
+  EXPECT_EQ(across(fresh.pvs()), 0u);
+  EXPECT_NEAR(solver.mean_pvs(), fresh.mean_pvs(), 0.15 * fresh.mean_pvs());
+
+  // Delete the wall: it leaves every PVS, and resumed sampling sees across again.
+  std::vector<uint32_t> without(n + 1);
+  for (uint32_t o = 0; o <= n; ++o) without[o] = o < n ? o : kNoObject;
+  const AgvsEditStats del = solver.edit(scene, *caster, without);
+  EXPECT_EQ(del.deleted, 1u);
+  EXPECT_EQ(del.removed_deleted, cells_seeing_wall);
+  EXPECT_EQ(solver.pvs().object_count(), n);
+  solver.set_limits(240000, 0, 0);
+  solver.run();
+  EXPECT_GT(across(solver.pvs()), across_before / 2) << "the view across the middle is found again";
+
+  // A map that is not one-to-one is refused and changes nothing.
+  std::vector<uint32_t> twice(n, 0);
+  const uint64_t entries = solver.pvs().entries();
+  EXPECT_THROW(solver.edit(scene, *caster, twice), Error);
+  EXPECT_EQ(solver.pvs().entries(), entries);
+}
+
+TEST(Agvs, MatchObjectsByNameAndGeometry) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
+  const Scene walled = with_box(scene, Box3({0, 0, 0}, {1, 1, 1}), "inserted");
+  const std::vector<uint32_t> m = match_objects(scene, walled);
+  ASSERT_EQ(m.size(), scene.object_count());
+  for (uint32_t o = 0; o < m.size(); ++o) EXPECT_EQ(m[o], o);
+  const std::vector<uint32_t> back = match_objects(walled, scene);
+  EXPECT_EQ(back.back(), kNoObject) << "the box was deleted";
+  // A moved object is a deletion and an insertion.
+  Scene moved = scene;
+  for (uint32_t t = 0; t < moved.triangles.size(); ++t)
+    if (moved.triangle_object[t] == 3)
+      for (uint32_t v : moved.triangles[t]) moved.vertices[v].z += 0.0;
+  moved.vertices[moved.triangles[std::find(moved.triangle_object.begin(), moved.triangle_object.end(), 3u) -
+                                 moved.triangle_object.begin()][0]]
+      .z += 0.25;
+  moved.finalize();
+  EXPECT_EQ(match_objects(scene, moved)[3], kNoObject);
+}
+
+TEST(Agvs, VisibilityFilterExtendsUndersampledPvss) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 2, 3});
+  const CellLocator cells = office_cells(scene, 30);
+  const auto caster = make_embree_caster(scene);
+  AgvsConfig config = quiet(AgvsMethod::kAgvs, 600);
+  config.batch_size = 200;
+  config.filter_statistics = true;
+  AgvsSolver solver(scene, *caster, cells, config);
+  solver.run();
+  EXPECT_THROW(AgvsSolver(scene, *caster, cells, quiet(AgvsMethod::kAgvs, 10)).filtered_pvs({}), Error)
+      << "the object space filter needs the statistics";
+  auto as_pvs = [&](const std::vector<std::vector<uint32_t>>& lists) {
+    GlobalPvs p(cells.cell_count(), static_cast<uint32_t>(scene.object_count()));
+    for (uint32_t c = 0; c < lists.size(); ++c)
+      for (uint32_t o : lists[c]) p.insert(c, o);
+    return p;
+  };
+  const GlobalPvs raw = solver.pvs();
+  VisibilityFilter f;
+  f.k = 0;
+  const GlobalPvs k0 = as_pvs(solver.filtered_pvs(f));
+  f.k = 1;
+  const GlobalPvs k1 = as_pvs(solver.filtered_pvs(f));
+  f.k = 4;
+  const GlobalPvs k4 = as_pvs(solver.filtered_pvs(f));
+  f.view_neighbours = 2;
+  const GlobalPvs k4v = as_pvs(solver.filtered_pvs(f));
+  // Supersets, growing with k and with the view space filter.
+  for (uint32_t c = 0; c < cells.cell_count(); ++c)
+    for (uint32_t o = 0; o < scene.object_count(); ++o) {
+      if (raw.contains(c, o)) EXPECT_TRUE(k0.contains(c, o));
+      if (k0.contains(c, o)) EXPECT_TRUE(k1.contains(c, o));
+      if (k1.contains(c, o)) EXPECT_TRUE(k4.contains(c, o));
+      if (k4.contains(c, o)) EXPECT_TRUE(k4v.contains(c, o));
+    }
+  EXPECT_GT(k4.entries(), k1.entries());
+  EXPECT_GT(k4v.entries(), k4.entries());
+  // Undersampled: the filter removes wrong pixels (the paper's figure 1).
+  const auto error = [&](const GlobalPvs& p) {
+    return measure_pixel_error(scene, *caster, cells, p, 40, 64, 64, 90, 5, true).pixels;
+  };
+  const double e_raw = error(raw), e_k1 = error(k1);
+  EXPECT_GT(e_raw, 0.0);
+  EXPECT_LT(e_k1, 0.5 * e_raw);
+  // Dense sampling shrinks the extension: more samples, a smaller relative growth.
+  AgvsConfig dense = config;
+  dense.max_samples = 200000;
+  AgvsSolver more(scene, *caster, cells, dense);
+  more.run();
+  f = VisibilityFilter{};
+  const double growth_sparse = static_cast<double>(k1.entries()) / raw.entries();
+  const double growth_dense = static_cast<double>(as_pvs(more.filtered_pvs(f)).entries()) / more.pvs().entries();
+  EXPECT_LT(growth_dense, growth_sparse);
+  // The filter is the same for any thread count.
+  {
+    ThreadLimit one(1);
+    EXPECT_TRUE(as_pvs(solver.filtered_pvs(f)) == k1);
+  }
 }
 
 }  // namespace

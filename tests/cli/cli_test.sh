@@ -178,6 +178,65 @@ expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 40000 
 cmp -s resumed.pvs agvs.pvs && ok || bad "20000 samples resumed to 40000 differ from 40000 in one run"
 expect_error "another scene or other view cells" "$VC" pvs office.vcells --scene office.obj --cells 8 --samples 10 \
   --resume half.vagvs -o x.pvs
+# The visibility filter: the written PVSs are supersets of the sampled ones.
+expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 2000 --batch 500 --filter --filter-neighbours 1 \
+  -o filtered.pvs --report filtered.json -q
+python3 -c "
+import json; r=json.load(open('filtered.json'))
+f = r['filter']
+assert r['effects']['visibility_filter']['enabled'] and f['object_space'] and f['view_neighbours'] == 1, r['filter']
+assert f['mean_pvs_size_filtered'] == r['mean_pvs_size_written'] > r['mean_pvs_size'] == f['mean_pvs_size_unfiltered'], f
+" && ok || bad "pvs --filter report"
+expect_ok "$VC" query filtered.pvs 2 2 1.5
+expect_error "--filter" "$VC" pvs office.vcells --scene office.obj --samples 10 --filter-k 2 -o x.pvs
+expect_error "without the filter" "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 40000 \
+  --resume half.vagvs --filter -o x.pvs
+# Dynamic edits: a wall inserted into the scene (an OBJ group appended), then the wall deleted.
+python3 - <<'PY'
+xs, ys, zs = [], [], []
+for line in open("office.obj"):
+    if line.startswith("v "):
+        x, y, z = map(float, line.split()[1:4]); xs.append(x); ys.append(y); zs.append(z)
+mid = 0.5 * (min(xs) + max(xs))
+lo = (mid - 0.05, min(ys) - 1, min(zs) - 1); hi = (mid + 0.05, max(ys) + 1, max(zs) + 1)
+corners = [(hi[0] if k & 1 else lo[0], hi[1] if k & 2 else lo[1], hi[2] if k & 4 else lo[2]) for k in range(8)]
+quads = [(0, 4, 6, 2), (1, 3, 7, 5), (0, 1, 5, 4), (2, 6, 7, 3), (0, 2, 3, 1), (4, 5, 7, 6)]
+with open("walled.obj", "w") as f:
+    f.write(open("office.obj").read())
+    f.write("g inserted_wall\n")
+    for c in corners: f.write("v %r %r %r\n" % c)
+    for q in quads: f.write("f " + " ".join(str(i - 8) for i in q) + "\n")
+PY
+expect_ok "$VC" pvs office.vcells --scene walled.obj --edited-from office.obj --cells 16 --samples 40000 \
+  --resume half.vagvs --save walled.vagvs -o walled.pvs --report walled.json -q
+python3 -c "
+import json; r=json.load(open('walled.json')); e=r['edit']
+assert e['inserted_objects'] == 1 and e['deleted_objects'] == 0 and e['entries_in_penumbrae'] > 0, e
+" && ok || bad "pvs --edited-from report"
+# Resuming the edited state needs no second edit.
+expect_ok "$VC" pvs office.vcells --scene walled.obj --edited-from office.obj --cells 16 --samples 50000 \
+  --resume walled.vagvs -o walled2.pvs --report walled2.json -q
+[ "$(json_get walled2.json "['edit']")" = "None" ] && ok || bad "a resumed edited state was edited again"
+expect_error "needs --resume" "$VC" pvs office.vcells --scene walled.obj --edited-from office.obj --samples 10 -o x.pvs
+expect_error "fingerprints differ" "$VC" pvs office.vcells --scene walled.obj --samples 10 -o x.pvs
+python3 - <<'PY'
+# office.obj without its first group's faces: a deleted object.
+out, group, first = [], None, None
+for line in open("office.obj"):
+    if line.startswith(("g ", "o ")):
+        group = line
+        first = first or line
+    if line.startswith("f ") and group == first:
+        continue
+    out.append(line)
+open("fewer.obj", "w").write("".join(out))
+PY
+expect_ok "$VC" pvs office.vcells --scene fewer.obj --edited-from office.obj --cells 16 --samples 40000 \
+  --resume half.vagvs -o fewer.pvs --report fewer.json -q
+python3 -c "
+import json; r=json.load(open('fewer.json')); e=r['edit']
+assert e['deleted_objects'] == 1 and e['inserted_objects'] == 0 and e['entries_of_deleted_objects'] > 0, e
+" && ok || bad "pvs --edited-from with a deleted object"
 expect_error "give when to stop" "$VC" pvs office.vcells --scene office.obj -o x.pvs
 expect_error "fingerprints differ" "$VC" pvs office.vcells --scene city.obj --samples 10 -o x.pvs
 expect_error "unknown PVS method" "$VC" pvs office.vcells --scene office.obj --samples 10 --method fast -o x.pvs

@@ -14,6 +14,8 @@
 #include <optional>
 #include <set>
 
+#include "viewcells/agvs/penumbra.h"
+#include "viewcells/bsp/adjacency.h"
 #include "viewcells/core/error.h"
 #include "viewcells/io/binary_file.h"
 #include "viewcells/core/progress.h"
@@ -56,6 +58,26 @@ void CellLocator::cells_of_segment(const Vec3& a, const Vec3& b, std::vector<int
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }
 
+std::vector<std::vector<uint32_t>> CellLocator::neighbours() const {
+  std::vector<std::vector<uint32_t>> out(cell_count_);
+  // The leaves' convex cells (a BSP read from a file has none), replayed from the view box.
+  Subdivision with_cells = bsp_;
+  with_cells.cells.assign(bsp_.nodes.size(), ConvexPolyhedron());
+  clip_to_leaves(bsp_, ConvexPolyhedron::box(bsp_.view_box, 0),
+                 [&](int32_t n, const ConvexPolyhedron& part) { with_cells.cells[n] = part; });
+  for (const LeafAdjacency& a : leaf_adjacency(with_cells)) {
+    const int32_t ca = leaf_cell_[a.a], cb = leaf_cell_[a.b];
+    if (ca == cb) continue;
+    out[ca].push_back(static_cast<uint32_t>(cb));
+    out[cb].push_back(static_cast<uint32_t>(ca));
+  }
+  for (auto& list : out) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return out;
+}
+
 GlobalPvs::GlobalPvs(uint32_t cells, uint32_t objects)
     : cells_(cells), objects_(objects), words_((objects + 63) / 64), bits_(size_t(cells) * words_, 0), sizes_(cells, 0) {}
 
@@ -69,6 +91,16 @@ bool GlobalPvs::insert(uint32_t cell, uint32_t object) {
   return true;
 }
 
+bool GlobalPvs::erase(uint32_t cell, uint32_t object) {
+  uint64_t& w = bits_[size_t(cell) * words_ + object / 64];
+  const uint64_t bit = uint64_t{1} << (object % 64);
+  if (!(w & bit)) return false;
+  w &= ~bit;
+  --sizes_[cell];
+  --entries_;
+  return true;
+}
+
 std::vector<uint32_t> GlobalPvs::list(uint32_t cell) const {
   std::vector<uint32_t> out;
   out.reserve(sizes_[cell]);
@@ -79,7 +111,7 @@ std::vector<uint32_t> GlobalPvs::list(uint32_t cell) const {
 }
 
 uint32_t contribute(GlobalPvs& pvs, const std::vector<int32_t>& cells, uint32_t object_a, uint32_t object_b,
-                    bool contributed[2], int32_t origin_cell, bool* at_origin) {
+                    bool contributed[2], int32_t origin_cell, bool at_origin[2]) {
   const uint32_t objs[2] = {object_a, object_b};
   uint32_t gain = 0;
   for (int32_t cell : cells)
@@ -88,8 +120,10 @@ uint32_t contribute(GlobalPvs& pvs, const std::vector<int32_t>& cells, uint32_t 
       if (!pvs.insert(static_cast<uint32_t>(cell), objs[e])) continue;
       ++gain;
       if (contributed) contributed[e] = true;
-      if (at_origin && cell == origin_cell) *at_origin = true;
+      if (at_origin && cell == origin_cell) at_origin[e] = true;
     }
+  // Both ends see the same object: both rays were wrong pixels before.
+  if (at_origin && objs[0] == objs[1] && objs[0] != kNoObject) at_origin[1] = at_origin[0];
   return gain;
 }
 
@@ -119,6 +153,32 @@ const char* to_string(AgvsDistribution d) {
     case AgvsDistribution::kCount: break;
   }
   return "?";
+}
+
+std::vector<uint32_t> match_objects(const Scene& before, const Scene& after) {
+  // Per object: its name and a hash of its triangles' corner coordinates, in order.
+  auto keys = [](const Scene& s) {
+    std::vector<ByteWriter> geometry(s.object_count());
+    for (uint32_t t = 0; t < s.triangles.size(); ++t)
+      for (uint32_t v : s.triangles[t]) geometry[s.triangle_object[t]].put(s.vertices[v]);
+    std::vector<std::pair<std::string, uint64_t>> out;
+    for (uint32_t o = 0; o < s.object_count(); ++o) out.emplace_back(s.objects[o].name, fnv1a64(geometry[o].data()));
+    return out;
+  };
+  std::multimap<std::pair<std::string, uint64_t>, uint32_t> free;
+  const auto after_keys = keys(after);
+  for (uint32_t o = 0; o < after_keys.size(); ++o) free.emplace(after_keys[o], o);
+  std::vector<uint32_t> new_of_old;
+  for (const auto& key : keys(before)) {
+    const auto it = free.find(key);  // the first among equals: multimap keeps insertion order
+    if (it == free.end()) {
+      new_of_old.push_back(kNoObject);
+    } else {
+      new_of_old.push_back(it->second);
+      free.erase(it);
+    }
+  }
+  return new_of_old;
 }
 
 // ------------------------------------------------------------------------------ the solver
@@ -159,6 +219,64 @@ Vec3 sphere_direction(double u1, double u2) {
   const double sin_theta = std::sqrt(std::max(0.0, 1 - cos_theta * cos_theta));
   return {sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta};
 }
+
+/// Bounding boxes in a median-split tree: which boxes touch a query box.
+class BoxTree {
+ public:
+  explicit BoxTree(std::vector<std::pair<Box3, uint32_t>> items) : items_(std::move(items)) {
+    if (items_.empty()) return;
+    nodes_.resize(1);
+    build(0, 0, static_cast<uint32_t>(items_.size()), 0);
+  }
+  void query(const Box3& q, std::vector<uint32_t>& out) const {
+    if (nodes_.empty()) return;
+    uint32_t stack[96];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+      const Node& n = nodes_[stack[--top]];
+      if (!touches(n.bounds, q)) continue;
+      if (n.left == 0) {
+        for (uint32_t i = n.first; i < n.first + n.count; ++i)
+          if (touches(items_[i].first, q)) out.push_back(items_[i].second);
+      } else {
+        stack[top++] = n.left;
+        stack[top++] = n.left + 1;
+      }
+    }
+  }
+
+ private:
+  struct Node {
+    Box3 bounds;
+    uint32_t left = 0, first = 0, count = 0;  ///< left: first child (the second follows); 0: a leaf
+  };
+  static bool touches(const Box3& a, const Box3& b) {
+    return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y && a.lo.z <= b.hi.z &&
+           b.lo.z <= a.hi.z;
+  }
+  void build(uint32_t id, uint32_t first, uint32_t last, int depth) {
+    Box3 b, centres;
+    for (uint32_t i = first; i < last; ++i) b.extend(items_[i].first), centres.extend(items_[i].first.center());
+    nodes_[id].bounds = b;
+    if (last - first <= 4 || depth >= 40) {
+      nodes_[id].first = first, nodes_[id].count = last - first;
+      return;
+    }
+    const Vec3 e = centres.extent();
+    const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+    const uint32_t mid = first + (last - first) / 2;
+    std::nth_element(items_.begin() + first, items_.begin() + mid, items_.begin() + last,
+                     [axis](const auto& p, const auto& q) { return p.first.center()[axis] < q.first.center()[axis]; });
+    const uint32_t left = static_cast<uint32_t>(nodes_.size());
+    nodes_.resize(left + 2);
+    nodes_[id].left = left;
+    build(left, first, mid, depth + 1);
+    build(left + 1, mid, last, depth + 1);
+  }
+  std::vector<std::pair<Box3, uint32_t>> items_;
+  std::vector<Node> nodes_;
+};
 
 struct Candidate {
   Vec3 origin, term;           ///< the segment's other end, and the end where the object was seen
@@ -226,11 +344,11 @@ struct CandidateBuffer {
 }  // namespace
 
 struct AgvsSolver::Impl {
-  const Scene& scene;
+  const Scene* scene_;  ///< rebound by scene edits
   const CellLocator& cells;
   AgvsConfig config;
-  const RayCaster& caster_ref;
-  SegmentCaster caster;
+  const RayCaster* caster_ref_;
+  std::unique_ptr<SegmentCaster> caster_;
   GlobalPvs pvs;
   AgvsStats stats;
   // Surface sampling: rendered objects, and each one's triangles by cumulative area.
@@ -251,28 +369,54 @@ struct AgvsSolver::Impl {
   // added an entry to the cell containing their origin.
   std::deque<std::pair<uint64_t, uint64_t>> window;
   double error = std::numeric_limits<double>::quiet_NaN();
+  /// With no wrong camera ray in the whole history kept (no estimate possible): the share's
+  /// upper bound with probability P = 0.9, in pixels. NaN otherwise.
+  double error_bound = std::numeric_limits<double>::quiet_NaN();
   double eps;  ///< offset of ray origins from surfaces
+  // The visibility filter's sampling densities (config.filter_statistics): segments through
+  // each cell, and per cell and object the segments through the cell that hit the object
+  // (saturating).
+  std::vector<uint64_t> cell_samples;
+  std::vector<uint16_t> hit_counts;
+
+  const Scene& scene() const { return *scene_; }
+  const RayCaster& caster_ref() const { return *caster_ref_; }
+  const SegmentCaster& caster() const { return *caster_; }
 
   Impl(const Scene& s, const RayCaster& rc, const CellLocator& c, const AgvsConfig& cfg)
-      : scene(s),
-        cells(c),
+      : cells(c),
         config(cfg),
-        caster_ref(rc),
-        caster(s, rc, c.view_box(), cfg.empty_space),
         pvs(c.cell_count(), static_cast<uint32_t>(s.object_count())),
         halton{Halton(cfg.seed, 11), Halton(cfg.seed, 12), Halton(cfg.seed, 13), Halton(cfg.seed, 14),
                Halton(cfg.seed, 15)} {
-    stats.empty_space = caster.empty_space();
-    eps = 1e-6 * std::max(s.bounds.diagonal(), c.view_box().diagonal());
-    triangles_of.resize(s.object_count());
+    bind(s, rc);
+    if (config.filter_statistics) {
+      cell_samples.assign(c.cell_count(), 0);
+      hit_counts.assign(size_t(c.cell_count()) * s.object_count(), 0);
+    }
+  }
+
+  /// Takes the scene and its caster: what sampling derives from them.
+  void bind(const Scene& s, const RayCaster& rc) {
+    auto segment_caster = std::make_unique<SegmentCaster>(s, rc, cells.view_box(), config.empty_space);
+    std::vector<std::vector<std::pair<double, uint32_t>>> tris(s.object_count());
     for (uint32_t t = 0; t < s.triangles.size(); ++t) {
       const double area = 0.5 * length(s.triangle_normal(t));
-      auto& list = triangles_of[s.triangle_object[t]];
+      auto& list = tris[s.triangle_object[t]];
       list.emplace_back((list.empty() ? 0.0 : list.back().first) + area, t);
     }
+    std::vector<uint32_t> sampled;
     for (uint32_t o = 0; o < s.object_count(); ++o)
-      if (s.objects[o].rendered && !triangles_of[o].empty() && triangles_of[o].back().first > 0) objects.push_back(o);
-    if (objects.empty()) throw Error("the scene has no rendered object to sample");
+      if (s.objects[o].rendered && !tris[o].empty() && tris[o].back().first > 0) sampled.push_back(o);
+    if (sampled.empty()) throw Error("the scene has no rendered object to sample");
+    scene_ = &s;
+    caster_ref_ = &rc;
+    caster_ = std::move(segment_caster);
+    stats.empty_space = caster_->empty_space();
+    eps = 1e-6 * std::max(s.bounds.diagonal(), cells.view_box().diagonal());
+    triangles_of = std::move(tris);
+    objects = std::move(sampled);
+    object_radius.clear();
     for (const ObjectInfo& o : s.objects) object_radius.push_back(0.5 * o.bounds.diagonal());
   }
 
@@ -284,6 +428,7 @@ struct AgvsSolver::Impl {
     const double target = u1 * list.back().first;
     const auto it = std::lower_bound(list.begin(), list.end(), std::make_pair(target, 0u));
     const uint32_t t = (it == list.end() ? list.back() : *it).second;
+    const Scene& scene = this->scene();
     const auto& tri = scene.triangles[t];
     const double su = std::sqrt(u2);
     const Vec3 p = scene.vertices[tri[0]] * (1 - su) + scene.vertices[tri[1]] * (su * (1 - u3)) +
@@ -382,7 +527,7 @@ struct AgvsSolver::Impl {
       auto hits_object = [&](double lambda) {
         const Vec3 target = at + d * (lambda * radius);
         // From just off `from`, which may lie on a surface itself.
-        const Hit h = caster_ref.intersect(Ray{from, target - from, 1e-6, 1.0 + 1e-6});
+        const Hit h = caster_ref().intersect(Ray{from, target - from, 1e-6, 1.0 + 1e-6});
         ++discovery_rays;
         return h.hit() && h.object == object;
       };
@@ -403,7 +548,7 @@ struct AgvsSolver::Impl {
     points_out[n] = (c.origin + moved) * 0.5;
     dirs_out[n++] = normalize(dir);
     // Depth discontinuity: where does the silhouette ray really end?
-    const Hit h = caster_ref.intersect(Ray{c.origin, normalize(dir), eps});
+    const Hit h = caster_ref().intersect(Ray{c.origin, normalize(dir), eps});
     ++discovery_rays;
     constexpr double kDepthJump = 3.0;  // the paper's k
     if (h.hit()) {
@@ -418,6 +563,19 @@ struct AgvsSolver::Impl {
       }
     }
     return n;
+  }
+
+  /// The filter's densities: one more segment through `cell`, hitting objects a and b.
+  void count_hits(int32_t cell, uint32_t a, uint32_t b) {
+    ++cell_samples[cell];
+    const size_t row = size_t(cell) * pvs.object_count();
+    auto bump = [&](uint32_t o) {
+      if (o == kNoObject) return;
+      uint16_t& h = hit_counts[row + o];
+      if (h < std::numeric_limits<uint16_t>::max()) ++h;
+    };
+    bump(a);
+    if (b != a) bump(b);
   }
 
   /// Radius of what lies at a segment end: its object, or else the view cell there.
@@ -534,7 +692,7 @@ struct AgvsSolver::Impl {
       }
     tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
       Chunk& c = chunks[k];
-      c.rays = caster.cast(std::span<const Vec3>(points.data() + c.first, c.size),
+      c.rays = caster().cast(std::span<const Vec3>(points.data() + c.first, c.size),
                            std::span<const Vec3>(dirs.data() + c.first, c.size), c.segs, c.sample_of);
     });
     // The cells of every segment, in parallel.
@@ -554,7 +712,9 @@ struct AgvsSolver::Impl {
     uint64_t dist_contribution[kDists] = {}, dist_rays[kDists] = {};
     dist_rays[kSil] += discovery_rays;
     uint64_t vsd_rays = 0, vsd_contributing = 0;
-    std::vector<uint32_t> sample_new_at_origin(count, 0);
+    // The estimator's camera rays per sample (0 when the sample's point is inside a solid: no
+    // camera stands there) and those that were wrong pixels (an entry new to the point's cell).
+    std::vector<uint8_t> camera_rays(count, 0), wrong_rays(count, 0);
     std::vector<int32_t> origin_cell(count, -2);
     for (size_t k = 0; k < chunks.size(); ++k) {
       const Chunk& c = chunks[k];
@@ -564,28 +724,37 @@ struct AgvsSolver::Impl {
         const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
         bool contributed[2] = {false, false};
         uint64_t gain = 0;
-        if (config.method == AgvsMethod::kRef) {
-          // Per cell: the object hit forward from the sample's point, for its cell only, when
-          // the point is on this segment (not inside a solid, whose re-casts start elsewhere).
+        // Whether the sample's point lies on this segment: its own segment (re-casts of points
+        // inside solids start elsewhere; see-through companions are the first one's).
+        auto on_segment = [&] {
           const Vec3 a = c.segs.a(i), ab = c.segs.b(i) - a;
           const double t = dot(points[sample] - a, ab);
+          return t >= 0 && t <= dot(ab, ab);
+        };
+        if (config.method == AgvsMethod::kRef) {
+          // Per cell: the object hit forward from the sample's point, for its cell only; one
+          // camera ray, counted once per sample.
           const uint32_t o = objs[1];
-          if (o != kNoObject && t >= 0 && t <= dot(ab, ab) &&
-              pvs.insert(static_cast<uint32_t>(ref_cell[sample]), o)) {
-            ++gain;
-            sample_new_at_origin[sample] = 1;
+          if (camera_rays[sample] == 0 && on_segment()) {
+            camera_rays[sample] = 1;
+            if (config.filter_statistics) count_hits(ref_cell[sample], o, kNoObject);
+            if (o != kNoObject && pvs.insert(static_cast<uint32_t>(ref_cell[sample]), o)) {
+              ++gain;
+              wrong_rays[sample] = 1;
+            }
           }
         } else {
-          if (c.dist == kVsd && origin_cell[sample] == -2) origin_cell[sample] = cells.cell_at(points[sample]);
-          bool at_origin = false;
-          gain = contribute(pvs, seg_cells[chunk_start[k] + i], objs[0], objs[1], contributed, origin_cell[sample],
-                            &at_origin);
-          // The estimator's ray: the sample's own segment through its point (a camera there);
-          // re-cast segments of points inside solids are not what a camera would see.
-          if (at_origin && c.dist == kVsd) {
-            const Vec3 a = c.segs.a(i), ab = c.segs.b(i) - a;
-            const double t = dot(points[sample] - a, ab);
-            if (t >= 0 && t <= dot(ab, ab)) sample_new_at_origin[sample] = 1;
+          const bool own = c.dist == kVsd && camera_rays[sample] == 0 && on_segment();
+          if (own && origin_cell[sample] == -2) origin_cell[sample] = cells.cell_at(points[sample]);
+          bool at_origin[2] = {false, false};
+          const std::vector<int32_t>& pierced = seg_cells[chunk_start[k] + i];
+          gain = contribute(pvs, pierced, objs[0], objs[1], contributed, own ? origin_cell[sample] : -1, at_origin);
+          if (config.filter_statistics)
+            for (int32_t cell : pierced) count_hits(cell, objs[0], objs[1]);
+          // The estimator's rays: a camera at the point sees along both rays of its segment.
+          if (own) {
+            camera_rays[sample] = 2;
+            wrong_rays[sample] = static_cast<uint8_t>(at_origin[0] + at_origin[1]);
           }
         }
         dist_contribution[c.dist] += gain;
@@ -603,8 +772,8 @@ struct AgvsSolver::Impl {
     }
     // The estimator counts view space-direction samples (all of them for SGVS and REF).
     for (uint32_t s = first_of[kVsd]; s < end_of[kVsd]; ++s) {
-      ++vsd_rays;
-      vsd_contributing += sample_new_at_origin[s];
+      vsd_rays += camera_rays[s];
+      vsd_contributing += wrong_rays[s];
     }
     // Weights for the next batch: contribution per ray, over the recent batches (each batch
     // counts half as much as the one after it: small contributions are noisy).
@@ -624,26 +793,36 @@ struct AgvsSolver::Impl {
     update_estimate(vsd_rays, vsd_contributing);
   }
 
-  /// Equation 5: the window holds the most recent batches whose view space-direction rays
-  /// number at least (1 - e) / (k^2 e (1 - P)), e the contributing share over them.
-  void update_estimate(uint64_t rays, uint64_t contributing) {
-    window.emplace_front(rays, contributing);
+  /// Equation 5: the window holds the most recent batches whose camera rays (view
+  /// space-direction rays from free space) number at least (1 - e) / (k^2 e (1 - P)), e the
+  /// wrong share over them.
+  void update_estimate(uint64_t rays, uint64_t wrong) {
+    window.emplace_front(rays, wrong);
+    evaluate_window();
+  }
+
+  void evaluate_window() {
     uint64_t n = 0, nc = 0;
     size_t used = 0;
-    error = std::numeric_limits<double>::quiet_NaN();
+    error = error_bound = std::numeric_limits<double>::quiet_NaN();
+    stats.window_rays = 0;
     for (const auto& [r, c] : window) {
       n += r;
       nc += c;
       ++used;
-      if (n == 0) continue;
-      // With no contributing ray yet, e is at most about 1 / n.
-      const double e = nc ? static_cast<double>(nc) / static_cast<double>(n) : 1.0 / static_cast<double>(n);
+      if (nc == 0) continue;  // e = 0 would need an infinite window
+      const double e = static_cast<double>(nc) / static_cast<double>(n);
       const double need = (1 - e) / (config.window_k * config.window_k * e * (1 - config.window_p));
       if (static_cast<double>(n) >= need) {
-        error = config.resolution * static_cast<double>(nc) / static_cast<double>(n);
-        stats.window_samples = n;
+        error = config.resolution * e;
+        stats.window_rays = n;
         break;
       }
+    }
+    if (std::isnan(error) && nc == 0 && n > 0) {
+      // No wrong ray in all the history kept: with probability 0.9 the share is below
+      // ln(10) / n (the binomial's bound for zero successes).
+      error_bound = config.resolution * std::log(10.0) / static_cast<double>(n);
     }
     window.resize(std::min(window.size(), std::max<size_t>(used, 1)));
     // Keep what a smaller error would need: the whole history up to a bound.
@@ -651,6 +830,133 @@ struct AgvsSolver::Impl {
   }
 
   double mean_pvs() const { return static_cast<double>(pvs.entries()) / cells.cell_count(); }
+
+  AgvsEditStats edit(const Scene& edited, const RayCaster& rc, const std::vector<uint32_t>& new_of_old) {
+    const uint32_t old_n = pvs.object_count(), new_n = static_cast<uint32_t>(edited.object_count());
+    if (new_of_old.size() != old_n)
+      throw Error("the edit maps " + std::to_string(new_of_old.size()) + " objects, the solution has " +
+                  std::to_string(old_n));
+    AgvsEditStats st;
+    std::vector<char> kept(new_n, 0);
+    for (uint32_t m : new_of_old) {
+      if (m == kNoObject) {
+        ++st.deleted;
+        continue;
+      }
+      if (m >= new_n || kept[m]) throw Error("the edit's object map is not one-to-one");
+      kept[m] = 1;
+    }
+    std::vector<uint32_t> inserted;
+    for (uint32_t o = 0; o < new_n; ++o)
+      if (!kept[o]) inserted.push_back(o);
+    st.inserted = static_cast<uint32_t>(inserted.size());
+    bind(edited, rc);  // the only step that may throw; it changes nothing before it succeeds
+    // The solution over the new objects, without the deleted ones.
+    GlobalPvs next(cells.cell_count(), new_n);
+    std::vector<uint16_t> next_hits;
+    if (config.filter_statistics) next_hits.assign(size_t(cells.cell_count()) * new_n, 0);
+    for (uint32_t c = 0; c < cells.cell_count(); ++c) {
+      for (uint32_t o : pvs.list(c)) {
+        if (new_of_old[o] == kNoObject) ++st.removed_deleted;
+        else next.insert(c, new_of_old[o]);
+      }
+      if (config.filter_statistics)
+        for (uint32_t o = 0; o < old_n; ++o)
+          if (new_of_old[o] != kNoObject)
+            next_hits[size_t(c) * new_n + new_of_old[o]] = hit_counts[size_t(c) * old_n + o];
+    }
+    // Inserted objects: what they may hide from each cell leaves its PVS.
+    const Scene& sc = scene();
+    Box3 all = sc.bounds;
+    all.extend(cells.view_box());
+    const double reach = all.diagonal();
+    std::vector<std::vector<Vec3>> vertices_of(new_n);
+    for (uint32_t t = 0; t < sc.triangles.size(); ++t)
+      if (!kept[sc.triangle_object[t]])
+        for (uint32_t v : sc.triangles[t]) vertices_of[sc.triangle_object[t]].push_back(sc.vertices[v]);
+    for (uint32_t o : inserted) {
+      if (vertices_of[o].empty() || !sc.objects[o].occluder) continue;  // hides nothing
+      const std::vector<Vec3> hull = convex_hull_vertices(vertices_of[o]);
+      std::vector<std::vector<uint32_t>> removed(cells.cell_count());
+      std::vector<char> cleared(cells.cell_count(), 0);
+      tbb::parallel_for(uint32_t{0}, cells.cell_count(), [&](uint32_t c) {
+        const ConvexRegion shadow = penumbra(hull, cells.cell_bounds(c), reach);
+        cleared[c] = shadow.is_everything();
+        for (uint32_t e : next.list(c))
+          if (shadow.may_intersect(sc.objects[e].bounds)) removed[c].push_back(e);
+      });
+      for (uint32_t c = 0; c < cells.cell_count(); ++c) {
+        st.cells_cleared += cleared[c];
+        for (uint32_t e : removed[c]) st.removed_penumbra += next.erase(c, e);
+      }
+    }
+    pvs = std::move(next);
+    hit_counts = std::move(next_hits);
+    // Mutation candidates keep their segments; their objects follow the map.
+    for (CandidateBuffer* b : {&two_point, &silhouette})
+      for (auto& [id, cand] : b->candidates)
+        if (cand.object != kNoObject) cand.object = new_of_old[cand.object];
+    // The estimator's rays described the old scene.
+    window.clear();
+    evaluate_window();
+    return st;
+  }
+
+  std::vector<std::vector<uint32_t>> filtered(const VisibilityFilter& f) const {
+    const uint32_t n_cells = cells.cell_count(), n_obj = pvs.object_count();
+    if (f.object_space && !config.filter_statistics)
+      throw Error("the object space filter needs the sampling densities (AgvsConfig::filter_statistics)");
+    if (!(f.k >= 0) || !std::isfinite(f.k)) throw Error("the filter factor k must be finite and >= 0");
+    const Scene& sc = scene();
+    std::vector<std::vector<uint32_t>> out(n_cells);
+    std::vector<std::pair<Box3, uint32_t>> boxes;
+    for (uint32_t o = 0; o < n_obj; ++o)
+      if (sc.objects[o].rendered && sc.objects[o].triangle_count > 0) boxes.emplace_back(sc.objects[o].bounds, o);
+    const BoxTree tree(std::move(boxes));
+    tbb::parallel_for(uint32_t{0}, n_cells, [&](uint32_t c) {
+      std::vector<uint32_t> list = pvs.list(c);
+      if (f.object_space) {
+        const double n_v = static_cast<double>(cell_samples[c]);
+        const Box3& cb = cells.cell_bounds(c);
+        std::vector<uint32_t> found;
+        for (uint32_t o : pvs.list(c)) {
+          const Box3& ob = sc.objects[o].bounds;
+          const double hits = hit_counts[size_t(c) * n_obj + o];
+          const double e_g = n_v > 0 ? 2 * box_distance(cb, ob) / std::sqrt(n_v) : 0.0;
+          const double e_l = hits > 0 ? object_radius[o] / std::sqrt(hits) : e_g;
+          const double e = f.k * std::min(e_g, e_l);
+          tree.query(Box3(ob.lo - Vec3{e, e, e}, ob.hi + Vec3{e, e, e}), found);
+        }
+        list.insert(list.end(), found.begin(), found.end());
+        std::sort(list.begin(), list.end());
+        list.erase(std::unique(list.begin(), list.end()), list.end());
+      }
+      out[c] = std::move(list);
+    });
+    if (f.view_neighbours > 0) {
+      // Merge with the most similar neighbours (by the object space result, Jaccard).
+      const auto near = cells.neighbours();
+      std::vector<std::vector<uint32_t>> merged(n_cells);
+      tbb::parallel_for(uint32_t{0}, n_cells, [&](uint32_t c) {
+        std::vector<std::pair<double, uint32_t>> ranked;
+        for (uint32_t nb : near[c]) {
+          std::vector<uint32_t> common;
+          std::set_intersection(out[c].begin(), out[c].end(), out[nb].begin(), out[nb].end(), std::back_inserter(common));
+          const double uni = static_cast<double>(out[c].size() + out[nb].size() - common.size());
+          ranked.emplace_back(uni > 0 ? -static_cast<double>(common.size()) / uni : 0.0, nb);  // most similar first
+        }
+        std::sort(ranked.begin(), ranked.end());
+        std::vector<uint32_t> list = out[c];
+        for (size_t k = 0; k < ranked.size() && k < f.view_neighbours; ++k)
+          list.insert(list.end(), out[ranked[k].second].begin(), out[ranked[k].second].end());
+        std::sort(list.begin(), list.end());
+        list.erase(std::unique(list.begin(), list.end()), list.end());
+        merged[c] = std::move(list);
+      });
+      out = std::move(merged);
+    }
+    return out;
+  }
 };
 
 PixelErrorMeasure measure_pixel_error(const Scene& scene, const RayCaster& caster, const CellLocator& cells,
@@ -746,18 +1052,23 @@ void AgvsSolver::run() {
       m.stats.stop_reason = "estimated pixel error at most " + std::to_string(c.pixel_error);
       break;
     }
+    if (c.pixel_error > 0 && !std::isnan(m.error_bound) && m.error_bound <= c.pixel_error) {
+      m.stats.stop_reason = "no wrong camera ray seen: pixel error below " + std::to_string(c.pixel_error) +
+                            " with probability 0.9";
+      break;
+    }
     const uint64_t done = m.stats.samples;
     m.batch(m.stats.batches, c.batch_size);
     if (show) progress->advance(m.stats.samples - done);
     m.stats.seconds = before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    m.stats.curve.push_back({m.stats.seconds, m.stats.samples, m.stats.rays, m.mean_pvs(), m.error});
+    m.stats.curve.push_back({m.stats.seconds, m.stats.samples, m.stats.rays, m.mean_pvs(), m.error, m.error_bound});
   }
   if (show) progress->finish();
 }
 
 namespace {
 constexpr char kStateMagic[5] = "VAGS";
-constexpr uint32_t kStateVersion = 2;
+constexpr uint32_t kStateVersion = 3;
 }  // namespace
 
 void GlobalPvs::save(ByteWriter& w) const {
@@ -795,7 +1106,7 @@ void AgvsSolver::save(const std::string& path, uint64_t identity) const {
   w.put(m.config.batch_size);
   m.pvs.save(w);
   const AgvsStats& s = m.stats;
-  w.put(s.samples), w.put(s.rays), w.put(s.batches), w.put(s.seconds), w.put(s.window_samples);
+  w.put(s.samples), w.put(s.rays), w.put(s.batches), w.put(s.seconds), w.put(s.window_rays);
   for (int d = 0; d < kDists; ++d) {
     w.put(s.dist_samples[d]), w.put(s.dist_rays[d]), w.put(s.dist_contribution[d]), w.put(s.dist_probability[d]);
     w.put(m.halton_index[d]), w.put(m.weight[d]), w.put(m.recent_contribution[d]), w.put(m.recent_rays[d]);
@@ -809,7 +1120,19 @@ void AgvsSolver::save(const std::string& path, uint64_t identity) const {
   for (const auto& [n, nc] : m.window) w.put(n), w.put(nc);
   w.put<uint64_t>(s.curve.size());
   for (const AgvsPoint& p : s.curve) w.put(p);
+  w.put(static_cast<uint8_t>(m.config.filter_statistics));
+  if (m.config.filter_statistics) {
+    w.put_array(m.cell_samples);
+    w.put_array(m.hit_counts);
+  }
   write_container(path, kStateMagic, kStateVersion, w.data());
+}
+
+uint64_t AgvsSolver::state_identity(const std::string& path) {
+  uint32_t version = 0;
+  const std::string payload = read_container(path, kStateMagic, kStateVersion, version);
+  ByteReader r(payload, path);
+  return r.get<uint64_t>();
 }
 
 void AgvsSolver::load(const std::string& path, uint64_t identity) {
@@ -827,7 +1150,7 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   GlobalPvs pvs = GlobalPvs::load(r, m.pvs.cell_count(), m.pvs.object_count());
   AgvsStats s = m.stats;
   s.samples = r.get<uint64_t>(), s.rays = r.get<uint64_t>(), s.batches = r.get<uint64_t>();
-  s.seconds = r.get<double>(), s.window_samples = r.get<uint64_t>();
+  s.seconds = r.get<double>(), s.window_rays = r.get<uint64_t>();
   uint64_t halton[kDists];
   double weight[kDists], recent_c[kDists], recent_r[kDists];
   for (int d = 0; d < kDists; ++d) {
@@ -851,6 +1174,18 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   if (points > payload.size()) r.fail("curve too long");
   s.curve.clear();
   for (uint64_t k = 0; k < points; ++k) s.curve.push_back(r.get<AgvsPoint>());
+  const bool with_filter = r.get<uint8_t>() != 0;
+  if (with_filter != m.config.filter_statistics)
+    throw Error(path, 0, with_filter ? "this state keeps the visibility filter's statistics: resume with the filter"
+                                     : "this state has no visibility filter statistics: resume without the filter");
+  std::vector<uint64_t> cell_samples;
+  std::vector<uint16_t> hit_counts;
+  if (with_filter) {
+    r.get_array(cell_samples, m.cell_samples.size());
+    r.get_array(hit_counts, m.hit_counts.size());
+    if (cell_samples.size() != m.cell_samples.size() || hit_counts.size() != m.hit_counts.size())
+      r.fail("filter statistics of the wrong size");
+  }
   if (!r.at_end()) r.fail("trailing bytes");
   s.mutation_candidates = two_point.size();
   // Commit.
@@ -865,11 +1200,23 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   m.two_point = std::move(two_point);
   m.silhouette = std::move(silhouette);
   m.window = std::move(window);
+  m.cell_samples = std::move(cell_samples);
+  m.hit_counts = std::move(hit_counts);
+  m.evaluate_window();
+}
+
+AgvsEditStats AgvsSolver::edit(const Scene& edited, const RayCaster& caster, const std::vector<uint32_t>& new_of_old) {
+  return impl_->edit(edited, caster, new_of_old);
+}
+
+std::vector<std::vector<uint32_t>> AgvsSolver::filtered_pvs(const VisibilityFilter& filter) const {
+  return impl_->filtered(filter);
 }
 
 const GlobalPvs& AgvsSolver::pvs() const { return impl_->pvs; }
 const AgvsStats& AgvsSolver::stats() const { return impl_->stats; }
 double AgvsSolver::pixel_error() const { return impl_->error; }
+double AgvsSolver::pixel_error_bound() const { return impl_->error_bound; }
 double AgvsSolver::mean_pvs() const { return impl_->mean_pvs(); }
 
 }  // namespace viewcells

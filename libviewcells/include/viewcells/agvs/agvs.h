@@ -12,7 +12,9 @@
 /// the ray, not the second (the paper measures time): rays dominate the cost, and wall-clock
 /// weights would make results depend on the machine and the thread count.
 ///
-/// Not yet here: the visibility filter and dynamic edits.
+/// Also here: the visibility filter (section 5: PVSs extended by objects likely visible given
+/// the sampling density) and dynamic edits (section 6: objects deleted and inserted, the
+/// solution repaired, sampling resumed).
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -44,6 +46,8 @@ class CellLocator {
                         std::vector<std::tuple<int32_t, double, double>>& stack,
                         std::vector<int32_t>& leaves) const;
   const Box3& cell_bounds(uint32_t c) const { return bounds_[c]; }
+  /// Per cell, the cells sharing a part of its boundary of positive area, sorted.
+  std::vector<std::vector<uint32_t>> neighbours() const;
   double cell_volume(uint32_t c) const { return volume_[c]; }
 
  private:
@@ -66,6 +70,8 @@ class GlobalPvs {
   }
   /// Adds the entry; true when it is new.
   bool insert(uint32_t cell, uint32_t object);
+  /// Removes the entry (dynamic edits only); true when it was there.
+  bool erase(uint32_t cell, uint32_t object);
   uint32_t size(uint32_t cell) const { return sizes_[cell]; }
   uint64_t entries() const { return entries_; }
   std::vector<uint32_t> list(uint32_t cell) const;  ///< sorted object ids
@@ -84,10 +90,11 @@ class GlobalPvs {
 
 /// Adds a visibility sample's objects (kNoObject: none) to the PVS of every cell in `cells`
 /// (those its segment pierces) and returns its contribution there, equation 2: the number of
-/// new entries. contributed[e] tells whether end e's object added one; at_origin whether an
-/// entry went to `origin_cell` (the pixel error estimator's contributing ray).
+/// new entries. contributed[e] tells whether end e's object added one, at_origin[e] whether
+/// it added one to `origin_cell` (the ray from the sample's point towards end e was a wrong
+/// pixel of a camera there: the pixel error estimator's contributing ray).
 uint32_t contribute(GlobalPvs& pvs, const std::vector<int32_t>& cells, uint32_t object_a, uint32_t object_b,
-                    bool contributed[2] = nullptr, int32_t origin_cell = -1, bool* at_origin = nullptr);
+                    bool contributed[2] = nullptr, int32_t origin_cell = -1, bool at_origin[2] = nullptr);
 
 enum class AgvsMethod {
   kAgvs,  ///< the adaptive mixture of every distribution
@@ -128,8 +135,38 @@ struct AgvsConfig {
   /// weight: the pixel error estimator needs its rays, and it guarantees progress everywhere.
   double min_share = 0.05;
   EmptySpaceMode empty_space = EmptySpaceMode::kAuto;
+  /// Keep the visibility filter's sampling densities (segments per cell; per cell and object,
+  /// those that hit it: 2 bytes per cell and object). Required by the object space filter.
+  bool filter_statistics = false;
   bool show_progress = true;
 };
+
+/// The visibility filter (paper section 5), applied to a copy of the PVSs (sampling goes on
+/// with the unfiltered ones). Object space: each object o of a cell's PVS has its bounding box
+/// extended by e(o) = k min(e_g(o), e_l(o)), e_g = 2 d(o) / sqrt(n_v) (d: distance between the
+/// cell's and the object's bounds, n_v: segments through the cell), e_l = r(o) / sqrt(n_v(o))
+/// (r: half the object's diagonal, n_v(o): segments through the cell that hit o), and every
+/// rendered object its box touches joins the PVS. View space: each cell's PVS is merged with
+/// those of its `view_neighbours` neighbouring cells with the most similar PVSs (Jaccard).
+struct VisibilityFilter {
+  bool object_space = true;
+  double k = 1.0;
+  uint32_t view_neighbours = 0;
+};
+
+/// What a dynamic edit did.
+struct AgvsEditStats {
+  uint32_t deleted = 0, inserted = 0;
+  uint64_t removed_deleted = 0;   ///< entries of deleted objects
+  uint64_t removed_penumbra = 0;  ///< entries in an inserted object's penumbra from their cell
+  uint32_t cells_cleared = 0;     ///< cells an inserted object touches (their PVS emptied)
+};
+
+/// Objects of `before` that are still in `after`, by name and identical geometry (in order
+/// among equals): new_of_old[o] is o's index in `after`, or kNoObject when it was deleted (or
+/// changed: an edit is a deletion and an insertion). Objects of `after` that no entry names
+/// are the inserted ones.
+std::vector<uint32_t> match_objects(const Scene& before, const Scene& after);
 
 /// One point of the convergence curve, after a batch.
 struct AgvsPoint {
@@ -137,6 +174,7 @@ struct AgvsPoint {
   uint64_t samples = 0, rays = 0;
   double mean_pvs = 0;     ///< mean PVS size over the cells
   double pixel_error = 0;  ///< estimated (NaN before the first window is full)
+  double pixel_error_bound = 0;  ///< see AgvsSolver::pixel_error_bound (NaN when none)
 };
 
 struct AgvsStats {
@@ -147,10 +185,10 @@ struct AgvsStats {
   uint64_t dist_contribution[kDistributions] = {};
   double dist_probability[kDistributions] = {};  ///< of the last batch
   uint64_t mutation_candidates = 0;           ///< in the buffer now
-  /// View space-direction samples in the estimator's window (equation 5). The window reaches
-  /// back until it holds enough samples for its own error; while the error falls fast it
-  /// takes in older batches of higher error, so the estimate errs high (a safe stop).
-  uint64_t window_samples = 0;
+  /// Camera rays in the estimator's window (equation 5; 0 when no window is full). The
+  /// window reaches back until it holds enough rays for its own error; while the error falls
+  /// fast it takes in older batches of higher error, so the estimate errs high (a safe stop).
+  uint64_t window_rays = 0;
   double seconds = 0;
   std::string stop_reason;
   EmptySpaceDecision empty_space;
@@ -174,10 +212,30 @@ class AgvsSolver {
   /// seed; sampling then continues exactly as if it had not stopped. Error on any mismatch or
   /// corruption, and then the solver is unchanged.
   void load(const std::string& path, uint64_t identity);
+  /// The identity a state file was saved with (Error when it is not a readable state).
+  static uint64_t state_identity(const std::string& path);
   const GlobalPvs& pvs() const;
   const AgvsStats& stats() const;
-  /// The current pixel error estimate (NaN before the first full window).
+  /// Dynamic edits (paper section 6): the scene becomes `edited` (with its caster; both must
+  /// outlive the solver), whose objects are the old ones through `new_of_old` (kNoObject:
+  /// deleted) plus the inserted ones. Deleted objects leave every PVS; for each inserted
+  /// object and each cell, the PVS entries whose bounds meet the object's penumbra from the
+  /// cell (ConvexRegion, by CGAL's hull) are removed, since it may now hide them. The
+  /// estimator's window restarts; run() then resumes sampling, which finds again what is
+  /// still visible. Error (solver unchanged) when the map is not one-to-one or the edited
+  /// scene cannot be sampled.
+  AgvsEditStats edit(const Scene& edited, const RayCaster& caster, const std::vector<uint32_t>& new_of_old);
+  /// The PVSs with the visibility filter applied (sorted object lists per cell). Error when
+  /// the object space filter is asked for without config.filter_statistics.
+  std::vector<std::vector<uint32_t>> filtered_pvs(const VisibilityFilter& filter) const;
+  /// The current pixel error estimate (section 4.5): wrong camera rays, i.e. view
+  /// space-direction rays from free space that added an entry to the cell of their origin,
+  /// per ray of the window, times the resolution. NaN before the first full window.
   double pixel_error() const;
+  /// When no camera ray of all the history kept was wrong, no window can be full (e = 0
+  /// needs an infinite one): then the error is below this bound with probability 0.9
+  /// (ln 10 / rays, times the resolution). NaN otherwise. Termination by pixel error accepts it.
+  double pixel_error_bound() const;
   double mean_pvs() const;
 
  private:

@@ -81,6 +81,16 @@ struct Box3 {
   bool operator==(const Box3& o) const { return lo == o.lo && hi == o.hi; }
 };
 
+/// Euclidean distance between two boxes (0 when they touch or overlap).
+inline double box_distance(const Box3& a, const Box3& b) {
+  double s = 0;
+  for (int k = 0; k < 3; ++k) {
+    const double gap = std::max({0.0, a.lo[k] - b.hi[k], b.lo[k] - a.hi[k]});
+    s += gap * gap;
+  }
+  return std::sqrt(s);
+}
+
 /// Parametric interval [t0, t1] of the line o + t*d inside box b (slab test).
 /// Returns false when the line misses the box. Zero direction components are handled.
 /// Inline: the sampler calls it once per sample.
