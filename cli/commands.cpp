@@ -95,7 +95,6 @@ struct GenerateArgs {
   std::string kind;
   uint64_t seed = 1;
   int size = 1;
-  bool sealed = false;
   std::string output;
 };
 
@@ -104,11 +103,10 @@ int run_generate(const GenerateArgs& a, const Common& c) {
   config.kind = parse_generator_kind(a.kind);
   config.seed = a.seed;
   config.size = a.size;
-  config.sealed = a.sealed;
   Stopwatch sw;
   const Scene scene = generate_scene(config);
   write_obj(scene, a.output);
-  c.log("viewcells: generated " + std::string(to_string(config.kind)) + (a.sealed ? ", sealed" : "") + " (size " + std::to_string(a.size) +
+  c.log("viewcells: generated " + std::string(to_string(config.kind)) + " (size " + std::to_string(a.size) +
         ", seed " + std::to_string(a.seed) + "): " + std::to_string(scene.object_count()) + " objects, " +
         std::to_string(scene.triangle_count()) + " triangles -> " + a.output + " in " + fmt(sw.seconds(), 2) + " s");
   return 0;
@@ -869,6 +867,7 @@ struct PvsArgs {
   uint32_t measure_cameras = 0;
   uint32_t measure_size = 1024;
   std::string save, resume, edited_from;
+  std::vector<std::string> references;
   bool filter = false;
   double filter_k = 1.0;
   uint32_t filter_neighbours = 0;
@@ -1094,6 +1093,16 @@ int run_pvs(const PvsArgs& a, const Common& c) {
             " samples");
     }
   }
+  for (const std::string& path : a.references) {
+    const PvsFile ref = read_pvs(path);
+    if (ref.pvs.cell_count != cells.cell_count() || ref.object_count != pf.object_count ||
+        ref.scene_fingerprint != pf.scene_fingerprint || ref.leaf_cell != pf.leaf_cell)
+      throw Error(path, 0, "is not a .pvs of these view cells of this scene");
+    GlobalPvs table(cells.cell_count(), pf.object_count);
+    for (uint32_t i = 0; i < ref.pvs.cell_count; ++i)
+      for (uint32_t o : ref.pvs.cell_pvs(i)) table.insert(i, o);
+    solver->add_reference(std::move(table));
+  }
   solver->run();
   if (!a.save.empty()) {
     solver->save(a.save, identity);
@@ -1142,6 +1151,7 @@ int run_pvs(const PvsArgs& a, const Common& c) {
   }
   auto measure_json = [&](const std::optional<PixelErrorMeasure>& m) {
     return m ? json{{"pixels", m->pixels}, {"share", m->share}, {"cameras", m->cameras},
+                    {"cameras_with_wrong_pixels", m->cameras_wrong},
                     {"camera_size", a.measure_size}, {"fov_degrees", 90}}
              : json(nullptr);
   };
@@ -1162,7 +1172,8 @@ int run_pvs(const PvsArgs& a, const Common& c) {
     for (const AgvsPoint& p : st.curve)
       curve.push_back({{"seconds", p.seconds}, {"samples", p.samples}, {"rays", p.rays}, {"mean_pvs_size", p.mean_pvs},
                        {"pixel_error", std::isnan(p.pixel_error) ? json(nullptr) : json(p.pixel_error)},
-                       {"pixel_error_bound", std::isnan(p.pixel_error_bound) ? json(nullptr) : json(p.pixel_error_bound)}});
+                       {"pixel_error_bound", std::isnan(p.pixel_error_bound) ? json(nullptr) : json(p.pixel_error_bound)},
+                       {"covered", json(std::vector<uint64_t>(p.covered, p.covered + a.references.size()))}});
     const json report = {
         {"command", "pvs"},
         {"input", a.input},
@@ -1328,8 +1339,6 @@ int run(int argc, char** argv) {
   g->add_option("--size", gen.size,
                 "Scale >= 1: office rooms and floors, city blocks per side (city 20 ~ 1M triangles)")
       ->capture_default_str();
-  g->add_flag("--sealed", gen.sealed,
-              "Overlap boxes placed face to face by 1 mm instead of leaving 1 mm gaps (no slits between rooms)");
   g->add_option("-o,--output", gen.output, "Output .obj file")->required();
 
   InfoArgs info;
@@ -1478,6 +1487,11 @@ int run(int argc, char** argv) {
                  "Dynamic edit: --scene is an edited version of this scene (the one the hierarchy and the --resume "
                  "state were computed on). Objects are matched by name and geometry; deleted ones leave the PVSs, "
                  "and what inserted ones may hide is removed before sampling resumes");
+  pv->add_option("--reference", pva.references,
+                 "A .pvs of the same cells (another method's result; up to 2): the report's curve counts the "
+                 "entries found so far that it has too")
+      ->expected(1, AgvsPoint::kReferences)
+      ->check(CLI::ExistingFile);
   pv->add_option("--measure-size", pva.measure_size, "Width and height of the measuring cameras, in pixels")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

@@ -8,10 +8,8 @@ vc=build-release/cli/viewcells
 dir=out/bench
 mkdir -p "$dir"
 # bench_scene KIND SIZE: generates out/bench/KINDSIZE.obj once (seed 1) and prints its path.
-# KIND may end in -sealed (e.g. office-sealed): the generator's --sealed variant.
 bench_scene() {
-  local path="$dir/$1$2.obj" kind="${1%-sealed}" sealed=()
-  [ "$kind" != "$1" ] && sealed=(--sealed)
-  [ -f "$path" ] || "$vc" generate "$kind" "${sealed[@]}" --size "$2" --seed 1 -o "$path" -q
+  local path="$dir/$1$2.obj"
+  [ -f "$path" ] || "$vc" generate "$1" --size "$2" --seed 1 -o "$path" -q
   echo "$path"
 }

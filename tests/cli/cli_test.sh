@@ -173,6 +173,16 @@ assert r['effects']['silhouette_mutation']['enabled']
 " && ok || bad "pvs report"
 expect_ok "$VC" query agvs.pvs 2 2 1.5
 grep -q "^cell [0-9]* of 16" out.txt && ok || bad "query on a pvs from AGVS"
+# --reference: the curve counts the entries another solution has too (here AGVS's own final one).
+expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 40000 --method sgvs --reference agvs.pvs \
+  -o sgvs.pvs --report sgvs.json -q
+python3 -c "
+import json; a=json.load(open('agvs.json')); s=json.load(open('sgvs.json'))
+cov = [p['covered'][0] for p in s['curve']]
+assert cov == sorted(cov) and 0 < cov[-1] <= min(a['pvs_entries'], s['pvs_entries']), cov[-5:]
+" && ok || bad "pvs --reference coverage"
+expect_error "these view cells" "$VC" pvs office.vcells --scene office.obj --cells 8 --samples 10 --reference agvs.pvs \
+  -o x.pvs
 expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 20000 --save half.vagvs -o half.pvs -q
 expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 40000 --resume half.vagvs -o resumed.pvs -q
 cmp -s resumed.pvs agvs.pvs && ok || bad "20000 samples resumed to 40000 differ from 40000 in one run"

@@ -101,6 +101,13 @@ bool GlobalPvs::erase(uint32_t cell, uint32_t object) {
   return true;
 }
 
+uint64_t GlobalPvs::common_entries(const GlobalPvs& other) const {
+  if (other.cells_ != cells_ || other.objects_ != objects_) throw Error("PVS tables of different shapes");
+  uint64_t n = 0;
+  for (size_t w = 0; w < bits_.size(); ++w) n += static_cast<uint64_t>(__builtin_popcountll(bits_[w] & other.bits_[w]));
+  return n;
+}
+
 std::vector<uint32_t> GlobalPvs::list(uint32_t cell) const {
   std::vector<uint32_t> out;
   out.reserve(sizes_[cell]);
@@ -378,6 +385,7 @@ struct AgvsSolver::Impl {
   // (saturating).
   std::vector<uint64_t> cell_samples;
   std::vector<uint16_t> hit_counts;
+  std::vector<GlobalPvs> references;  ///< for the curve's coverage only
 
   const Scene& scene() const { return *scene_; }
   const RayCaster& caster_ref() const { return *caster_ref_; }
@@ -968,42 +976,58 @@ PixelErrorMeasure measure_pixel_error(const Scene& scene, const RayCaster& caste
   Rng rng(seed, 77);
   const Box3& box = cells.view_box();
   const double f = std::tan(0.5 * fov_degrees * std::numbers::pi / 180.0);
-  uint64_t wrong = 0, pixels = 0;
-  std::vector<Ray> rays(size_t(width) * height);
-  std::vector<Hit> hits(rays.size());
-  PixelErrorMeasure out;
-  for (uint32_t cam = 0; cam < cameras; ++cam) {
-    Vec3 eye;
+  // The cameras first, serially (reproducible); then rendered in parallel. Wrong pixels come
+  // in clusters (a camera that sees a missing object sees it over many pixels), so many
+  // small cameras measure better than a few large ones for the same number of rays.
+  struct Camera {
+    Vec3 eye, forward, right, up;
     int32_t cell = -1;
+  };
+  std::vector<Camera> cams(cameras);
+  for (Camera& cam : cams) {
     for (int tries = 0;; ++tries) {
       if (tries > 100000) throw Error("no camera position found outside the solids");
-      eye = {rng.uniform(box.lo.x, box.hi.x), rng.uniform(box.lo.y, box.hi.y), rng.uniform(box.lo.z, box.hi.z)};
-      cell = cells.cell_at(eye);
-      if (cell < 0) continue;
+      cam.eye = {rng.uniform(box.lo.x, box.hi.x), rng.uniform(box.lo.y, box.hi.y), rng.uniform(box.lo.z, box.hi.z)};
+      cam.cell = cells.cell_at(cam.eye);
+      if (cam.cell < 0) continue;
       if (!skip_inside_solids) break;
-      const Hit probe = caster.intersect(Ray{eye, sphere_direction(rng.uniform(), rng.uniform())});
+      const Hit probe = caster.intersect(Ray{cam.eye, sphere_direction(rng.uniform(), rng.uniform())});
       if (!probe.hit() || probe.front) break;  // a back face first: the eye is inside a solid
     }
-    const Vec3 forward = sphere_direction(rng.uniform(), rng.uniform());
+    cam.forward = sphere_direction(rng.uniform(), rng.uniform());
     Vec3 right, up;
-    orthonormal_basis(forward, right, up);
+    orthonormal_basis(cam.forward, right, up);
     const double roll = 2 * std::numbers::pi * rng.uniform();  // random orientation about the view axis
-    const Vec3 r2 = right * std::cos(roll) + up * std::sin(roll), u2 = cross(r2, forward) * -1.0;
-    const double aspect = static_cast<double>(height) / width;
-    for (uint32_t y = 0; y < height; ++y)
-      for (uint32_t x = 0; x < width; ++x) {
-        const double sx = (2 * (x + 0.5) / width - 1) * f, sy = (2 * (y + 0.5) / height - 1) * f * aspect;
-        rays[size_t(y) * width + x] = Ray{eye, normalize(forward + r2 * sx + u2 * sy)};
-      }
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-      caster.intersect(std::span<const Ray>(rays.data() + r.begin(), r.size()),
-                       std::span<Hit>(hits.data() + r.begin(), r.size()));
-    });
-    for (const Hit& h : hits)
-      if (h.hit() && scene.objects[h.object].rendered && !pvs.contains(static_cast<uint32_t>(cell), h.object)) ++wrong;
-    pixels += rays.size();
-    ++out.cameras;
+    cam.right = right * std::cos(roll) + up * std::sin(roll);
+    cam.up = cross(cam.right, cam.forward) * -1.0;
   }
+  const double aspect = static_cast<double>(height) / width;
+  std::vector<uint64_t> wrong_of(cameras, 0);
+  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, cameras, 1), [&](const tbb::blocked_range<uint32_t>& range) {
+    std::vector<Ray> rays(size_t(width) * height);
+    std::vector<Hit> hits(rays.size());
+    for (uint32_t k = range.begin(); k < range.end(); ++k) {
+      const Camera& cam = cams[k];
+      for (uint32_t y = 0; y < height; ++y)
+        for (uint32_t x = 0; x < width; ++x) {
+          const double sx = (2 * (x + 0.5) / width - 1) * f, sy = (2 * (y + 0.5) / height - 1) * f * aspect;
+          rays[size_t(y) * width + x] = Ray{cam.eye, normalize(cam.forward + cam.right * sx + cam.up * sy)};
+        }
+      // Large images: in slices, so that one camera also uses every core.
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        caster.intersect(std::span<const Ray>(rays.data() + r.begin(), r.size()),
+                         std::span<Hit>(hits.data() + r.begin(), r.size()));
+      });
+      for (const Hit& h : hits)
+        if (h.hit() && scene.objects[h.object].rendered && !pvs.contains(static_cast<uint32_t>(cam.cell), h.object))
+          ++wrong_of[k];
+    }
+  });
+  PixelErrorMeasure out;
+  out.cameras = cameras;
+  const uint64_t wrong = std::accumulate(wrong_of.begin(), wrong_of.end(), uint64_t{0});
+  const uint64_t pixels = uint64_t{cameras} * width * height;
+  for (uint64_t w : wrong_of) out.cameras_wrong += w > 0;
   out.share = static_cast<double>(wrong) / static_cast<double>(pixels);
   out.pixels = out.share * resolution;
   return out;
@@ -1061,7 +1085,9 @@ void AgvsSolver::run() {
     m.batch(m.stats.batches, c.batch_size);
     if (show) progress->advance(m.stats.samples - done);
     m.stats.seconds = before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    m.stats.curve.push_back({m.stats.seconds, m.stats.samples, m.stats.rays, m.mean_pvs(), m.error, m.error_bound});
+    AgvsPoint point{m.stats.seconds, m.stats.samples, m.stats.rays, m.mean_pvs(), m.error, m.error_bound};
+    for (size_t k = 0; k < m.references.size(); ++k) point.covered[k] = m.pvs.common_entries(m.references[k]);
+    m.stats.curve.push_back(point);
   }
   if (show) progress->finish();
 }
@@ -1180,6 +1206,7 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
                                      : "this state has no visibility filter statistics: resume without the filter");
   std::vector<uint64_t> cell_samples;
   std::vector<uint16_t> hit_counts;
+  std::vector<GlobalPvs> references;  ///< for the curve's coverage only
   if (with_filter) {
     r.get_array(cell_samples, m.cell_samples.size());
     r.get_array(hit_counts, m.hit_counts.size());
@@ -1211,6 +1238,14 @@ AgvsEditStats AgvsSolver::edit(const Scene& edited, const RayCaster& caster, con
 
 std::vector<std::vector<uint32_t>> AgvsSolver::filtered_pvs(const VisibilityFilter& filter) const {
   return impl_->filtered(filter);
+}
+
+void AgvsSolver::add_reference(GlobalPvs reference) {
+  if (impl_->references.size() >= AgvsPoint::kReferences)
+    throw Error("at most " + std::to_string(AgvsPoint::kReferences) + " reference solutions");
+  if (reference.cell_count() != impl_->pvs.cell_count() || reference.object_count() != impl_->pvs.object_count())
+    throw Error("the reference PVSs are for other view cells or another scene");
+  impl_->references.push_back(std::move(reference));
 }
 
 const GlobalPvs& AgvsSolver::pvs() const { return impl_->pvs; }

@@ -29,13 +29,12 @@ const char* to_string(GeneratorKind kind) {
 
 namespace {
 
-/// Half the gap left between boxes that a layout places face to face (sealed scenes: half
-/// their overlap).
+/// Half the gap left between boxes that a layout places face to face.
 constexpr double kHalfGap = 0.001;
 
 class MeshBuilder {
  public:
-  MeshBuilder(Scene& scene, bool sealed) : scene_(scene), shrink_(sealed ? -kHalfGap : kHalfGap) {}
+  explicit MeshBuilder(Scene& scene) : scene_(scene) {}
 
   void begin_object(std::string name) {
     current_ = static_cast<uint32_t>(scene_.objects.size());
@@ -45,11 +44,10 @@ class MeshBuilder {
   }
 
   /// A closed box with outward normals, each face split into a grid (n[a] cells along axis a).
-  /// The box is shrunk (sealed: grown) by kHalfGap on every side so that neighbours never
-  /// share a face.
+  /// The box is shrunk by kHalfGap on every side so that neighbours never share a face.
   void add_box(Vec3 lo, Vec3 hi, int nx = 1, int ny = 1, int nz = 1) {
-    lo += Vec3{shrink_, shrink_, shrink_};
-    hi -= Vec3{shrink_, shrink_, shrink_};
+    lo += Vec3{kHalfGap, kHalfGap, kHalfGap};
+    hi -= Vec3{kHalfGap, kHalfGap, kHalfGap};
     VC_CHECK(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z);
     const int n[3] = {std::max(1, nx), std::max(1, ny), std::max(1, nz)};
     // Vertices on the lattice surface, shared between faces so the box is watertight.
@@ -97,7 +95,6 @@ class MeshBuilder {
     scene_.triangle_object.push_back(current_);
   }
   Scene& scene_;
-  double shrink_;
   uint32_t current_ = kNoObject;
 };
 
@@ -148,10 +145,10 @@ void add_furniture(MeshBuilder& mb, Rng& rng, const std::string& prefix, double 
   }
 }
 
-Scene generate_office(uint64_t seed, int size, bool sealed) {
+Scene generate_office(uint64_t seed, int size) {
   using L = OfficeLayout;
   Scene scene;
-  MeshBuilder mb(scene, sealed);
+  MeshBuilder mb(scene);
   Rng rng(seed, 0x0ff1ce);
   const int rooms_per_side = 1 + size;
   const int floors = 1 + (size - 1) / 3;
@@ -238,9 +235,9 @@ Scene generate_office(uint64_t seed, int size, bool sealed) {
 
 // ------------------------------------------------------------------------------------ city
 
-Scene generate_city(uint64_t seed, int size, bool sealed) {
+Scene generate_city(uint64_t seed, int size) {
   Scene scene;
-  MeshBuilder mb(scene, sealed);
+  MeshBuilder mb(scene);
   Rng rng(seed, 0xc17);
   constexpr double kBlock = 60.0, kStreet = 16.0, kPitch = kBlock + kStreet;
   const int blocks = size;
@@ -324,8 +321,8 @@ Scene generate_scene(const GeneratorConfig& config) {
   Scene scene;
   switch (config.kind) {
     case GeneratorKind::kOffice:
-    case GeneratorKind::kRotatedOffice: scene = generate_office(config.seed, config.size, config.sealed); break;
-    case GeneratorKind::kCity: scene = generate_city(config.seed, config.size, config.sealed); break;
+    case GeneratorKind::kRotatedOffice: scene = generate_office(config.seed, config.size); break;
+    case GeneratorKind::kCity: scene = generate_city(config.seed, config.size); break;
   }
   scene.grouping = ObjectGrouping::kGroups;
   scene.finalize();
@@ -334,7 +331,6 @@ Scene generate_scene(const GeneratorConfig& config) {
     scene.source = "generated rotated-office (size " + std::to_string(config.size) + ", seed " +
                    std::to_string(config.seed) + ", 30 degrees about z)";
   }
-  if (config.sealed) scene.source += ", sealed";
   return scene;
 }
 

@@ -74,6 +74,8 @@ class GlobalPvs {
   bool erase(uint32_t cell, uint32_t object);
   uint32_t size(uint32_t cell) const { return sizes_[cell]; }
   uint64_t entries() const { return entries_; }
+  /// Entries that `other` (of the same shape) has too.
+  uint64_t common_entries(const GlobalPvs& other) const;
   std::vector<uint32_t> list(uint32_t cell) const;  ///< sorted object ids
   bool operator==(const GlobalPvs& o) const { return cells_ == o.cells_ && objects_ == o.objects_ && bits_ == o.bits_; }
   void save(ByteWriter& w) const;
@@ -175,6 +177,10 @@ struct AgvsPoint {
   double mean_pvs = 0;     ///< mean PVS size over the cells
   double pixel_error = 0;  ///< estimated (NaN before the first window is full)
   double pixel_error_bound = 0;  ///< see AgvsSolver::pixel_error_bound (NaN when none)
+  static constexpr int kReferences = 2;
+  /// Entries also in reference PVS k (AgvsSolver::add_reference; 0 without one): how much of
+  /// another method's solution this one has found.
+  uint64_t covered[kReferences] = {};
 };
 
 struct AgvsStats {
@@ -212,6 +218,10 @@ class AgvsSolver {
   /// seed; sampling then continues exactly as if it had not stopped. Error on any mismatch or
   /// corruption, and then the solver is unchanged.
   void load(const std::string& path, uint64_t identity);
+  /// A reference solution (e.g. another method's final PVSs, same cells and objects): every
+  /// point of the convergence curve counts the entries it shares with it. At most
+  /// AgvsPoint::kReferences; Error when the shape differs.
+  void add_reference(GlobalPvs reference);
   /// The identity a state file was saved with (Error when it is not a readable state).
   static uint64_t state_identity(const std::string& path);
   const GlobalPvs& pvs() const;
@@ -254,6 +264,7 @@ struct PixelErrorMeasure {
   double pixels = 0;     ///< mean wrong pixels per camera, scaled to `resolution`
   double share = 0;      ///< wrong pixels / all pixels
   uint32_t cameras = 0;
+  uint32_t cameras_wrong = 0;  ///< cameras with at least one wrong pixel
 };
 PixelErrorMeasure measure_pixel_error(const Scene& scene, const RayCaster& caster, const CellLocator& cells,
                                       const GlobalPvs& pvs, uint32_t cameras, uint32_t width, uint32_t height,

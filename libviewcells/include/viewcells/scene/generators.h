@@ -1,10 +1,8 @@
 #pragma once
 /// Deterministic scene generators (same kind, seed and size give the same scene, bit for bit),
 /// so that tests and demos need no downloads. Z is up; units are metres. Every object is a set
-/// of closed, outward-oriented boxes that never share a face: by default they keep 1 mm gaps
-/// (so neighbours never touch), sealed scenes overlap them by 1 mm instead (so no slit between
-/// a wall and the floor lets rays from one room into the next). Either way generated scenes
-/// are solid and empty view space detection applies.
+/// of closed, outward-oriented boxes that never touch (1 mm gaps), so generated scenes are
+/// solid and empty view space detection applies.
 #include <cstdint>
 #include <string>
 
@@ -29,8 +27,6 @@ struct GeneratorConfig {
   /// about a thousand triangles). City: size x size blocks (size 20 is about a million
   /// triangles and ten thousand objects).
   int size = 1;
-  /// Boxes placed face to face overlap by 1 mm instead of keeping a 1 mm gap.
-  bool sealed = false;
 };
 
 /// Generates the scene; objects are named (e.g. "f0_room_a2_desk", "block_3_4_building_1").
