@@ -520,23 +520,26 @@ struct AgvsSolver::Impl {
   /// one that misses the object (binary search) passes its silhouette. If that ray then hits
   /// something more than k r(o) beyond the moved point (a depth discontinuity), a second
   /// search runs along the jump. Returns the samples' points and directions (one or two).
-  int silhouette_samples(Rng& rng, Vec3 points_out[2], Vec3 dirs_out[2]) {
-    if (silhouette.empty()) return 0;
-    const Candidate c = silhouette.take();
+  /// `angle_u`: the two uniform numbers that choose the directions of the two searches (drawn
+  /// beforehand, so that searches run in parallel and stay reproducible); `rays` counts the
+  /// discovery rays. Thread-safe.
+  int silhouette_samples(const Candidate& c, const double angle_u[2], Vec3 points_out[2], Vec3 dirs_out[2],
+                         uint64_t& rays) const {
     const double r = c.r_term;
     if (c.object == kNoObject || !(r > 0)) return 0;
+    int searches = 0;
     auto search = [&](const Vec3& from, const Vec3& at, uint32_t object, double radius, Vec3& found) {
       const Vec3 axis = at - from;
       if (!(length(axis) > eps)) return false;
       Vec3 u, v;
       orthonormal_basis(normalize(axis), u, v);
-      const double a = 2 * std::numbers::pi * rng.uniform();
+      const double a = 2 * std::numbers::pi * angle_u[searches++];
       const Vec3 d = u * std::cos(a) + v * std::sin(a);
       auto hits_object = [&](double lambda) {
         const Vec3 target = at + d * (lambda * radius);
         // From just off `from`, which may lie on a surface itself.
         const Hit h = caster_ref().intersect(Ray{from, target - from, 1e-6, 1.0 + 1e-6});
-        ++discovery_rays;
+        ++rays;
         return h.hit() && h.object == object;
       };
       if (hits_object(1.0)) return false;  // the object reaches past r along d: no silhouette here
@@ -557,7 +560,7 @@ struct AgvsSolver::Impl {
     dirs_out[n++] = normalize(dir);
     // Depth discontinuity: where does the silhouette ray really end?
     const Hit h = caster_ref().intersect(Ray{c.origin, normalize(dir), eps});
-    ++discovery_rays;
+    ++rays;
     constexpr double kDepthJump = 3.0;  // the paper's k
     if (h.hit()) {
       const Vec3 end = c.origin + normalize(dir) * h.t;
@@ -645,6 +648,14 @@ struct AgvsSolver::Impl {
     constexpr int kOrder[kDists] = {kSil, kTpm, kOd, kTp, kVsd};
     discovery_rays = 0;
     uint32_t failed = 0;
+    struct SilhouetteJob {
+      Candidate candidate;
+      double u[2] = {0, 0};
+      int n = 0;
+      Vec3 points[2], dirs[2];
+      uint64_t rays = 0;
+    };
+    std::vector<SilhouetteJob> sil_jobs;
     for (int d : kOrder) {
       first_of[d] = static_cast<uint32_t>(points.size());
       const uint32_t target = want[d] + (d == kVsd ? failed : 0);
@@ -661,13 +672,15 @@ struct AgvsSolver::Impl {
           dir = sphere_direction(rng.uniform(), rng.uniform());
           ref_cell.push_back(static_cast<int32_t>(c));
         } else if (d == kSil) {
-          Vec3 sp[2], sd[2];
-          const int got = silhouette_samples(rng, sp, sd);
-          if (got == 0) ++failed;
-          for (int j = 0; j < got; ++j) {
-            points.push_back(sp[j]);
-            dirs.push_back(sd[j]);
+          // Candidates and random numbers drawn here, in order; the searches run below.
+          if (silhouette.empty()) {
+            ++failed;
+            continue;
           }
+          SilhouetteJob job;
+          job.candidate = silhouette.take();
+          job.u[0] = rng.uniform(), job.u[1] = rng.uniform();
+          sil_jobs.push_back(job);
           continue;
         } else if (!draw(d, rng, p, dir)) {
           ++failed;
@@ -675,6 +688,22 @@ struct AgvsSolver::Impl {
         }
         points.push_back(p);
         dirs.push_back(dir);
+      }
+      if (d == kSil && !sil_jobs.empty()) {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, sil_jobs.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+          for (size_t j = r.begin(); j < r.end(); ++j) {
+            SilhouetteJob& job = sil_jobs[j];
+            job.n = silhouette_samples(job.candidate, job.u, job.points, job.dirs, job.rays);
+          }
+        });
+        for (const SilhouetteJob& job : sil_jobs) {
+          discovery_rays += job.rays;
+          if (job.n == 0) ++failed;
+          for (int j = 0; j < job.n; ++j) {
+            points.push_back(job.points[j]);
+            dirs.push_back(job.dirs[j]);
+          }
+        }
       }
       end_of[d] = static_cast<uint32_t>(points.size());
     }
