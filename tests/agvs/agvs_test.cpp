@@ -330,6 +330,17 @@ TEST(Agvs, DeletingAndInsertingAnObjectRestoresAConsistentSolution) {
   const uint64_t entries = solver.pvs().entries();
   EXPECT_THROW(solver.edit(scene, *caster, twice), Error);
   EXPECT_EQ(solver.pvs().entries(), entries);
+  // So is an edited scene that cannot be sampled (nothing rendered), after all the work.
+  Scene dark = walled;
+  for (ObjectInfo& o : dark.objects) o.rendered = false;
+  const auto dark_caster = make_embree_caster(dark);
+  std::vector<uint32_t> plus_wall(n);
+  for (uint32_t o = 0; o < n; ++o) plus_wall[o] = o;
+  EXPECT_THROW(solver.edit(dark, *dark_caster, plus_wall), Error);
+  EXPECT_EQ(solver.pvs().entries(), entries);
+  EXPECT_EQ(solver.pvs().object_count(), n);
+  solver.set_limits(250000, 0, 0);
+  solver.run();  // still sampling the scene it had
 }
 
 TEST(Agvs, MatchObjectsByNameAndGeometry) {

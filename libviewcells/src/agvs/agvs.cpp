@@ -887,7 +887,6 @@ struct AgvsSolver::Impl {
     for (uint32_t o = 0; o < new_n; ++o)
       if (!kept[o]) inserted.push_back(o);
     st.inserted = static_cast<uint32_t>(inserted.size());
-    bind(edited, rc);  // the only step that may throw; it changes nothing before it succeeds
     // The solution over the new objects, without the deleted ones.
     GlobalPvs next(cells.cell_count(), new_n);
     std::vector<uint16_t> next_hits;
@@ -903,7 +902,7 @@ struct AgvsSolver::Impl {
             next_hits[size_t(c) * new_n + new_of_old[o]] = hit_counts[size_t(c) * old_n + o];
     }
     // Inserted objects: what they may hide from each cell leaves its PVS.
-    const Scene& sc = scene();
+    const Scene& sc = edited;
     Box3 all = sc.bounds;
     all.extend(cells.view_box());
     const double reach = all.diagonal();
@@ -927,6 +926,8 @@ struct AgvsSolver::Impl {
         for (uint32_t e : removed[c]) st.removed_penumbra += next.erase(c, e);
       }
     }
+    // Everything is computed: commit (bind changes nothing when it throws).
+    bind(edited, rc);
     pvs = std::move(next);
     hit_counts = std::move(next_hits);
     // Mutation candidates keep their segments; their objects follow the map.
