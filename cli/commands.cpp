@@ -1158,7 +1158,7 @@ int run_pvs(const PvsArgs& a, const Common& c) {
   c.log("viewcells: " + std::to_string(st.samples) + " samples (" + std::to_string(st.rays) + " rays) in " +
         fmt(st.seconds, 2) + " s; mean PVS " + fmt(solver->mean_pvs(), 1) + " objects; estimated pixel error " +
         (!std::isnan(err)     ? fmt(err, 2)
-         : !std::isnan(bound) ? "below " + fmt(bound, 2) + " (no wrong camera ray seen)"
+         : !std::isnan(bound) ? "below " + fmt(bound, 2) + " (90% bound: too few wrong camera rays for an estimate)"
                               : std::string("not yet known")) + " (" + st.stop_reason + "); -> " + a.output);
   if (!a.report.empty()) {
     json dists = json::array();
@@ -1173,6 +1173,8 @@ int run_pvs(const PvsArgs& a, const Common& c) {
       curve.push_back({{"seconds", p.seconds}, {"samples", p.samples}, {"rays", p.rays}, {"mean_pvs_size", p.mean_pvs},
                        {"pixel_error", std::isnan(p.pixel_error) ? json(nullptr) : json(p.pixel_error)},
                        {"pixel_error_bound", std::isnan(p.pixel_error_bound) ? json(nullptr) : json(p.pixel_error_bound)},
+                       {"camera_rays", p.camera_rays},
+                       {"wrong_camera_rays", p.wrong_camera_rays},
                        {"covered", json(std::vector<uint64_t>(p.covered, p.covered + a.references.size()))}});
     const json report = {
         {"command", "pvs"},

@@ -69,9 +69,9 @@ for k, m in enumerate(("sgvs", "ref")):
     print(f"| {m.upper()} | {entries:,} | {100 * have:.1f}% | {fmt_t(own)} | {fmt_t(agvs)} | "
           f"{'' if speed is None else f'{speed:.1f} x'} |")
 print(f"\nMeasured pixel error: 20,000 random cameras of 32x32 (90 degrees; wrong pixels come in clusters, so many "
-      f"small cameras measure better than few large ones), wrong pixels scaled to 1024x1024. '< x': no wrong camera "
-      f"ray in the estimator's history, so no window is full; the error is below x with probability 0.9. Dashed in "
-      f"the plot.\n")
+      f"small cameras measure better than few large ones), wrong pixels scaled to 1024x1024. '< x': too few wrong "
+      f"camera rays in the newer half of the run for equation 5's window; the error is below x with probability "
+      f"0.9. Dashed in the plot.\n")
 print(f"\n![mean PVS](docs/agvs/{kind}{size}-pvs.png) ![pixel error](docs/agvs/{kind}{size}-error.png)\n")
 PY
 gnuplot <<GP

@@ -45,7 +45,8 @@ print(f"The {kind} of size {size} (seed 1), {cells} view cells; each method stop
       f"(saved and resumed). Estimated: equation 5's window (P = 0.9, k = 0.5) of the camera rays (view "
       f"space-direction rays from free space); measured: {cameras} random cameras of {camera_size}x{camera_size} "
       f"(90 degrees) against the PVSs at that point. Both in pixels of a 1024x1024 image. Ratio: estimated over "
-      f"measured ('<': no wrong camera ray in the history kept, the 90% bound instead).\n")
+      f"measured ('<': too few wrong camera rays in the newer half of the run for a window, the 90% upper bound "
+      f"instead).\n")
 print("| method | samples | mean PVS | estimated | window (camera rays) | measured | ratio |")
 print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
 within = {}

@@ -376,8 +376,7 @@ struct AgvsSolver::Impl {
   // added an entry to the cell containing their origin.
   std::deque<std::pair<uint64_t, uint64_t>> window;
   double error = std::numeric_limits<double>::quiet_NaN();
-  /// With no wrong camera ray in the whole history kept (no estimate possible): the share's
-  /// upper bound with probability P = 0.9, in pixels. NaN otherwise.
+  /// With too few wrong camera rays for a window: the error's 90% upper bound, in pixels.
   double error_bound = std::numeric_limits<double>::quiet_NaN();
   double eps;  ///< offset of ray origins from surfaces
   // The visibility filter's sampling densities (config.filter_statistics): segments through
@@ -827,6 +826,8 @@ struct AgvsSolver::Impl {
     stats.samples += count;
     stats.batches += 1;
     stats.mutation_candidates = two_point.size();
+    stats.camera_rays += vsd_rays;
+    stats.wrong_camera_rays += vsd_contributing;
     update_estimate(vsd_rays, vsd_contributing);
   }
 
@@ -838,12 +839,20 @@ struct AgvsSolver::Impl {
     evaluate_window();
   }
 
+  /// The window reaches back at most over the newer half of all camera rays so far: an
+  /// estimate must describe the current solution, and the error keeps falling. If even that
+  /// half holds too few wrong rays for equation 5 (the error is below what it resolves), there
+  /// is no estimate, and error_bound gives the one-sided 90% Poisson upper bound over it.
   void evaluate_window() {
+    uint64_t total = 0;
+    for (const auto& [r, c] : window) total += r;
+    const uint64_t reach = std::max<uint64_t>(total / 2, 1);
     uint64_t n = 0, nc = 0;
     size_t used = 0;
     error = error_bound = std::numeric_limits<double>::quiet_NaN();
     stats.window_rays = 0;
     for (const auto& [r, c] : window) {
+      if (used > 0 && n + r > reach) break;
       n += r;
       nc += c;
       ++used;
@@ -856,14 +865,15 @@ struct AgvsSolver::Impl {
         break;
       }
     }
-    if (std::isnan(error) && nc == 0 && n > 0) {
-      // No wrong ray in all the history kept: with probability 0.9 the share is below
-      // ln(10) / n (the binomial's bound for zero successes).
-      error_bound = config.resolution * std::log(10.0) / static_cast<double>(n);
+    if (std::isnan(error) && n > 0) {
+      // Wilson-Hilferty: the 90% upper bound of a Poisson mean with nc events.
+      const double k1 = static_cast<double>(nc) + 1, z = 1.2816;
+      const double upper = k1 * std::pow(1 - 1 / (9 * k1) + z / (3 * std::sqrt(k1)), 3);
+      error_bound = config.resolution * upper / static_cast<double>(n);
+      stats.window_rays = n;
     }
-    window.resize(std::min(window.size(), std::max<size_t>(used, 1)));
-    // Keep what a smaller error would need: the whole history up to a bound.
-    if (std::isnan(error) && window.size() > 100000) window.pop_back();
+    // The history the next windows may need (at most half of it is ever used).
+    while (window.size() > 200000) window.pop_back();
   }
 
   double mean_pvs() const { return static_cast<double>(pvs.entries()) / cells.cell_count(); }
@@ -1107,15 +1117,16 @@ void AgvsSolver::run() {
       break;
     }
     if (c.pixel_error > 0 && !std::isnan(m.error_bound) && m.error_bound <= c.pixel_error) {
-      m.stats.stop_reason = "no wrong camera ray seen: pixel error below " + std::to_string(c.pixel_error) +
-                            " with probability 0.9";
+      m.stats.stop_reason = "too few wrong camera rays for an estimate: pixel error below " +
+                            std::to_string(c.pixel_error) + " with probability 0.9";
       break;
     }
     const uint64_t done = m.stats.samples;
     m.batch(m.stats.batches, c.batch_size);
     if (show) progress->advance(m.stats.samples - done);
     m.stats.seconds = before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    AgvsPoint point{m.stats.seconds, m.stats.samples, m.stats.rays, m.mean_pvs(), m.error, m.error_bound};
+    AgvsPoint point{m.stats.seconds, m.stats.samples, m.stats.rays, m.mean_pvs(), m.error, m.error_bound,
+                    m.stats.camera_rays, m.stats.wrong_camera_rays};
     for (size_t k = 0; k < m.references.size(); ++k) point.covered[k] = m.pvs.common_entries(m.references[k]);
     m.stats.curve.push_back(point);
   }
@@ -1163,6 +1174,7 @@ void AgvsSolver::save(const std::string& path, uint64_t identity) const {
   m.pvs.save(w);
   const AgvsStats& s = m.stats;
   w.put(s.samples), w.put(s.rays), w.put(s.batches), w.put(s.seconds), w.put(s.window_rays);
+  w.put(s.camera_rays), w.put(s.wrong_camera_rays);
   for (int d = 0; d < kDists; ++d) {
     w.put(s.dist_samples[d]), w.put(s.dist_rays[d]), w.put(s.dist_contribution[d]), w.put(s.dist_probability[d]);
     w.put(m.halton_index[d]), w.put(m.weight[d]), w.put(m.recent_contribution[d]), w.put(m.recent_rays[d]);
@@ -1207,6 +1219,7 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   AgvsStats s = m.stats;
   s.samples = r.get<uint64_t>(), s.rays = r.get<uint64_t>(), s.batches = r.get<uint64_t>();
   s.seconds = r.get<double>(), s.window_rays = r.get<uint64_t>();
+  s.camera_rays = r.get<uint64_t>(), s.wrong_camera_rays = r.get<uint64_t>();
   uint64_t halton[kDists];
   double weight[kDists], recent_c[kDists], recent_r[kDists];
   for (int d = 0; d < kDists; ++d) {

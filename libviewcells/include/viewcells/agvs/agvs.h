@@ -177,6 +177,7 @@ struct AgvsPoint {
   double mean_pvs = 0;     ///< mean PVS size over the cells
   double pixel_error = 0;  ///< estimated (NaN before the first window is full)
   double pixel_error_bound = 0;  ///< see AgvsSolver::pixel_error_bound (NaN when none)
+  uint64_t camera_rays = 0, wrong_camera_rays = 0;  ///< the estimator's rays so far, in all
   static constexpr int kReferences = 2;
   /// Entries also in reference PVS k (AgvsSolver::add_reference; 0 without one): how much of
   /// another method's solution this one has found.
@@ -191,10 +192,9 @@ struct AgvsStats {
   uint64_t dist_contribution[kDistributions] = {};
   double dist_probability[kDistributions] = {};  ///< of the last batch
   uint64_t mutation_candidates = 0;           ///< in the buffer now
-  /// Camera rays in the estimator's window (equation 5; 0 when no window is full). The
-  /// window reaches back until it holds enough rays for its own error; while the error falls
-  /// fast it takes in older batches of higher error, so the estimate errs high (a safe stop).
+  /// Camera rays in the estimator's window (equation 5), or those the bound was computed over.
   uint64_t window_rays = 0;
+  uint64_t camera_rays = 0, wrong_camera_rays = 0;  ///< the estimator's rays since the start
   double seconds = 0;
   std::string stop_reason;
   EmptySpaceDecision empty_space;
@@ -242,9 +242,10 @@ class AgvsSolver {
   /// space-direction rays from free space that added an entry to the cell of their origin,
   /// per ray of the window, times the resolution. NaN before the first full window.
   double pixel_error() const;
-  /// When no camera ray of all the history kept was wrong, no window can be full (e = 0
-  /// needs an infinite one): then the error is below this bound with probability 0.9
-  /// (ln 10 / rays, times the resolution). NaN otherwise. Termination by pixel error accepts it.
+  /// The window reaches back over the newer half of all camera rays at most (the estimate
+  /// describes the current solution). When even that half holds too few wrong rays for
+  /// equation 5, there is no estimate, and this is the one-sided 90% upper bound of the error
+  /// over it (Poisson); NaN otherwise. Termination by pixel error accepts it.
   double pixel_error_bound() const;
   double mean_pvs() const;
 
