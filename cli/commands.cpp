@@ -863,6 +863,7 @@ struct PvsArgs {
   double pixel_error = 0, seconds = 0;
   uint64_t samples = 0, seed = 1;
   uint32_t batch = 20000;
+  double min_share = 0.25;
   bool fast = false;
   uint32_t measure_cameras = 0;
   uint32_t measure_size = 1024;
@@ -1013,6 +1014,7 @@ int run_pvs(const PvsArgs& a, const Common& c) {
   config.method = parse_agvs_method(a.method);
   config.seed = a.seed;
   config.batch_size = a.batch;
+  config.min_share = a.min_share;
   config.max_samples = a.samples;
   config.max_seconds = a.seconds;
   config.pixel_error = a.pixel_error;
@@ -1470,6 +1472,11 @@ int run(int argc, char** argv) {
   pv->add_option("--seed", pva.seed, "Random seed")->capture_default_str();
   pv->add_option("--batch", pva.batch, "Samples per batch")->capture_default_str()->check(CLI::PositiveNumber);
   pv->add_flag("--fast", pva.fast, "Embree without robust mode");
+  pv->add_option("--min-share", pva.min_share,
+                 "AGVS: share of every batch kept for view space-direction samples whatever their weight; they are "
+                 "the pixel error estimator's camera rays (more: a finer estimate, fewer samples for the mutations)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   pv->add_option("--measure-cameras", pva.measure_cameras,
                  "Also measure the pixel error: render this many random cameras by ray casting and count the "
                  "pixels whose object is missing from the PVS");

@@ -343,6 +343,35 @@ TEST(Agvs, DeletingAndInsertingAnObjectRestoresAConsistentSolution) {
   solver.run();  // still sampling the scene it had
 }
 
+TEST(Agvs, CellNeighboursWithoutSplitRecords) {
+  // A BSP read from a .pvs file has nodes but no split records: neighbours must not need them.
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 2});
+  const SegmentSet segs = test::sample_scene(scene, 20000, 3);
+  SubdivisionConfig sc;
+  sc.strategy = SplitStrategy::kKdCycling;
+  sc.max_cells = 24;
+  sc.show_progress = false;
+  Subdivision s = subdivide(scene, segs, CostModel{}, sc);
+  std::vector<int32_t> leaf_cell(s.nodes.size(), -1);
+  const std::vector<int32_t> leaves = s.leaves();
+  for (size_t i = 0; i < leaves.size(); ++i) leaf_cell[leaves[i]] = static_cast<int32_t>(i);
+  const auto n = static_cast<uint32_t>(leaves.size());
+  const CellLocator with(s, leaf_cell, n);
+  Subdivision bare = s;
+  bare.splits.clear();
+  bare.cells.clear();
+  const CellLocator without(bare, leaf_cell, n);
+  const auto a = with.neighbours(), b = without.neighbours();
+  EXPECT_EQ(a, b);
+  size_t pairs = 0;
+  for (uint32_t c = 0; c < n; ++c) {
+    EXPECT_FALSE(a[c].empty()) << "cell " << c << " has no neighbour";
+    for (uint32_t d : a[c]) EXPECT_TRUE(std::binary_search(a[d].begin(), a[d].end(), c)) << "symmetric";
+    pairs += a[c].size();
+  }
+  EXPECT_GE(pairs / 2, n - 1) << "the cells are connected";
+}
+
 TEST(Agvs, MatchObjectsByNameAndGeometry) {
   const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
   const Scene walled = with_box(scene, Box3({0, 0, 0}, {1, 1, 1}), "inserted");

@@ -198,6 +198,12 @@ assert r['effects']['visibility_filter']['enabled'] and f['object_space'] and f[
 assert f['mean_pvs_size_filtered'] == r['mean_pvs_size_written'] > r['mean_pvs_size'] == f['mean_pvs_size_unfiltered'], f
 " && ok || bad "pvs --filter report"
 expect_ok "$VC" query filtered.pvs 2 2 1.5
+expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 2000 --batch 500 --filter-neighbours 1 \
+  -o neighbours.pvs --report neighbours.json -q
+python3 -c "
+import json; r=json.load(open('neighbours.json'))
+assert r['mean_pvs_size_written'] > r['mean_pvs_size'] and not r['filter']['object_space'], r['filter']
+" && ok || bad "pvs --filter-neighbours alone extends the PVSs"
 expect_error "--filter" "$VC" pvs office.vcells --scene office.obj --samples 10 --filter-k 2 -o x.pvs
 expect_error "without the filter" "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 40000 \
   --resume half.vagvs --filter -o x.pvs

@@ -65,7 +65,10 @@ std::vector<std::vector<uint32_t>> CellLocator::neighbours() const {
   with_cells.cells.assign(bsp_.nodes.size(), ConvexPolyhedron());
   clip_to_leaves(bsp_, ConvexPolyhedron::box(bsp_.view_box, 0),
                  [&](int32_t n, const ConvexPolyhedron& part) { with_cells.cells[n] = part; });
-  for (const LeafAdjacency& a : leaf_adjacency(with_cells)) {
+  std::vector<int32_t> leaves;
+  for (size_t n = 0; n < bsp_.nodes.size(); ++n)
+    if (bsp_.nodes[n].plane < 0) leaves.push_back(static_cast<int32_t>(n));
+  for (const LeafAdjacency& a : leaf_adjacency(with_cells, leaves)) {
     const int32_t ca = leaf_cell_[a.a], cb = leaf_cell_[a.b];
     if (ca == cb) continue;
     out[ca].push_back(static_cast<uint32_t>(cb));
@@ -1075,6 +1078,7 @@ PixelErrorMeasure measure_pixel_error(const Scene& scene, const RayCaster& caste
 
 AgvsSolver::AgvsSolver(const Scene& scene, const RayCaster& caster, const CellLocator& cells, const AgvsConfig& config) {
   if (config.batch_size == 0) throw Error("the batch size must be positive");
+  if (!(config.min_share >= 0 && config.min_share <= 1)) throw Error("the minimum share must be within [0, 1]");
   if (!(config.window_p > 0 && config.window_p < 1) || !(config.window_k > 0))
     throw Error("the pixel error window needs 0 < P < 1 and k > 0");
   if (scene.object_count() == 0) throw Error("cannot sample an empty scene");
@@ -1171,6 +1175,7 @@ void AgvsSolver::save(const std::string& path, uint64_t identity) const {
   w.put(static_cast<int32_t>(m.config.method));
   w.put(m.config.seed);
   w.put(m.config.batch_size);
+  w.put(m.config.min_share);
   m.pvs.save(w);
   const AgvsStats& s = m.stats;
   w.put(s.samples), w.put(s.rays), w.put(s.batches), w.put(s.seconds), w.put(s.window_rays);
@@ -1212,8 +1217,10 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   const int32_t method = r.get<int32_t>();
   const uint64_t seed = r.get<uint64_t>();
   const uint32_t batch = r.get<uint32_t>();
-  if (method != static_cast<int32_t>(m.config.method) || seed != m.config.seed || batch != m.config.batch_size)
-    throw Error(path, 0, "this state was computed with another method, seed or batch size");
+  const double min_share = r.get<double>();
+  if (method != static_cast<int32_t>(m.config.method) || seed != m.config.seed || batch != m.config.batch_size ||
+      min_share != m.config.min_share)
+    throw Error(path, 0, "this state was computed with another method, seed, batch size or minimum share");
   // Read everything into locals first: a corrupt file leaves the solver as it was.
   GlobalPvs pvs = GlobalPvs::load(r, m.pvs.cell_count(), m.pvs.object_count());
   AgvsStats s = m.stats;

@@ -50,10 +50,15 @@ double overlap_area(const std::vector<std::pair<double, double>>& subject,
 }  // namespace
 
 std::vector<LeafAdjacency> leaf_adjacency(const Subdivision& s, double min_relative_area) {
+  return leaf_adjacency(s, s.leaves(), min_relative_area);
+}
+
+std::vector<LeafAdjacency> leaf_adjacency(const Subdivision& s, const std::vector<int32_t>& leaves,
+                                          double min_relative_area) {
   const double min_area = min_relative_area * s.view_box.diagonal() * s.view_box.diagonal();
   // Faces on split planes (ids >= 6; 0..5 are the view box), by plane and side.
   std::map<int32_t, std::vector<std::pair<int32_t, size_t>>> faces[2];  // [positive side?][plane] -> (leaf, face)
-  for (int32_t leaf : s.leaves()) {
+  for (int32_t leaf : leaves) {
     const auto& cell_faces = s.cells[leaf].faces();
     for (size_t f = 0; f < cell_faces.size(); ++f) {
       const PolyFace& face = cell_faces[f];

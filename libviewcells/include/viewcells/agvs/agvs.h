@@ -134,8 +134,9 @@ struct AgvsConfig {
   uint64_t recalibrate_every = 2'000'000;
   uint32_t mutation_buffer = 1 << 18;  ///< mutation candidates kept (fewest mutations first)
   /// Share of each batch kept for the view space-direction distribution whatever its
-  /// weight: the pixel error estimator needs its rays, and it guarantees progress everywhere.
-  double min_share = 0.05;
+  /// weight: the pixel error estimator needs its rays (at 5%, AGVS's estimator could not
+  /// resolve errors below several pixels), and it guarantees progress everywhere.
+  double min_share = 0.25;
   EmptySpaceMode empty_space = EmptySpaceMode::kAuto;
   /// Keep the visibility filter's sampling densities (segments per cell; per cell and object,
   /// those that hit it: 2 bytes per cell and object). Required by the object space filter.

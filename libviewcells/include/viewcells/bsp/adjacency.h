@@ -17,5 +17,9 @@ struct LeafAdjacency {
 /// All neighbouring pairs of the current leaves, sorted by (a, b). Pairs touching in less than
 /// min_relative_area * (view box diagonal)^2 (edges, corners, rounding) are left out.
 std::vector<LeafAdjacency> leaf_adjacency(const Subdivision& s, double min_relative_area = 1e-12);
+/// The same for the given leaves (whose cells must be built), for a BSP without split records
+/// (one read from a .pvs file).
+std::vector<LeafAdjacency> leaf_adjacency(const Subdivision& s, const std::vector<int32_t>& leaves,
+                                          double min_relative_area = 1e-12);
 
 }  // namespace viewcells
