@@ -147,6 +147,33 @@ TEST(Agvs, MeasuredPixelError) {
   EXPECT_EQ(measure_pixel_error(scene, *caster, cells, full, 5, 64, 64, 90, 1, true).pixels, 0.0);
 }
 
+TEST(Agvs, EstimateOrBoundAgainstTheMeasuredError) {
+  // SGVS stopped at doubling sample counts; at each stop cameras rendered against the same
+  // PVSs. After the first batch, either a window is full and its estimate is within a factor
+  // of 2 of the measurement, or the 90% upper bound is given, and it lies above it.
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 2, 1});
+  const CellLocator cells = office_cells(scene, 30);
+  const auto caster = make_embree_caster(scene);
+  AgvsSolver solver(scene, *caster, cells, quiet(AgvsMethod::kSgvs, 0));
+  int bounds = 0;
+  for (uint64_t n : {10000, 20000, 40000, 80000, 160000}) {
+    solver.set_limits(n, 0, 0);
+    solver.run();
+    const double estimate = solver.pixel_error(), bound = solver.pixel_error_bound();
+    ASSERT_NE(std::isnan(estimate), std::isnan(bound)) << "an estimate or a bound, never both";
+    const double measured = measure_pixel_error(scene, *caster, cells, solver.pvs(), 4000, 16, 16, 90, 9, true).pixels;
+    ASSERT_GT(measured, 0.0);
+    if (!std::isnan(estimate)) {
+      EXPECT_GT(estimate, 0.5 * measured) << n << " samples";
+      EXPECT_LT(estimate, 2.0 * measured) << n << " samples";
+    } else {
+      EXPECT_GE(bound, measured) << n << " samples";
+      ++bounds;
+    }
+  }
+  EXPECT_GT(bounds, 0);
+}
+
 TEST(Agvs, SavedStateResumesExactly) {
   const Scene scene = generate_scene({GeneratorKind::kOffice, 2, 5});
   const CellLocator cells = office_cells(scene, 30);
