@@ -77,6 +77,6 @@ plot "$out/sgvs.dat" using 1:2 with linespoints lw 2 lc 2 title "SGVS estimated"
      "$out/agvs.dat" using 1:3 with lines lw 1 dt 2 lc 1 title "AGVS bound (no window)", \
      "$out/agvs.dat" using 1:4 with points pt 7 ps 1.5 lc 1 title "AGVS measured"
 GP
-python3 scripts/replace-section.py BENCHMARKS.md estimator \
+python3 scripts/replace-section.py BENCHMARKS.md "estimator-$kind$size" \
   "scripts/bench-estimator.sh $kind $size $cells $max_samples $cameras $camera_size" "$out/table.md"
 cat "$out/table.md"
