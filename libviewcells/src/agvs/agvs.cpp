@@ -753,13 +753,14 @@ struct AgvsSolver::Impl {
     uint64_t vsd_rays = 0, vsd_contributing = 0;
     // The estimator's camera rays per sample (0 when the sample's point is inside a solid: no
     // camera stands there) and those that were wrong pixels (an entry new to the point's cell).
-    std::vector<uint8_t> camera_rays(count, 0), wrong_rays(count, 0);
+    std::vector<uint8_t> camera_rays(count, 0), wrong_rays(count, 0), has_segment(count, 0);
     std::vector<int32_t> origin_cell(count, -2);
     for (size_t k = 0; k < chunks.size(); ++k) {
       const Chunk& c = chunks[k];
       dist_rays[c.dist] += c.rays;
       for (size_t i = 0; i < c.segs.size(); ++i) {
         const uint32_t sample = c.first + c.sample_of[i];
+        has_segment[sample] = 1;
         const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
         bool contributed[2] = {false, false};
         uint64_t gain = 0;
@@ -811,6 +812,9 @@ struct AgvsSolver::Impl {
     }
     // The estimator counts view space-direction samples (all of them for SGVS and REF).
     for (uint32_t s = first_of[kVsd]; s < end_of[kVsd]; ++s) {
+      // No segment at all: both rays left the scene without a hit (the caster emits nothing
+      // then), so the point is free and its camera sees nothing there: right pixels.
+      if (!has_segment[s]) camera_rays[s] = config.method == AgvsMethod::kRef ? 1 : 2;
       vsd_rays += camera_rays[s];
       vsd_contributing += wrong_rays[s];
     }
