@@ -1107,9 +1107,17 @@ void AgvsSolver::run() {
   // The limits count from the start of the computation (a resumed state included) and are
   // checked between batches, so that where a run stops never changes the batches: a run
   // resumed from a state continues exactly as an uninterrupted one.
-  const bool show = c.show_progress && c.max_samples > m.stats.samples;
+  // The bar follows the samples, else the time; with only a pixel error to reach, a counter.
+  // Its status line shows the mean PVS and the pixel error estimate (or bound).
+  const bool by_samples = c.max_samples > 0, by_time = !by_samples && c.max_seconds > 0;
+  const bool show = c.show_progress && (!by_samples || c.max_samples > m.stats.samples);
   std::optional<Progress> progress;
-  if (show) progress.emplace("pvs", c.max_samples - m.stats.samples);
+  const uint64_t start_ms = static_cast<uint64_t>(before * 1000);
+  if (show)
+    progress.emplace("pvs", by_samples ? c.max_samples - m.stats.samples
+                            : by_time  ? static_cast<uint64_t>(std::max(0.0, c.max_seconds - before) * 1000)
+                                       : 0);
+  uint64_t shown_ms = start_ms;
   while (true) {
     const double seconds = before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (c.max_samples && m.stats.samples >= c.max_samples) {
@@ -1131,7 +1139,24 @@ void AgvsSolver::run() {
     }
     const uint64_t done = m.stats.samples;
     m.batch(m.stats.batches, c.batch_size);
-    if (show) progress->advance(m.stats.samples - done);
+    if (show) {
+      char status[160];
+      if (!std::isnan(m.error))
+        std::snprintf(status, sizeof status, "mean PVS %.1f, pixel error ~%.2f", m.mean_pvs(), m.error);
+      else if (!std::isnan(m.error_bound))
+        std::snprintf(status, sizeof status, "mean PVS %.1f, pixel error < %.2f", m.mean_pvs(), m.error_bound);
+      else
+        std::snprintf(status, sizeof status, "mean PVS %.1f", m.mean_pvs());
+      progress->set_status(status);
+      if (by_time) {
+        const uint64_t now_ms = static_cast<uint64_t>(
+            (before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count()) * 1000);
+        progress->advance(now_ms - shown_ms);
+        shown_ms = now_ms;
+      } else {
+        progress->advance(m.stats.samples - done);
+      }
+    }
     m.stats.seconds = before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     AgvsPoint point{m.stats.seconds, m.stats.samples, m.stats.rays, m.mean_pvs(), m.error, m.error_bound,
                     m.stats.camera_rays, m.stats.wrong_camera_rays};

@@ -29,6 +29,11 @@ void Progress::advance(uint64_t n) {
   if (lock.owns_lock()) draw(done, false);
 }
 
+void Progress::set_status(std::string status) {
+  std::lock_guard lock(status_mutex_);
+  status_ = std::move(status);
+}
+
 void Progress::finish() {
   if (finished_) return;
   finished_ = true;
@@ -47,8 +52,18 @@ void Progress::draw(uint64_t done, bool final) {
   for (int i = 0; i < kWidth; ++i) bar[i] = i < filled ? '#' : '.';
   bar[kWidth] = '\0';
   const double eta = frac > 0 ? elapsed * (1.0 - frac) / frac : 0.0;
-  std::fprintf(stderr, "\r%-12s [%s] %5.1f%%  %.1fs elapsed, %.1fs left   ", label_.c_str(), bar,
-               100.0 * frac, elapsed, final ? 0.0 : eta);
+  std::string status;
+  {
+    std::lock_guard lock(status_mutex_);
+    status = status_;
+  }
+  if (total_ == 0) {
+    std::fprintf(stderr, "\r%-12s %llu done  %.1fs elapsed  %s   ", label_.c_str(),
+                 static_cast<unsigned long long>(done), elapsed, status.c_str());
+  } else {
+    std::fprintf(stderr, "\r%-12s [%s] %5.1f%%  %.1fs elapsed, %.1fs left  %s   ", label_.c_str(), bar,
+                 100.0 * frac, elapsed, final ? 0.0 : eta, status.c_str());
+  }
   if (final) std::fputc('\n', stderr);
   std::fflush(stderr);
 }

@@ -11,13 +11,16 @@ namespace viewcells {
 
 class Progress {
  public:
-  /// total: units of work; label: shown before the bar. Enabled when stderr is a TTY.
+  /// total: units of work (0: unknown, a counter instead of a bar); label: shown before the
+  /// bar. Enabled when stderr is a TTY.
   Progress(std::string label, uint64_t total);
   ~Progress();
   Progress(const Progress&) = delete;
   Progress& operator=(const Progress&) = delete;
 
   void advance(uint64_t n = 1);
+  /// Text shown after the bar (e.g. a running estimate); thread-safe.
+  void set_status(std::string status);
   /// Draws the final state and ends the line.
   void finish();
   bool enabled() const { return enabled_; }
@@ -32,6 +35,8 @@ class Progress {
   std::atomic<uint64_t> done_{0};
   std::atomic<int64_t> last_draw_ns_{0};
   std::mutex draw_mutex_;
+  std::mutex status_mutex_;
+  std::string status_;
   std::chrono::steady_clock::time_point start_;
 };
 
