@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <deque>
 #include <limits>
 #include <map>
@@ -1129,12 +1130,15 @@ void AgvsSolver::run() {
       break;
     }
     if (c.pixel_error > 0 && !std::isnan(m.error) && m.error <= c.pixel_error) {
-      m.stats.stop_reason = "estimated pixel error at most " + std::to_string(c.pixel_error);
+      char text[96];
+      std::snprintf(text, sizeof text, "estimated pixel error at most %g", c.pixel_error);
+      m.stats.stop_reason = text;
       break;
     }
     if (c.pixel_error > 0 && !std::isnan(m.error_bound) && m.error_bound <= c.pixel_error) {
-      m.stats.stop_reason = "too few wrong camera rays for an estimate: pixel error below " +
-                            std::to_string(c.pixel_error) + " with probability 0.9";
+      char text[96];
+      std::snprintf(text, sizeof text, "pixel error below %g with probability 0.9", c.pixel_error);
+      m.stats.stop_reason = text;
       break;
     }
     const uint64_t done = m.stats.samples;
