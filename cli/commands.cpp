@@ -1061,7 +1061,7 @@ int run_pvs(const PvsArgs& a, const Common& c) {
         " until " +
         (a.pixel_error > 0 ? "an estimated pixel error of " + fmt(a.pixel_error, 2) + " "
                            : std::string()) +
-        (a.seconds > 0 ? std::to_string(a.seconds) + " s " : std::string()) +
+        (a.seconds > 0 ? fmt(a.seconds, 1) + " s " : std::string()) +
         (a.samples ? std::to_string(a.samples) + " samples" : std::string()));
   // A saved state belongs to a scene and these view cells.
   auto identity_of = [&](uint64_t scene_fingerprint) {

@@ -2,7 +2,9 @@
 # Installs dependencies, builds, and runs the pipeline on the built-in default scene (a
 # generated two-storey office): visibility sampling, view space subdivision into 2000 cells and
 # merging, 100 view cells cut from the merge history, their PVSs compressed into a .pvs file,
-# and a viewpoint looked up in it. Coloured cell mesh and slice images. Outputs: out/demo/.
+# then computed again by adaptive global visibility sampling (AGVS, 20 s, with the measured
+# pixel error), and a viewpoint looked up in it. Coloured cell mesh and slice images.
+# Outputs: out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -18,8 +20,12 @@ mkdir -p "$out"
   --slice-png "$out/view-cells.png" --slice-z 1.5 --scene "$out/office.obj"
 "$vc" compress "$out/office.vcells" --count 100 -o "$out/office.pvs" --flat "$out/office.vflt" \
   --report "$out/compress-report.json"
-"$vc" query "$out/office.pvs" 3 12 1.5 | head -n 8
+"$vc" pvs "$out/office.vcells" --scene "$out/office.obj" --cells 100 --time 20 --seed 1 -o "$out/office-agvs.pvs" \
+  --report "$out/pvs-report.json" --measure-cameras 5000 --measure-size 32 --save "$out/office.vagvs"
+"$vc" query "$out/office-agvs.pvs" 3 12 1.5 | head -n 8
 echo
 echo "demo: scene $out/office.obj; hierarchy $out/office.vcells (look at $out/slice.png, $out/cells.ply);"
-echo "      100 view cells $out/view-cells.json ($out/view-cells.png); PVS $out/office.pvs;"
-echo "      what was enabled and why, costs and timings: $out/build-report.json, $out/compress-report.json"
+echo "      100 view cells $out/view-cells.json ($out/view-cells.png); PVS from the construction samples"
+echo "      $out/office.pvs, by AGVS $out/office-agvs.pvs (continue with --resume $out/office.vagvs);"
+echo "      what was enabled and why, costs and timings: $out/build-report.json, $out/compress-report.json,"
+echo "      $out/pvs-report.json"
