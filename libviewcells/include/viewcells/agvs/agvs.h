@@ -7,7 +7,8 @@
 /// unit of cost, and the estimated pixel error (section 4.5) says when to stop.
 ///
 /// Deterministic: work is done in batches; samples are drawn serially (Halton sequences for
-/// the stationary distributions, seeded streams for the mutations), cast in parallel, and
+/// the stationary distributions, seeded streams for the mutations; the silhouette searches
+/// run in parallel from candidates and random numbers drawn serially), cast in parallel, and
 /// their contributions applied in sample order. The cost unit of a distribution's weight is
 /// the ray, not the second (the paper measures time): rays dominate the cost, and wall-clock
 /// weights would make results depend on the machine and the thread count.
