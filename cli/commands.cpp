@@ -1008,6 +1008,9 @@ void write_pvs_checked(const std::string& path, const PvsFile& pf, const std::ve
     if (back.pvs.cell_pvs(i) != lists[i]) throw Error(path, 0, "read-back check failed for cell " + std::to_string(i));
 }
 
+/// NaN (not known) as JSON null.
+json number_or_null(double v) { return std::isnan(v) ? json(nullptr) : json(v); }
+
 int run_pvs(const PvsArgs& a, const Common& c) {
   ThreadLimit threads(c.threads);
   AgvsConfig config;
@@ -1100,10 +1103,9 @@ int run_pvs(const PvsArgs& a, const Common& c) {
     if (ref.pvs.cell_count != cells.cell_count() || ref.object_count != pf.object_count ||
         ref.scene_fingerprint != pf.scene_fingerprint || ref.leaf_cell != pf.leaf_cell)
       throw Error(path, 0, "is not a .pvs of these view cells of this scene");
-    GlobalPvs table(cells.cell_count(), pf.object_count);
-    for (uint32_t i = 0; i < ref.pvs.cell_count; ++i)
-      for (uint32_t o : ref.pvs.cell_pvs(i)) table.insert(i, o);
-    solver->add_reference(std::move(table));
+    std::vector<std::vector<uint32_t>> ref_lists(ref.pvs.cell_count);
+    for (uint32_t i = 0; i < ref.pvs.cell_count; ++i) ref_lists[i] = ref.pvs.cell_pvs(i);
+    solver->add_reference(GlobalPvs::from_lists(pf.object_count, ref_lists));
   }
   solver->run();
   if (!a.save.empty()) {
@@ -1124,9 +1126,7 @@ int run_pvs(const PvsArgs& a, const Common& c) {
   } else {
     for (uint32_t i = 0; i < cells.cell_count(); ++i) lists[i] = solver->pvs().list(i);
   }
-  GlobalPvs written(cells.cell_count(), pf.object_count);
-  for (uint32_t i = 0; i < cells.cell_count(); ++i)
-    for (uint32_t o : lists[i]) written.insert(i, o);
+  const GlobalPvs written = GlobalPvs::from_lists(pf.object_count, lists);
   const double mean_written = static_cast<double>(written.entries()) / cells.cell_count();
   if (filtering)
     c.log("viewcells: visibility filter (" + std::string(a.filter ? "object space, k = " + fmt(a.filter_k, 2) : "") +
@@ -1173,8 +1173,8 @@ int run_pvs(const PvsArgs& a, const Common& c) {
     json curve = json::array();
     for (const AgvsPoint& p : st.curve)
       curve.push_back({{"seconds", p.seconds}, {"samples", p.samples}, {"rays", p.rays}, {"mean_pvs_size", p.mean_pvs},
-                       {"pixel_error", std::isnan(p.pixel_error) ? json(nullptr) : json(p.pixel_error)},
-                       {"pixel_error_bound", std::isnan(p.pixel_error_bound) ? json(nullptr) : json(p.pixel_error_bound)},
+                       {"pixel_error", number_or_null(p.pixel_error)},
+                       {"pixel_error_bound", number_or_null(p.pixel_error_bound)},
                        {"camera_rays", p.camera_rays},
                        {"wrong_camera_rays", p.wrong_camera_rays},
                        {"covered", json(std::vector<uint64_t>(p.covered, p.covered + a.references.size()))}});
@@ -1221,8 +1221,8 @@ int run_pvs(const PvsArgs& a, const Common& c) {
         {"mean_pvs_size", solver->mean_pvs()},
         {"mean_pvs_size_written", mean_written},
         {"pvs_entries", solver->pvs().entries()},
-        {"estimated_pixel_error", std::isnan(err) ? json(nullptr) : json(err)},
-        {"pixel_error_bound", std::isnan(bound) ? json(nullptr) : json(bound)},
+        {"estimated_pixel_error", number_or_null(err)},
+        {"pixel_error_bound", number_or_null(bound)},
         {"estimator_window_rays", st.window_rays},
         {"measured_pixel_error", measure_json(measured)},
         {"stop_reason", st.stop_reason},

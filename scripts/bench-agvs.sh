@@ -12,8 +12,8 @@ seconds="${4:-60}"
 source "$(dirname "$0")/bench-setup.sh"
 scene=$(bench_scene "$kind" "$size")
 out="$dir/agvs-$kind$size"
-mkdir -p "$out" docs/agvs
-"$vc" build "$scene" --samples 500000 --max-cells $((4 * cells)) --seed 1 -q -o "$out/level.vcells"
+mkdir -p docs/agvs
+bench_level "$scene" "$cells" "$out"
 # SGVS and REF first: AGVS's curve then also counts how much of their final PVSs it has found.
 for m in sgvs ref agvs; do
   refs=()

@@ -16,8 +16,8 @@ camera_size="${6:-32}"
 source "$(dirname "$0")/bench-setup.sh"
 scene=$(bench_scene "$kind" "$size")
 out="$dir/estimator-$kind$size"
-mkdir -p "$out" docs/agvs
-"$vc" build "$scene" --samples 500000 --max-cells $((4 * cells)) --seed 1 -q -o "$out/level.vcells"
+mkdir -p docs/agvs
+bench_level "$scene" "$cells" "$out"
 for m in sgvs agvs; do
   state=()
   n=250000

@@ -10,8 +10,7 @@ cells="${3:-500}"
 source "$(dirname "$0")/bench-setup.sh"
 scene=$(bench_scene "$kind" "$size")
 out="$dir/filter-$kind$size"
-mkdir -p "$out"
-"$vc" build "$scene" --samples 500000 --max-cells $((4 * cells)) --seed 1 -q -o "$out/level.vcells"
+bench_level "$scene" "$cells" "$out"
 for n in 100000 1000000 10000000; do
   for f in object both; do
     opts=(--filter)

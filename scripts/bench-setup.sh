@@ -13,3 +13,9 @@ bench_scene() {
   [ -f "$path" ] || "$vc" generate "$1" --size "$2" --seed 1 -o "$path" -q
   echo "$path"
 }
+# bench_level SCENE CELLS OUT: the view cells the PVS benchmarks share, a merge history of AV-S
+# cells (500,000 construction samples, 4 x CELLS cells, seed 1), written to OUT/level.vcells.
+bench_level() {
+  mkdir -p "$3"
+  "$vc" build "$1" --samples 500000 --max-cells $((4 * $2)) --seed 1 -q -o "$3/level.vcells"
+}

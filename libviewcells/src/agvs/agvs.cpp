@@ -85,6 +85,13 @@ std::vector<std::vector<uint32_t>> CellLocator::neighbours() const {
 GlobalPvs::GlobalPvs(uint32_t cells, uint32_t objects)
     : cells_(cells), objects_(objects), words_((objects + 63) / 64), bits_(size_t(cells) * words_, 0), sizes_(cells, 0) {}
 
+GlobalPvs GlobalPvs::from_lists(uint32_t objects, const std::vector<std::vector<uint32_t>>& lists) {
+  GlobalPvs p(static_cast<uint32_t>(lists.size()), objects);
+  for (uint32_t c = 0; c < lists.size(); ++c)
+    for (uint32_t o : lists[c]) p.insert(c, o);
+  return p;
+}
+
 bool GlobalPvs::insert(uint32_t cell, uint32_t object) {
   uint64_t& w = bits_[size_t(cell) * words_ + object / 64];
   const uint64_t bit = uint64_t{1} << (object % 64);
@@ -370,7 +377,6 @@ struct AgvsSolver::Impl {
   uint64_t halton_index[kDists] = {};
   // Mutation candidates of the two mutation strategies.
   CandidateBuffer two_point, silhouette;
-  uint64_t discovery_rays = 0;  ///< silhouette searches' rays in the current batch
   // The mixture: contribution and rays of each distribution in the last batch.
   double weight[kDists] = {};
   double recent_contribution[kDists] = {}, recent_rays[kDists] = {};
@@ -379,6 +385,7 @@ struct AgvsSolver::Impl {
   // The pixel error estimator's window: per batch, view space-direction rays and those that
   // added an entry to the cell containing their origin.
   std::deque<std::pair<uint64_t, uint64_t>> window;
+  uint64_t window_total = 0;  ///< camera rays since the start (or the last edit), trimmed ones too
   double error = std::numeric_limits<double>::quiet_NaN();
   /// With too few wrong camera rays for a window: the error's 90% upper bound, in pixels.
   double error_bound = std::numeric_limits<double>::quiet_NaN();
@@ -649,7 +656,7 @@ struct AgvsSolver::Impl {
     // The view space-direction samples last: they also replace the draws that failed (no
     // mutation candidate left, a degenerate two-point pair), so every batch has n samples.
     constexpr int kOrder[kDists] = {kSil, kTpm, kOd, kTp, kVsd};
-    discovery_rays = 0;
+    uint64_t discovery_rays = 0;  // the silhouette searches' rays
     uint32_t failed = 0;
     struct SilhouetteJob {
       Candidate candidate;
@@ -844,6 +851,7 @@ struct AgvsSolver::Impl {
   /// wrong share over them.
   void update_estimate(uint64_t rays, uint64_t wrong) {
     window.emplace_front(rays, wrong);
+    window_total += rays;
     evaluate_window();
   }
 
@@ -852,9 +860,7 @@ struct AgvsSolver::Impl {
   /// half holds too few wrong rays for equation 5 (the error is below what it resolves), there
   /// is no estimate, and error_bound gives the one-sided 90% Poisson upper bound over it.
   void evaluate_window() {
-    uint64_t total = 0;
-    for (const auto& [r, c] : window) total += r;
-    const uint64_t reach = std::max<uint64_t>(total / 2, 1);
+    const uint64_t reach = std::max<uint64_t>(window_total / 2, 1);
     uint64_t n = 0, nc = 0;
     size_t used = 0;
     error = error_bound = std::numeric_limits<double>::quiet_NaN();
@@ -880,8 +886,12 @@ struct AgvsSolver::Impl {
       error_bound = config.resolution * upper / static_cast<double>(n);
       stats.window_rays = n;
     }
-    // The history the next windows may need (at most half of it is ever used).
-    while (window.size() > 200000) window.pop_back();
+    // Batches beyond the newer half never come back into reach: a new batch moves every older
+    // one further back by all its rays, the half's start by only half of them.
+    size_t keep = 0;
+    for (uint64_t acc = 0; keep < window.size() && (keep == 0 || acc + window[keep].first <= reach); ++keep)
+      acc += window[keep].first;
+    window.resize(keep);
   }
 
   double mean_pvs() const { return static_cast<double>(pvs.entries()) / cells.cell_count(); }
@@ -954,6 +964,7 @@ struct AgvsSolver::Impl {
         if (cand.object != kNoObject) cand.object = new_of_old[cand.object];
     // The estimator's rays described the old scene.
     window.clear();
+    window_total = 0;
     evaluate_window();
     return st;
   }
@@ -975,7 +986,7 @@ struct AgvsSolver::Impl {
         const double n_v = static_cast<double>(cell_samples[c]);
         const Box3& cb = cells.cell_bounds(c);
         std::vector<uint32_t> found;
-        for (uint32_t o : pvs.list(c)) {
+        for (uint32_t o : list) {
           const Box3& ob = sc.objects[o].bounds;
           const double hits = hit_counts[size_t(c) * n_obj + o];
           const double e_g = n_v > 0 ? 2 * box_distance(cb, ob) / std::sqrt(n_v) : 0.0;
@@ -1222,6 +1233,7 @@ void AgvsSolver::save(const std::string& path, uint64_t identity) const {
   w.put(m.error);
   m.two_point.save(w);
   m.silhouette.save(w);
+  w.put(m.window_total);
   w.put<uint64_t>(m.window.size());
   for (const auto& [n, nc] : m.window) w.put(n), w.put(nc);
   w.put<uint64_t>(s.curve.size());
@@ -1272,6 +1284,7 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   const double error = r.get<double>();
   CandidateBuffer two_point = CandidateBuffer::load(r, m.config.mutation_buffer, payload.size());
   CandidateBuffer silhouette = CandidateBuffer::load(r, m.config.mutation_buffer, payload.size());
+  const uint64_t window_total = r.get<uint64_t>();
   const uint64_t windows = r.get<uint64_t>();
   if (windows > payload.size()) r.fail("estimator window too long");
   std::deque<std::pair<uint64_t, uint64_t>> window;
@@ -1310,6 +1323,7 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   m.two_point = std::move(two_point);
   m.silhouette = std::move(silhouette);
   m.window = std::move(window);
+  m.window_total = window_total;
   m.cell_samples = std::move(cell_samples);
   m.hit_counts = std::move(hit_counts);
   m.evaluate_window();

@@ -13,18 +13,13 @@ namespace viewcells {
 namespace {
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
+using Mesh = CGAL::Surface_mesh<Point>;
 
-}  // namespace
-
-ConvexRegion ConvexRegion::everything() {
-  ConvexRegion r;
-  r.everything_ = true;
-  return r;
-}
+Vec3 to_vec(const Point& p) { return {p.x(), p.y(), p.z()}; }
 
 /// Whether the points span a volume (CGAL's hull needs it): a base triangle from the points
 /// far from the first one and from the line of the first two, then an exact coplanarity test.
-static bool spans_volume(const std::vector<Point>& pts) {
+bool spans_volume(const std::vector<Point>& pts) {
   if (pts.size() < 4) return false;
   size_t i1 = 0, i2 = 0;
   double best = 0;
@@ -41,29 +36,39 @@ static bool spans_volume(const std::vector<Point>& pts) {
   return false;
 }
 
+/// CGAL's convex hull of the points; false when they span no volume.
+bool hull_mesh(std::span<const Vec3> points, Mesh& mesh) {
+  std::vector<Point> pts;
+  pts.reserve(points.size());
+  for (const Vec3& p : points) pts.emplace_back(p.x, p.y, p.z);
+  if (!spans_volume(pts)) return false;
+  CGAL::convex_hull_3(pts.begin(), pts.end(), mesh);
+  return true;
+}
+
+}  // namespace
+
+ConvexRegion ConvexRegion::everything() {
+  ConvexRegion r;
+  r.everything_ = true;
+  return r;
+}
+
 ConvexRegion ConvexRegion::hull(std::span<const Vec3> points) {
   ConvexRegion r;
   for (const Vec3& p : points) r.bounds_.extend(p);
   r.tolerance_ = 1e-9 * std::max(1.0, r.bounds_.diagonal());
-  std::vector<Point> pts;
-  pts.reserve(points.size());
-  for (const Vec3& p : points) pts.emplace_back(p.x, p.y, p.z);
-  if (!spans_volume(pts)) return r;  // degenerate: the bounding box alone
-  CGAL::Surface_mesh<Point> mesh;
-  CGAL::convex_hull_3(pts.begin(), pts.end(), mesh);
+  Mesh mesh;
+  if (!hull_mesh(points, mesh)) return r;  // degenerate: the bounding box alone
   Vec3 centre{0, 0, 0};
-  for (const auto v : mesh.vertices()) {
-    const Point& p = mesh.point(v);
-    centre += Vec3{p.x(), p.y(), p.z()};
-  }
+  for (const auto v : mesh.vertices()) centre += to_vec(mesh.point(v));
   centre = centre / static_cast<double>(mesh.number_of_vertices());
   for (const auto f : mesh.faces()) {
     Vec3 corner[3];
     int n = 0;
     for (const auto v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
       if (n == 3) break;
-      const Point& p = mesh.point(v);
-      corner[n++] = {p.x(), p.y(), p.z()};
+      corner[n++] = to_vec(mesh.point(v));
     }
     if (n < 3) continue;
     Vec3 normal = cross(corner[1] - corner[0], corner[2] - corner[0]);
@@ -92,17 +97,10 @@ bool ConvexRegion::may_intersect(const Box3& box) const {
 }
 
 std::vector<Vec3> convex_hull_vertices(std::span<const Vec3> points) {
-  std::vector<Point> pts;
-  pts.reserve(points.size());
-  for (const Vec3& p : points) pts.emplace_back(p.x, p.y, p.z);
-  if (!spans_volume(pts)) return {points.begin(), points.end()};
-  CGAL::Surface_mesh<Point> mesh;
-  CGAL::convex_hull_3(pts.begin(), pts.end(), mesh);
+  Mesh mesh;
+  if (!hull_mesh(points, mesh)) return {points.begin(), points.end()};
   std::vector<Vec3> out;
-  for (const auto v : mesh.vertices()) {
-    const Point& p = mesh.point(v);
-    out.push_back({p.x(), p.y(), p.z()});
-  }
+  for (const auto v : mesh.vertices()) out.push_back(to_vec(mesh.point(v)));
   return out;
 }
 
@@ -114,12 +112,11 @@ ConvexRegion penumbra(std::span<const Vec3> occluder, const Box3& cell, double r
   if (!(gap > 1e-9 * std::max(1.0, reach))) return ConvexRegion::everything();
   const double b = reach / gap;
   std::vector<Vec3> pts(occluder.begin(), occluder.end());
-  const Vec3 corners[8] = {{cell.lo.x, cell.lo.y, cell.lo.z}, {cell.hi.x, cell.lo.y, cell.lo.z},
-                           {cell.lo.x, cell.hi.y, cell.lo.z}, {cell.hi.x, cell.hi.y, cell.lo.z},
-                           {cell.lo.x, cell.lo.y, cell.hi.z}, {cell.hi.x, cell.lo.y, cell.hi.z},
-                           {cell.lo.x, cell.hi.y, cell.hi.z}, {cell.hi.x, cell.hi.y, cell.hi.z}};
   for (const Vec3& o : occluder)
-    for (const Vec3& x : corners) pts.push_back(o + (o - x) * b);
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 x{k & 1 ? cell.hi.x : cell.lo.x, k & 2 ? cell.hi.y : cell.lo.y, k & 4 ? cell.hi.z : cell.lo.z};
+      pts.push_back(o + (o - x) * b);
+    }
   return ConvexRegion::hull(pts);
 }
 

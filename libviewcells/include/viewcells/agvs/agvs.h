@@ -64,6 +64,8 @@ class GlobalPvs {
  public:
   GlobalPvs() = default;
   GlobalPvs(uint32_t cells, uint32_t objects);
+  /// The table of per-cell object lists (ids < objects).
+  static GlobalPvs from_lists(uint32_t objects, const std::vector<std::vector<uint32_t>>& lists);
   uint32_t cell_count() const { return cells_; }
   uint32_t object_count() const { return objects_; }
   bool contains(uint32_t cell, uint32_t object) const {
