@@ -18,6 +18,7 @@
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/bsp/subdivision_io.h"
 #include "viewcells/core/error.h"
+#include "viewcells/core/isa.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/io/binary_file.h"
@@ -87,7 +88,11 @@ std::string describe_box(const Box3& b) {
          fmt(b.hi.y) + ", " + fmt(b.hi.z) + "]";
 }
 
-void write_json(const std::string& path, const json& j) { write_text_file(path, j.dump(2) + "\n"); }
+/// Reports say which Embree ISA cast their rays: results are bit-identical only for the same one.
+void write_json(const std::string& path, json j) {
+  if (j.is_object()) j["embree_isa"] = embree_isa();
+  write_text_file(path, j.dump(2) + "\n");
+}
 
 // ------------------------------------------------------------------------------- generate
 
@@ -1335,6 +1340,11 @@ int run(int argc, char** argv) {
   app.add_option("--threads", common.threads, "Worker threads (0 = all cores); results do not depend on it")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("-q,--quiet", common.quiet, "No progress bars or log lines on stderr");
+  std::string isa;
+  app.add_option("--embree-isa", isa,
+                 "Embree's instruction set: sse2, sse4.2, avx, avx2 or avx512 (default: VIEWCELLS_EMBREE_ISA, else "
+                 "the CPU's best). Sampled results are bit-identical across machines only for the same ISA; reports "
+                 "and file headers record it");
 
   GenerateArgs gen;
   auto* g = app.add_subcommand("generate", "Write a generated test scene as OBJ (one group per object)");
@@ -1507,6 +1517,10 @@ int run(int argc, char** argv) {
   pv->add_option("-o,--output", pva.output, "The .pvs file to write")->required();
   pv->add_option("--report", pva.report, "JSON report: samples, rays, mean PVS size, estimated pixel error, curve");
 
+  bool isa_supported = false;
+  auto* is = app.add_subcommand("isa", "Print the Embree ISA that ray casting would use (see --embree-isa)");
+  is->add_flag("--supported", isa_supported, "Print every ISA this CPU runs instead, one per line, best last");
+
   QueryArgs qry;
   auto* qy = app.add_subcommand("query", "Print the view cell containing a point and its PVS");
   qy->add_option("pvs", qry.input, "A .pvs file (from compress)")->required();
@@ -1519,6 +1533,9 @@ int run(int argc, char** argv) {
     return app.exit(e);
   }
   try {
+    // One setting for the whole process, read by every caster and file header (core/isa.h).
+    if (!isa.empty()) setenv("VIEWCELLS_EMBREE_ISA", checked_embree_isa(isa).c_str(), 1);
+    embree_isa();  // a bad VIEWCELLS_EMBREE_ISA fails here, before any work
     if (*g) return run_generate(gen, common);
     if (*i) return run_info(info, common);
     if (*s) {
@@ -1538,6 +1555,14 @@ int run(int argc, char** argv) {
     if (*cp) return run_compress(cmp, common);
     if (*pv) return run_pvs(pva, common);
     if (*qy) return run_query(qry, common);
+    if (*is) {
+      if (isa_supported) {
+        for (const std::string& name : supported_embree_isas()) std::cout << name << '\n';
+      } else {
+        std::cout << embree_isa() << '\n';
+      }
+      return 0;
+    }
   } catch (const Error& e) {
     std::cerr << "viewcells: error: " << e.what() << '\n';
     return 1;

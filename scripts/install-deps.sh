@@ -7,7 +7,6 @@ packages=(
   build-essential cmake ninja-build pkg-config python3
   libembree-dev          # ray casting (Embree 3.13)
   libcgal-dev libgmp-dev libmpfr-dev   # exact predicates (header-only CGAL 5.5)
-  libopenmesh-dev        # PLY / OFF / STL loading
   libboost-graph-dev     # neighbour graph of view cells
   libtbb-dev             # parallelism
   libcli11-dev           # command line

@@ -309,7 +309,7 @@ void expect_adjacency_consistent(const Subdivision& s) {
   for (const auto& [p, a] : side_area[0]) faces_neg += a;
   for (const auto& [p, a] : side_area[1]) faces_pos += a;
   EXPECT_NEAR(faces_neg / faces_pos, 1.0, 1e-9);
-  EXPECT_NEAR(shared / faces_neg, 1.0, 1e-6);
+  EXPECT_NEAR(shared / faces_neg, 1.0, 1e-9);
 }
 
 TEST(Subdivision, AdjacencyIsSymmetricWithPositiveAreas) {

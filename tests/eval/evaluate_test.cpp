@@ -56,14 +56,22 @@ TEST(Evaluate, ConstructionSamplesReproduceTheMergeHistorysCosts) {
 TEST(Evaluate, CostOfAFixedPartitionConvergesWithMoreEvaluationSamples) {
   const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 2});
   const Subdivision s = build(scene, sample(scene, 20000, 1), "av-s", 16);
+  // Nested evaluation sets (prefixes of one run), so that each holds the one before: every
+  // PVS then only grows, and so does the cost, whatever the CPU's exact samples are.
+  const SegmentSet all = sample(scene, 1280000, 7);
   std::vector<double> cost;
   for (uint64_t n : {5000, 20000, 80000, 320000, 1280000}) {
-    cost.push_back(evaluate_subdivision(scene, s, evaluation_pvs(s, sample(scene, n, 7 + n)), CostModel{}).at(16));
+    SegmentSet prefix;
+    prefix.view_box = all.view_box;
+    prefix.append(all, 0, all.size() * n / 1280000);
+    cost.push_back(evaluate_subdivision(scene, s, evaluation_pvs(s, prefix), CostModel{}).at(16));
   }
-  // More samples find more of each PVS, so the cost grows, by less and less (from 20k on:
-  // below that, whole rooms are still missing from some PVSs).
-  for (size_t i = 1; i < cost.size(); ++i) EXPECT_GT(cost[i], cost[i - 1]) << i;
-  for (size_t i = 3; i < cost.size(); ++i) EXPECT_LT(cost[i] - cost[i - 1], cost[i - 1] - cost[i - 2]) << i;
+  for (size_t i = 1; i < cost.size(); ++i) EXPECT_GE(cost[i], cost[i - 1]) << i;
+  // And it converges: what a quadrupling adds shrinks (compared two steps apart, which
+  // sampling noise cannot reorder: from 20k on, whole rooms are no longer missing), and the
+  // last one adds less than 8%.
+  EXPECT_GT(cost[4], cost[0]);
+  EXPECT_LT(cost[4] - cost[3], cost[2] - cost[1]);
   EXPECT_LT((cost[4] - cost[3]) / cost[4], 0.08) << cost[3] << " -> " << cost[4];
 }
 

@@ -1,10 +1,12 @@
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
 #include "support/test_scenes.h"
 #include "viewcells/core/error.h"
+#include "viewcells/core/isa.h"
 #include "viewcells/io/binary_file.h"
 
 namespace viewcells {
@@ -47,13 +49,21 @@ TEST(BinaryFile, RoundTrip) {
 }
 
 TEST(BinaryFile, HeaderBytesAreStable) {
-  // Golden header: magic, version 1, payload size 3, then checksum and compressed size.
+  // Golden header: magic, version 1 (low 16 bits) and the Embree ISA code (third byte),
+  // payload size 3, then checksum and compressed size.
   const std::string path = test::temp_path("golden.bin");
   write_container(path, kMagic, 1, "abc");
   const std::string file = read_all(path);
   ASSERT_GE(file.size(), 32u);
   EXPECT_EQ(file.substr(0, 4), "TEST");
-  EXPECT_EQ(file.substr(4, 4), std::string("\x01\x00\x00\x00", 4));
+  EXPECT_EQ(file.substr(4, 2), std::string("\x01\x00", 2));
+  EXPECT_EQ(static_cast<uint8_t>(file[6]), embree_isa_code(embree_isa()));
+  EXPECT_EQ(file[7], '\0');
+  uint32_t version = 0;
+  std::string isa;
+  EXPECT_EQ(read_container(path, kMagic, 1, version, &isa), "abc");
+  EXPECT_EQ(version, 1u);
+  EXPECT_EQ(isa, embree_isa());
   EXPECT_EQ(file.substr(8, 8), std::string("\x03\x00\x00\x00\x00\x00\x00\x00", 8));
   uint64_t checksum;
   std::memcpy(&checksum, file.data() + 16, 8);
@@ -94,7 +104,17 @@ TEST(BinaryFile, CorruptionIsRejected) {
   test::write_file(newer_path, newer);
   expect_rejected(newer_path, "version 9");
 
-  expect_rejected(test::temp_path("absent.bin"), "cannot open");
+  expect_rejected(test::temp_path("absent.bin"), "no such file");
+  expect_rejected(std::filesystem::temp_directory_path().string(), "not a regular file");
+
+  // A header claiming far more bytes than zstd can expand the payload to is refused before
+  // anything is allocated (the checksum would only be checked afterwards).
+  std::string huge = bytes;
+  const uint64_t claim = uint64_t{1} << 50;
+  std::memcpy(huge.data() + 8, &claim, 8);
+  const std::string huge_path = test::temp_path("huge.bin");
+  test::write_file(huge_path, huge);
+  expect_rejected(huge_path, "corrupt");
 }
 
 TEST(BinaryFile, FailedWriteKeepsTheOldFile) {

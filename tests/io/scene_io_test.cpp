@@ -1,5 +1,7 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
 #include <sstream>
 
 #include "support/test_scenes.h"
@@ -98,7 +100,7 @@ TEST(SceneLoader, EmptyMissingAndUnknownFilesAreErrors) {
   expect_load_error(unknown, {"unknown scene format"});
 }
 
-// A closed unit cube in each OpenMesh format (ASCII, inline so the bytes are visible).
+// A closed unit cube in each mesh format (ASCII, inline so the bytes are visible).
 const char* kCubeOff = R"(OFF
 8 6 0
 0 0 0
@@ -139,7 +141,7 @@ std::string cube_stl() {
   return s.str();
 }
 
-TEST(SceneLoader, MeshFormatsThroughOpenMesh) {
+TEST(SceneLoader, MeshFormats) {
   const std::pair<std::string, std::string> files[] = {
       {"cube.off", kCubeOff}, {"cube.ply", cube_ply()}, {"cube.stl", cube_stl()}};
   for (const auto& [name, text] : files) {
@@ -161,7 +163,7 @@ TEST(SceneLoader, MeshFormatErrors) {
   expect_load_error(nan_off, {nan_off + ":6:", "NaN"});
   const std::string garbage = test::temp_path("garbage.ply");
   test::write_file(garbage, "this is not a ply file\n");
-  expect_load_error(garbage, {garbage, "could not parse"});
+  expect_load_error(garbage, {garbage, "not a PLY file"});
   const std::string truncated = test::temp_path("truncated.off");
   test::write_file(truncated, std::string(kCubeOff).substr(0, 60));
   expect_load_error(truncated, {truncated, "truncated"});
@@ -179,6 +181,142 @@ TEST(SceneLoader, MeshFormatErrors) {
   const std::string truncated_bin = test::temp_path("truncated_bin.stl");
   test::write_file(truncated_bin, binary);
   expect_load_error(truncated_bin, {truncated_bin});
+}
+
+/// The cube as binary PLY (either byte order, float coordinates, uchar/int lists, with an
+/// extra property and an extra element to skip) and as binary STL.
+std::string cube_binary_ply(bool big_endian) {
+  RawMesh m;
+  test::add_cube(m, {0, 0, 0}, {1, 1, 1}, "cube");
+  std::string s = std::string("ply\nformat ") + (big_endian ? "binary_big_endian" : "binary_little_endian") +
+                  " 1.0\ncomment made by a test\nelement vertex " + std::to_string(m.vertices.size()) +
+                  "\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nelement face " +
+                  std::to_string(m.triangles.size()) +
+                  "\nproperty list uchar int vertex_indices\nelement extra 2\nproperty list uchar double values\n"
+                  "end_header\n";
+  auto put = [&](auto v) {
+    char b[sizeof v];
+    std::memcpy(b, &v, sizeof v);
+    if (big_endian) std::reverse(b, b + sizeof v);
+    s.append(b, sizeof v);
+  };
+  for (const Vec3& v : m.vertices) {
+    put(static_cast<float>(v.x)), put(static_cast<float>(v.y)), put(static_cast<float>(v.z));
+    put(uint8_t{7});
+  }
+  for (const auto& t : m.triangles) {
+    put(uint8_t{3});
+    for (uint32_t v : t) put(static_cast<int32_t>(v));
+  }
+  for (int e = 0; e < 2; ++e) {
+    put(uint8_t{2});
+    put(1.5), put(2.5);
+  }
+  return s;
+}
+
+std::string cube_binary_stl() {
+  RawMesh m;
+  test::add_cube(m, {0, 0, 0}, {1, 1, 1}, "cube");
+  std::string s(80, ' ');
+  const uint32_t n = static_cast<uint32_t>(m.triangles.size());
+  s.append(reinterpret_cast<const char*>(&n), 4);
+  for (const auto& t : m.triangles) {
+    s.append(12, '\0');
+    for (uint32_t v : t)
+      for (double c : {m.vertices[v].x, m.vertices[v].y, m.vertices[v].z}) {
+        const float f = static_cast<float>(c);
+        s.append(reinterpret_cast<const char*>(&f), 4);
+      }
+    s.append(2, '\0');
+  }
+  return s;
+}
+
+TEST(SceneLoader, BinaryMeshFormats) {
+  const std::pair<std::string, std::string> files[] = {{"le.ply", cube_binary_ply(false)},
+                                                       {"be.ply", cube_binary_ply(true)},
+                                                       {"bin.stl", cube_binary_stl()}};
+  for (const auto& [name, bytes] : files) {
+    const std::string path = test::temp_path(name);
+    test::write_file(path, bytes);
+    const Scene s = load_scene(path);
+    EXPECT_EQ(s.triangle_count(), 12u) << name;
+    ASSERT_EQ(s.object_count(), 1u) << name;
+    EXPECT_NEAR(s.objects[0].signed_volume, 1.0, 1e-9) << name;
+  }
+}
+
+/// Every strict prefix of a mesh file is an error (each format declares what it holds or how
+/// it ends), never a smaller mesh, a hang or a crash.
+TEST(SceneLoader, EveryTruncationIsAnError) {
+  const std::pair<std::string, std::string> files[] = {{"off", kCubeOff},
+                                                       {"ply", cube_ply()},
+                                                       {"ply", cube_binary_ply(false)},
+                                                       {"stl", cube_stl()},
+                                                       {"stl", cube_binary_stl()}};
+  for (const auto& [ext, bytes] : files) {
+    // A trailing newline or the last bytes of "endsolid cube\n" may go without loss.
+    const size_t keep = ext == "stl" && bytes[0] == 's' ? bytes.rfind("endsolid") + 8 : bytes.size() - 1;
+    for (size_t n = 0; n < keep; ++n) {
+      const std::string cut = bytes.substr(0, n);
+      const std::string name = "prefix." + ext;
+      EXPECT_THROW((ext == "off" ? read_off(cut, name) : ext == "ply" ? read_ply(cut, name) : read_stl(cut, name)),
+                   Error)
+          << ext << " cut to " << n << " of " << bytes.size() << " bytes";
+    }
+  }
+}
+
+/// What a hostile-input probe found: counts that would allocate or loop without bound, files
+/// that invented faces, bytes that are not text. Each is a clear error naming the file.
+TEST(SceneLoader, HostileCountsAndBytes) {
+  auto expect_error = [](const std::string& name, const std::string& bytes, const std::string& fragment) {
+    const std::string path = test::temp_path(name);
+    test::write_file(path, bytes);
+    expect_load_error(path, {path, fragment});
+  };
+  const std::string ply_head = "ply\nformat binary_little_endian 1.0\n";
+  expect_error("no_end.ply", ply_head + "element vertex 3\nproperty float x\n", "no end_header");
+  expect_error("huge_count.ply",
+               ply_head + "element vertex 99999999999999999999999\nproperty float x\nproperty float y\n"
+                          "property float z\nend_header\n",
+               "too large");
+  expect_error("big_count.ply",
+               ply_head + "element vertex 1000000000000\nproperty float x\nproperty float y\nproperty float z\n"
+                          "end_header\n" + std::string(24, '\0'),
+               "only 24 bytes follow");
+  expect_error("no_props.ply", ply_head + "element vertex 1000000000000\nend_header\n", "no properties");
+  const std::string list_ply = ply_head +
+                               "element vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                               "element face 1\nproperty list uint int vertex_indices\nend_header\n" +
+                               std::string(36, '\0') + std::string("\xff\xff\xff\x7f", 4);
+  expect_error("huge_list.ply", list_ply, "list items");
+  expect_error("negative.off", "OFF\n-3 1 0\n0 0 0\n", "negative");
+  expect_error("many_vertices.off", "OFF\n3000000000 1 0\n0 0 0\n", "only");
+  expect_error("huge_face.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n2000000000 0 1 2\n", "line holds 3");
+  expect_error("cut_after_header.off", "OFF\n3 1 0\n", "truncated");
+  expect_error("invented_faces.off", "OFF\n3 1000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "only");
+  expect_error("few_faces.off", "OFF\n3 3 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n3 0 1 2\n", "truncated");
+  expect_error("index.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n", "out of range");
+  expect_error("bin.off", "OFF BINARY\n", "binary OFF");
+  expect_error("short.stl", "abc", "not an STL file");
+  std::string random(4096, '\0');
+  uint64_t x = 88172645463325252ULL;
+  for (char& c : random) {
+    x ^= x << 13, x ^= x >> 7, x ^= x << 17;
+    c = static_cast<char>(x);
+  }
+  expect_error("random.obj", random, "not a text OBJ");
+  expect_error("far.obj", "v 1e39 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n", ":1: coordinate '1e39' is beyond");
+  expect_error("overflow.obj", "v 1e400 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\n", "out of range");
+  expect_error("far.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1e30 0\n3 0 1 2\n", "beyond");
+  std::string far_stl = cube_binary_stl();
+  const float big = 1e30f;
+  std::memcpy(far_stl.data() + 84 + 12, &big, 4);
+  expect_error("far.stl", far_stl, "beyond");
+  // Not files at all.
+  expect_load_error("/dev/null", {"not a regular file"});
 }
 
 TEST(ObjWriter, RoundTripsExactly) {

@@ -7,8 +7,14 @@
 namespace viewcells {
 namespace {
 
+/// A half-plane a x + b y + c <= 0 of the split plane's 2D frame.
+struct HalfPlane {
+  double a, b, c;
+};
+
 struct Poly2 {
   std::vector<std::pair<double, double>> pts;  // counter-clockwise
+  std::vector<HalfPlane> sides;                 // the face as an intersection of half-planes
   double xmin, xmax, ymin, ymax;
   int32_t leaf;
 };
@@ -23,15 +29,13 @@ double area2(const std::vector<std::pair<double, double>>& p) {
   return 0.5 * a;
 }
 
-/// Area of the intersection of two convex counter-clockwise polygons (Sutherland-Hodgman).
-double overlap_area(const std::vector<std::pair<double, double>>& subject,
-                    const std::vector<std::pair<double, double>>& clip) {
+/// Area of the intersection of a convex polygon with a convex region given by half-planes
+/// (Sutherland-Hodgman).
+double overlap_area(const std::vector<std::pair<double, double>>& subject, const std::vector<HalfPlane>& clip) {
   std::vector<std::pair<double, double>> out = subject, in;
   for (size_t i = 0; i < clip.size() && !out.empty(); ++i) {
-    const auto a = clip[i], b = clip[(i + 1) % clip.size()];
-    auto inside = [&](const std::pair<double, double>& p) {
-      return (b.first - a.first) * (p.second - a.second) - (b.second - a.second) * (p.first - a.first);
-    };
+    const HalfPlane h = clip[i];
+    auto inside = [&](const std::pair<double, double>& p) { return -(h.a * p.first + h.b * p.second + h.c); };
     in.swap(out);
     out.clear();
     for (size_t k = 0; k < in.size(); ++k) {
@@ -45,6 +49,53 @@ double overlap_area(const std::vector<std::pair<double, double>>& subject,
     }
   }
   return out.size() >= 3 ? std::abs(area2(out)) : 0.0;
+}
+
+/// The sides of face `fi` of `cell` as half-planes of the frame (u, v) of `plane`: each edge is
+/// where the face meets a neighbouring face, so its line is taken from that face's plane (a
+/// direction known to the last bit) rather than from its two rounded end points, which on a
+/// short edge point anywhere. Edges whose neighbouring plane is nearly parallel to `plane`, or
+/// whose neighbour is not found, fall back to the line through the end points.
+std::vector<HalfPlane> face_sides(const ConvexPolyhedron& cell, size_t fi, const std::vector<Plane>& planes,
+                                  const Vec3& origin, const Vec3& u, const Vec3& v, bool reversed) {
+  const std::vector<PolyFace>& faces = cell.faces();
+  const std::vector<Vec3>& vs = cell.vertices();
+  // The face that walks the edge b -> a (a neighbour walks a shared edge the other way); a
+  // linear search, as cells have a few dozen edges.
+  auto neighbour = [&](uint32_t a, uint32_t b) -> const PolyFace* {
+    for (size_t g = 0; g < faces.size(); ++g) {
+      const std::vector<uint32_t>& w = faces[g].vertices;
+      for (size_t k = 0; k < w.size(); ++k)
+        if (w[k] == b && w[(k + 1) % w.size()] == a) return g == fi ? nullptr : &faces[g];
+    }
+    return nullptr;
+  };
+  const PolyFace& f = faces[fi];
+  std::vector<HalfPlane> out;
+  for (size_t k = 0; k < f.vertices.size(); ++k) {
+    const uint32_t a = f.vertices[k], b = f.vertices[(k + 1) % f.vertices.size()];
+    if (const PolyFace* neighbour_face = neighbour(a, b)) {
+      const PolyFace& g = *neighbour_face;
+      const Plane& q = planes[g.plane];
+      const double sign = g.outward_positive ? 1.0 : -1.0;  // inside: sign (n.x - d) <= 0
+      const HalfPlane h{sign * dot(q.normal, u), sign * dot(q.normal, v), sign * (dot(q.normal, origin) - q.offset)};
+      if (std::hypot(h.a, h.b) > 1e-6) {
+        const double len = std::hypot(h.a, h.b);
+        out.push_back({h.a / len, h.b / len, h.c / len});
+        continue;
+      }
+    }
+    // Through the end points. Unless reversed, the face runs counter-clockwise in (u, v), its
+    // inside to the left of a->b: (b - a) x (p - a) >= 0.
+    const double ax = dot(vs[a] - origin, u), ay = dot(vs[a] - origin, v), bx = dot(vs[b] - origin, u),
+                 by = dot(vs[b] - origin, v);
+    double na = by - ay, nb = -(bx - ax);  // right-hand normal of a->b: outward
+    if (reversed) na = -na, nb = -nb;
+    const double len = std::hypot(na, nb);
+    if (!(len > 0)) continue;  // no direction: leave the line to the other sides
+    out.push_back({na / len, nb / len, -(na * ax + nb * ay) / len});
+  }
+  return out;
 }
 
 }  // namespace
@@ -75,11 +126,19 @@ std::vector<LeafAdjacency> leaf_adjacency(const Subdivision& s, const std::vecto
     const Vec3 n = plane.normal;
     const Vec3 u = normalize(std::abs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
     const Vec3 v = cross(n, u);  // (u, v, n) right-handed: counter-clockwise about +n
+    // 2D coordinates relative to the view box's centre projected onto the plane: areas of
+    // faces far from the world's origin (a city at 1e5) keep their digits.
+    const Vec3 centre = s.view_box.center();
+    const Vec3 origin = centre - n * plane.distance(centre);
     auto project = [&](int32_t leaf, size_t f, bool reverse) {
       Poly2 p;
       p.leaf = leaf;
       const ConvexPolyhedron& cell = s.cells[leaf];
-      for (uint32_t id : cell.faces()[f].vertices) p.pts.push_back({dot(cell.vertices()[id], u), dot(cell.vertices()[id], v)});
+      p.sides = face_sides(cell, f, s.planes, origin, u, v, reverse);
+      for (uint32_t id : cell.faces()[f].vertices) {
+        const Vec3 d = cell.vertices()[id] - origin;
+        p.pts.push_back({dot(d, u), dot(d, v)});
+      }
       if (reverse) std::reverse(p.pts.begin(), p.pts.end());
       p.xmin = p.ymin = INFINITY;
       p.xmax = p.ymax = -INFINITY;
@@ -99,7 +158,7 @@ std::vector<LeafAdjacency> leaf_adjacency(const Subdivision& s, const std::vecto
       for (const Poly2& q : b) {
         if (q.xmin >= p.xmax) break;
         if (q.xmax <= p.xmin || q.ymin >= p.ymax || q.ymax <= p.ymin) continue;
-        const double area = overlap_area(p.pts, q.pts);
+        const double area = overlap_area(p.pts, q.sides);
         if (area > min_area) shared[{std::min(p.leaf, q.leaf), std::max(p.leaf, q.leaf)}] += area;
       }
     }

@@ -7,6 +7,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include "viewcells/core/isa.h"
+
 namespace viewcells {
 
 uint64_t fnv1a64(const std::string& bytes) {
@@ -47,7 +49,9 @@ void write_container(const std::string& path, const char (&magic)[5], uint32_t v
   compressed.resize(csize);
   ByteWriter header;
   header.put<uint32_t>(0);  // placeholder replaced by the magic below
-  header.put<uint32_t>(version);
+  // The version's third byte records the Embree ISA of the writing process (core/isa.h).
+  VC_CHECK(version > 0 && version <= 0xffff);
+  header.put<uint32_t>(version | static_cast<uint32_t>(embree_isa_code(embree_isa())) << 16);
   header.put<uint64_t>(payload.size());
   header.put<uint64_t>(fnv1a64(payload));
   header.put<uint64_t>(csize);
@@ -58,7 +62,10 @@ void write_container(const std::string& path, const char (&magic)[5], uint32_t v
 }
 
 std::string read_container(const std::string& path, const char (&magic)[5], uint32_t max_version,
-                           uint32_t& version) {
+                           uint32_t& version, std::string* isa) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw Error(path, 0, std::filesystem::exists(path, ec) ? "not a regular file" : "no such file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path, 0, "cannot open file");
   std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -67,7 +74,10 @@ std::string read_container(const std::string& path, const char (&magic)[5], uint
   if (std::memcmp(file.data(), magic, 4) != 0)
     throw Error(path, 0, "not a " + std::string(magic) + " file (wrong magic)");
   r.get<uint32_t>();
-  version = r.get<uint32_t>();
+  const uint32_t tagged_version = r.get<uint32_t>();
+  version = tagged_version & 0xffff;
+  if (isa) *isa = embree_isa_name(static_cast<uint8_t>(tagged_version >> 16));
+  if (tagged_version >> 24) throw Error(path, 0, "corrupt file: malformed version field");
   if (version == 0 || version > max_version)
     throw Error(path, 0, "format version " + std::to_string(version) + " is not supported (this build reads up to " +
                              std::to_string(max_version) + ")");
@@ -79,6 +89,11 @@ std::string read_container(const std::string& path, const char (&magic)[5], uint
                              std::to_string(file.size() - 32) + " (truncated?)");
   const unsigned long long frame_size = ZSTD_getFrameContentSize(file.data() + 32, csize);
   if (frame_size != raw_size) throw Error(path, 0, "corrupt file: compressed frame does not match header");
+  // zstd expands at most about 32,768-fold (a 128 KiB run-length block in 4 bytes): a larger
+  // claim is corrupt, and is refused before it is allocated.
+  if (raw_size > 65536 * (csize + 64))
+    throw Error(path, 0, "corrupt file: " + std::to_string(raw_size) + " bytes claimed from " + std::to_string(csize) +
+                             " compressed");
   std::string payload(raw_size, '\0');
   const size_t got = ZSTD_decompress(payload.data(), raw_size, file.data() + 32, csize);
   if (ZSTD_isError(got) || got != raw_size)

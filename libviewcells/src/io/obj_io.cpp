@@ -53,6 +53,11 @@ RawMesh read_obj(std::istream& in, const std::string& name) {
     pos = end + 1;
     ++line_no;
     if (auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    for (const char ch : line) {
+      const auto c = static_cast<unsigned char>(ch);
+      if ((c < 0x20 && c != '\t' && c != '\r' && c != '\f' && c != '\v') || c == 0x7f)
+        throw Error(name, line_no, "binary data: this is not a text OBJ file");
+    }
     std::string_view rest = line;
     const std::string_view kw = next_token(rest);
     if (kw.empty()) continue;
@@ -63,9 +68,14 @@ RawMesh read_obj(std::istream& in, const std::string& name) {
         const std::string_view tok = next_token(rest);
         if (tok.empty()) throw Error(name, line_no, "vertex needs three coordinates");
         const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), x);
+        if (ec == std::errc::result_out_of_range)
+          throw Error(name, line_no, "coordinate '" + std::string(tok) + "' is out of range");
         if (ec != std::errc() || ptr != tok.data() + tok.size())
           throw Error(name, line_no, "malformed coordinate '" + std::string(tok) + "'");
         if (!std::isfinite(x)) throw Error(name, line_no, "NaN or infinite coordinate '" + std::string(tok) + "'");
+        if (std::abs(x) > kMaxCoordinate)
+          throw Error(name, line_no, "coordinate '" + std::string(tok) +
+                                         "' is beyond what ray casting can represent (at most 1e18 in magnitude)");
       }
       mesh.vertices.push_back({c[0], c[1], c[2]});
     } else if (kw == "f") {

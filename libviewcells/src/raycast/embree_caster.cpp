@@ -7,11 +7,15 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdlib>
 #include <limits>
 #include <mutex>
+#include <sstream>
 #include <vector>
 
 #include "viewcells/core/error.h"
+#include "viewcells/core/isa.h"
 #include "viewcells/raycast/ray_caster.h"
 
 namespace viewcells {
@@ -44,6 +48,62 @@ void error_callback(void* user, RTCError code, const char* str) {
 
 constexpr unsigned kChunk = 64;  // rays per rtcIntersect1M call
 
+/// Embree's Ray::valid() bound on origins and directions (FLT_LARGE in its sources); a ray
+/// beyond it trips an assertion in Debian's build, so it is refused before it gets there.
+constexpr double kEmbreeLargest = 1.8e18;
+
+/// Largest |coordinate - centre| of the scene's vertices and the vertex that reaches it.
+std::pair<double, size_t> farthest_vertex(const Scene& scene, const Vec3& center) {
+  double r = 0;
+  size_t at = 0;
+  for (size_t i = 0; i < scene.vertices.size(); ++i) {
+    const Vec3 d = scene.vertices[i] - center;
+    const double m = std::max({std::abs(d.x), std::abs(d.y), std::abs(d.z)});
+    if (!(m <= r)) r = m, at = i;  // NaN-safe: a NaN distance is taken as the farthest
+  }
+  return {r, at};
+}
+
+/// Embree holds vertices in single precision, relative to the scene's centre. Refuses a scene
+/// whose extent makes single precision coarser than a hundredth of its median triangle edge
+/// (a stray triangle far away, or coordinates beyond float range): rays would leak or miss.
+void check_float_precision(const Scene& scene, const Vec3& center) {
+  const auto [reach, at] = farthest_vertex(scene, center);
+  std::vector<double> edges;
+  edges.reserve(scene.triangles.size());
+  for (const auto& t : scene.triangles) {
+    const Vec3 &a = scene.vertices[t[0]], &b = scene.vertices[t[1]], &c = scene.vertices[t[2]];
+    edges.push_back(std::max({length(b - a), length(c - b), length(a - c)}));
+  }
+  std::nth_element(edges.begin(), edges.begin() + edges.size() / 2, edges.end());
+  const double median_edge = edges[edges.size() / 2];
+  const double resolution = reach * std::ldexp(1.0, -23);  // float spacing at that distance
+  if (reach < kEmbreeLargest / 2 && resolution <= 0.01 * median_edge) return;
+  uint32_t object = kNoObject;
+  for (size_t t = 0; t < scene.triangles.size() && object == kNoObject; ++t)
+    for (uint32_t v : scene.triangles[t])
+      if (v == at) object = scene.triangle_object[t];
+  const Vec3& p = scene.vertices[at];
+  std::ostringstream msg;
+  msg.precision(6);
+  msg << "coordinates reach " << reach << " from the scene's centre, where single precision (Embree) resolves only "
+      << resolution << ", but the median triangle edge is " << median_edge << ": rays would leak or miss. "
+      << "The farthest vertex is (" << p.x << ", " << p.y << ", " << p.z << ")";
+  if (object != kNoObject) msg << " of object '" << scene.objects[object].name << "'";
+  msg << "; remove stray geometry, or split the scene into parts that single precision can hold";
+  throw Error(scene.source, 0, msg.str());
+}
+
+[[noreturn]] void invalid_ray(const Vec3& origin, const Vec3& dir, double tnear, double tfar) {
+  std::ostringstream msg;
+  msg.precision(17);
+  msg << "invalid ray for Embree: origin (" << origin.x << ", " << origin.y << ", " << origin.z << "), direction ("
+      << dir.x << ", " << dir.y << ", " << dir.z << "), t in [" << tnear << ", " << tfar
+      << "]: origins must lie within " << kEmbreeLargest
+      << " of the scene's centre and every value must be finite (is the view box far outside the scene?)";
+  throw Error(msg.str());
+}
+
 class EmbreeCaster final : public RayCaster {
  public:
   EmbreeCaster(const Scene& scene, const EmbreeConfig& config) : scene_(scene), config_(config) {
@@ -53,7 +113,9 @@ class EmbreeCaster final : public RayCaster {
     if (selected_.empty())
       throw Error(config.see_through ? "the scene has no see-through triangles" : "the scene has no occluding triangles");
     if (selected_.size() == scene.triangles.size()) selected_.clear();  // all: primitive = triangle
-    device_ = rtcNewDevice("verbose=0");
+    check_float_precision(scene, center_);
+    isa_ = config.isa.empty() ? embree_isa() : checked_embree_isa(config.isa);
+    device_ = rtcNewDevice(("verbose=0,isa=" + isa_).c_str());
     if (!device_) throw Error(std::string("embree: cannot create device: ") + error_name(rtcGetDeviceError(nullptr)));
     rtcSetDeviceErrorFunction(device_, error_callback, &sink_);
     try {
@@ -108,7 +170,7 @@ class EmbreeCaster final : public RayCaster {
   }
 
   std::string name() const override {
-    return std::string("embree ") + (config_.robust ? "robust" : "fast") + (config_.see_through ? " see-through" : "");
+    return std::string("embree ") + isa_ + (config_.robust ? " robust" : " fast") + (config_.see_through ? " see-through" : "");
   }
 
  private:
@@ -164,6 +226,12 @@ class EmbreeCaster final : public RayCaster {
 
   void to_native(const Vec3& origin, const Vec3& dir, double tnear, double tfar, RTCRayHit& rh) const {
     const Vec3 o = origin - center_;
+    // Written so that NaN fails every comparison and lands in the error.
+    const bool ok = std::abs(o.x) < kEmbreeLargest && std::abs(o.y) < kEmbreeLargest && std::abs(o.z) < kEmbreeLargest &&
+                    std::abs(dir.x) < kEmbreeLargest && std::abs(dir.y) < kEmbreeLargest &&
+                    std::abs(dir.z) < kEmbreeLargest && tnear >= 0 && tfar >= tnear;
+    if (!ok) [[unlikely]]
+      invalid_ray(origin, dir, tnear, tfar);
     rh.ray.org_x = static_cast<float>(o.x);
     rh.ray.org_y = static_cast<float>(o.y);
     rh.ray.org_z = static_cast<float>(o.z);
@@ -215,6 +283,7 @@ class EmbreeCaster final : public RayCaster {
   EmbreeConfig config_;
   std::vector<uint32_t> selected_;  ///< the triangle of each primitive; empty when all are
   Vec3 center_;
+  std::string isa_;
   RTCDevice device_ = nullptr;
   RTCScene rtc_scene_ = nullptr;
   mutable ErrorSink sink_;

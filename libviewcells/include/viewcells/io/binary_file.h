@@ -95,13 +95,15 @@ class ByteReader {
   size_t pos_ = 0;
 };
 
-/// Writes payload into `path` atomically (temporary file + rename).
+/// Writes payload into `path` atomically (temporary file + rename). The header records the
+/// format version and the Embree ISA this process casts with (embree_isa()).
 void write_container(const std::string& path, const char (&magic)[5], uint32_t version,
                      const std::string& payload);
-/// Reads and verifies a container; returns the payload and sets `version`.
-/// Throws Error for a missing file, wrong magic, a version above max_version, or corruption.
+/// Reads and verifies a container; returns the payload and sets `version` (and `isa`, the
+/// Embree ISA of the process that wrote it, when given). Throws Error for a missing or
+/// non-regular file, wrong magic, a version above max_version, or corruption.
 std::string read_container(const std::string& path, const char (&magic)[5], uint32_t max_version,
-                           uint32_t& version);
+                           uint32_t& version, std::string* isa = nullptr);
 
 /// FNV-1a 64-bit hash of a byte string.
 uint64_t fnv1a64(const std::string& bytes);

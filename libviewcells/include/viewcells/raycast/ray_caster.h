@@ -63,7 +63,12 @@ struct EmbreeConfig {
   /// Which triangles: those of occluding objects (what stops rays: the default), or those of
   /// the see-through ones (ObjectInfo::occluder false), to find where segments cross them.
   bool see_through = false;
+  /// Embree's instruction set: "" for embree_isa() (VIEWCELLS_EMBREE_ISA, else the CPU's best),
+  /// or one of "sse2", "sse4.2", "avx", "avx2", "avx512". Embree's kernels differ in the last
+  /// bits of their hits, so sampled results are identical across machines only for one ISA.
+  std::string isa;
 };
+
 
 /// Builds the Embree BVH (in a local frame centred on the scene, so float precision holds
 /// for coordinates around 1e5). Throws Error when Embree reports an error or when no
