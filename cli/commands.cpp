@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <charconv>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -67,6 +68,39 @@ Box3 parse_box(const std::string& text) {
   return b;
 }
 
+/// A whole number from lo to hi, written without sign or exponent (CLI11 alone reads "-1" into
+/// an unsigned option as 2^64 - 1).
+CLI::Validator whole(uint64_t lo, uint64_t hi) {
+  return CLI::Validator(
+      [lo, hi](const std::string& text) -> std::string {
+        uint64_t v = 0;
+        const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+        if (text.empty() || ec != std::errc() || ptr != text.data() + text.size() || v < lo || v > hi)
+          return "'" + text + "' is not allowed: give a whole number from " + std::to_string(lo) + " to " +
+                 std::to_string(hi);
+        return "";
+      },
+      "INT in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+}
+
+/// A finite number above zero.
+CLI::Validator positive() {
+  return CLI::Validator(
+      [](const std::string& text) -> std::string {
+        try {
+          size_t used = 0;
+          const double v = std::stod(text, &used);
+          if (used == text.size() && std::isfinite(v) && v > 0) return "";
+        } catch (const std::exception&) {
+        }
+        return "'" + text + "' is not allowed: give a number above 0";
+      },
+      "NUMBER > 0");
+}
+
+constexpr uint64_t kMaxSamples = uint64_t{1} << 40;  // a trillion rays: beyond any one machine's memory
+constexpr uint64_t kMaxCells = 10'000'000;
+
 struct Common {
   int threads = 0;
   bool quiet = false;
@@ -88,6 +122,32 @@ std::string describe_box(const Box3& b) {
          fmt(b.hi.y) + ", " + fmt(b.hi.z) + "]";
 }
 
+/// Before any work: refuses an output that is also an input or another output, or that exists
+/// as something other than a regular file (a device, FIFO, directory or symbolic link). Empty
+/// names are options not given.
+void check_files(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs) {
+  namespace fs = std::filesystem;
+  auto key = [](const std::string& p) {
+    std::error_code ec;
+    const fs::path k = fs::weakly_canonical(fs::absolute(p), ec);
+    return ec ? fs::absolute(p).lexically_normal().string() : k.string();
+  };
+  std::vector<std::pair<std::string, std::string>> seen;  // (canonical, as given)
+  for (const std::string& in : inputs)
+    if (!in.empty()) seen.push_back({key(in), in});
+  const size_t input_count = seen.size();
+  for (const std::string& out : outputs) {
+    if (out.empty()) continue;
+    check_output_target(out);
+    const std::string k = key(out);
+    for (size_t i = 0; i < seen.size(); ++i)
+      if (seen[i].first == k)
+        throw Error(out + ": is " + (i < input_count ? "an input of this command" : "given for two outputs") +
+                    " (" + seen[i].second + "); write it elsewhere");
+    seen.push_back({k, out});
+  }
+}
+
 /// Reports say which Embree ISA cast their rays: results are bit-identical only for the same one.
 void write_json(const std::string& path, json j) {
   if (j.is_object()) j["embree_isa"] = embree_isa();
@@ -104,6 +164,8 @@ struct GenerateArgs {
 };
 
 int run_generate(const GenerateArgs& a, const Common& c) {
+  check_files({}, {a.output});
+
   GeneratorConfig config;
   config.kind = parse_generator_kind(a.kind);
   config.seed = a.seed;
@@ -152,6 +214,8 @@ bool is_q3_map(const std::string& path) {
 }
 
 int run_info(const InfoArgs& a, const Common& c) {
+  check_files({a.scene}, {a.json_path});
+
   const Scene scene = load_scene(a.scene, parse_grouping(a.objects));
   const json summary = scene_summary(scene);
   const EmptySpaceDecision esd = decide_empty_space(scene, EmptySpaceMode::kAuto);
@@ -241,8 +305,11 @@ struct SampleArgs {
 
 void add_sampling_options(CLI::App* cmd, SampleArgs& a) {
   cmd->add_option("scene", a.scene, "Scene file (.obj, .ply, .off, .stl)")->required();
-  auto* samples_opt = cmd->add_option("--samples", a.samples, "Number of samples (two rays each)")->capture_default_str();
+  auto* samples_opt = cmd->add_option("--samples", a.samples, "Number of samples (two rays each)")
+                          ->capture_default_str()
+                          ->check(whole(1, kMaxSamples));
   cmd->add_option("--segments", a.segments, "Sample until this many valid segments exist (instead of --samples)")
+      ->check(whole(1, kMaxSamples))
       ->excludes(samples_opt);
   cmd->add_option("--seed", a.seed, "Random seed (same seed, same result for any --threads)")->capture_default_str();
   cmd->add_option("--objects", a.objects, "Object grouping: auto | groups | components | triangles")
@@ -396,6 +463,8 @@ struct SampleOnlyArgs {
 };
 
 int run_sample(const SampleArgs& a, const SampleOnlyArgs& o, const Common& c) {
+  check_files({a.scene}, {o.output, o.report});
+
   ThreadLimit threads(c.threads);
   const Sampled s = load_and_sample(a, c, threads.threads());
   const SamplingStats& st = s.result.stats;
@@ -490,6 +559,8 @@ void write_views(const Subdivision& s, const Scene* scene, const std::string& me
 }
 
 int run_build(const SampleArgs& a, const BuildArgs& b, const Common& c) {
+  check_files({a.scene}, {b.output, b.report, b.mesh, b.slice_png});
+
   ThreadLimit threads(c.threads);
   CostModel model;
   model.a = b.cost_a;
@@ -500,6 +571,9 @@ int run_build(const SampleArgs& a, const BuildArgs& b, const Common& c) {
   model.validate();  // before the sampling, not after
   const HeightBandDensity density = parse_density_band(b.density_band);
   const Sampled s = load_and_sample(a, c, threads.threads());
+  if (!std::isnan(b.slice_z) && !(b.slice_z >= s.result.segments.view_box.lo.z && b.slice_z <= s.result.segments.view_box.hi.z))
+    throw Error("--slice-z " + fmt(b.slice_z) + " lies outside the view space (z from " + fmt(s.result.segments.view_box.lo.z) + " to " +
+                fmt(s.result.segments.view_box.hi.z) + ")");
 
   SubdivisionConfig config;
   config.max_cells = b.max_cells;
@@ -616,6 +690,8 @@ struct ExportArgs {
 };
 
 int run_export(const ExportArgs& e, const Common& c) {
+  check_files({e.input, e.scene}, {e.mesh, e.png});
+
   if (e.mesh.empty() && e.png.empty()) throw Error("nothing to export: give --mesh and/or --slice-png");
   SubdivisionFile file = read_subdivision(e.input);
   rebuild_cells(file.subdivision);
@@ -910,7 +986,7 @@ struct CutArgs {
 };
 
 void add_cut_options(CLI::App* app, CutArgs& a) {
-  app->add_option("--count", a.count, "Exactly this many view cells")->check(CLI::PositiveNumber);
+  app->add_option("--count", a.count, "Exactly this many view cells")->check(whole(1, kMaxCells));
   app->add_option("--memory", a.memory,
                   "The most view cells whose approximate PVS storage fits this budget (bytes; K, M, G allowed)");
   app->add_option("--cost-ratio", a.cost_ratio,
@@ -944,6 +1020,8 @@ struct ExtractArgs {
 };
 
 int run_extract(const ExtractArgs& e, const Common& c) {
+  check_files({e.input, e.scene}, {e.output, e.mesh, e.png});
+
   SubdivisionFile file = read_merged(e.input);
   const MergeHistory& h = *file.history;
   const ViewCellSet set = choose_cells(h, e.cut, false);
@@ -1008,7 +1086,7 @@ PvsFile pvs_file_for(const SubdivisionFile& file, const ViewCellSet& set) {
 /// Writes the .pvs file, then reads it back: every cell's PVS must come back as `lists`.
 void write_pvs_checked(const std::string& path, const PvsFile& pf, const std::vector<std::vector<uint32_t>>& lists) {
   write_pvs(path, pf);
-  const PvsFile back = read_pvs(path);
+  const PvsFile back = read_pvs(staged_path(path));  // the command's outputs are renamed at its end
   for (uint32_t i = 0; i < back.pvs.cell_count; ++i)
     if (back.pvs.cell_pvs(i) != lists[i]) throw Error(path, 0, "read-back check failed for cell " + std::to_string(i));
 }
@@ -1017,6 +1095,13 @@ void write_pvs_checked(const std::string& path, const PvsFile& pf, const std::ve
 json number_or_null(double v) { return std::isnan(v) ? json(nullptr) : json(v); }
 
 int run_pvs(const PvsArgs& a, const Common& c) {
+  {
+    // --save may be the --resume state (continue and keep it up to date); nothing else may meet.
+    std::vector<std::string> inputs = {a.input, a.scene, a.edited_from};
+    inputs.insert(inputs.end(), a.references.begin(), a.references.end());
+    check_files(inputs, {a.output, a.report, a.save});
+    check_files({}, {a.output, a.report, a.resume});
+  }
   ThreadLimit threads(c.threads);
   AgvsConfig config;
   config.method = parse_agvs_method(a.method);
@@ -1240,6 +1325,8 @@ int run_pvs(const PvsArgs& a, const Common& c) {
 }
 
 int run_compress(const CompressArgs& a, const Common& c) {
+  check_files({a.input}, {a.output, a.flat, a.report});
+
   SubdivisionFile file = read_merged(a.input);
   const MergeHistory& h = *file.history;
   const ViewCellSet set = choose_cells(h, a.cut, true);
@@ -1256,7 +1343,7 @@ int run_compress(const CompressArgs& a, const Common& c) {
   const uint64_t after = pf.pvs.stored_entries();
   const uint64_t varint_before = varint_bytes(flat), varint_after = varint_bytes(pf.pvs.stored);
   write_pvs_checked(a.output, pf, flat);
-  const uint64_t file_bytes = std::filesystem::file_size(a.output);
+  const uint64_t file_bytes = std::filesystem::file_size(staged_path(a.output));
   c.log("viewcells: " + std::to_string(pf.pvs.cell_count) + " view cells (" + set.rule + "): " +
         std::to_string(before) + " PVS entries -> " + std::to_string(after) + " kept in " +
         std::to_string(pf.pvs.node_count()) + " hierarchy nodes (" + fmt(before ? double(after) / before : 1.0, 3) +
@@ -1281,7 +1368,7 @@ int run_compress(const CompressArgs& a, const Common& c) {
     const uint64_t rle = write_flat_rows(a.flat, pf);
     const uint64_t rows = static_cast<uint64_t>(pf.pvs.cell_count) * ((pf.object_count + 7) / 8);
     report["flat"] = {{"file", a.flat}, {"bit_row_bytes", rows}, {"run_length_bytes", rle},
-                      {"file_bytes", std::filesystem::file_size(a.flat)}};
+                      {"file_bytes", std::filesystem::file_size(staged_path(a.flat))}};
     c.log("viewcells: flat rows -> " + a.flat + ": " + std::to_string(rows) + " bytes of bit rows, " +
           std::to_string(rle) + " run-length coded (Quake style)");
   }
@@ -1376,7 +1463,7 @@ int run(int argc, char** argv) {
   BuildArgs bld;
   auto* bc = app.add_subcommand("build", "Sample visibility and subdivide the view space into cells (AV-S, section 4.2)");
   add_sampling_options(bc, bsmp);
-  bc->add_option("--max-cells", bld.max_cells, "Stop at this many cells")->capture_default_str()->check(CLI::PositiveNumber);
+  bc->add_option("--max-cells", bld.max_cells, "Stop at this many cells")->capture_default_str()->check(whole(1, kMaxCells));
   auto* no_ga = bc->add_flag("--no-ga", bld.no_ga, "No geometry-aligned split candidates");
   bc->add_flag("--ga", bld.ga, "Geometry-aligned candidates even for mostly axis-aligned scenes")->excludes(no_ga);
   bc->add_option("--ga-candidates", bld.ga_candidates, "Geometry-aligned planes tried per cell at most")
@@ -1405,7 +1492,7 @@ int run(int argc, char** argv) {
   bc->add_option("--mesh", bld.mesh, "Also write the cells as a PLY coloured by render cost");
   bc->add_option("--slice-png", bld.slice_png, "Also write a PNG of a horizontal slice through the cells");
   bc->add_option("--slice-z", bld.slice_z, "Height of the slice (default: middle of the view space)");
-  bc->add_option("--slice-width", bld.slice_width, "Slice image width in pixels")->capture_default_str();
+  bc->add_option("--slice-width", bld.slice_width, "Slice image width in pixels")->capture_default_str()->check(whole(16, 16384));
 
   ExportArgs exp;
   auto* ex = app.add_subcommand("export", "Look at a built hierarchy: cells as PLY, or a slice as PNG");
@@ -1413,7 +1500,7 @@ int run(int argc, char** argv) {
   ex->add_option("--mesh", exp.mesh, "PLY of the cells, coloured by render cost");
   ex->add_option("--slice-png", exp.png, "PNG of a horizontal slice");
   ex->add_option("--slice-z", exp.slice_z, "Height of the slice (default: middle of the view space)");
-  ex->add_option("--slice-width", exp.width, "Slice image width in pixels")->capture_default_str();
+  ex->add_option("--slice-width", exp.width, "Slice image width in pixels")->capture_default_str()->check(whole(16, 16384));
   ex->add_option("--scene", exp.scene, "Draw this scene's cross-section into the slice");
 
   SampleArgs csmp;
@@ -1431,7 +1518,8 @@ int run(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber)
       ->each([&](const std::string&) { cmpa.max_cells_given = true; });
-  cm->add_option("--eval-samples", cmpa.eval_samples, "Evaluation samples (default: 4 x --samples)");
+  cm->add_option("--eval-samples", cmpa.eval_samples, "Evaluation samples (default: 4 x --samples)")
+      ->check(whole(1, kMaxSamples));
   cm->add_option("--eval-seed", cmpa.eval_seed, "Evaluation seed (default: --seed + 1000003)");
   cm->add_option("--histogram-cells", cmpa.histogram_cells, "Cell count of the cost histograms (default: --max-cells)");
   cm->add_option("--cost-a", cmpa.cost_a, "Render cost model: minimum cost of an object")->capture_default_str();
@@ -1451,7 +1539,7 @@ int run(int argc, char** argv) {
   xt->add_option("--mesh", ext.mesh, "PLY of the BSP leaves coloured by their view cell's render cost");
   xt->add_option("--slice-png", ext.png, "PNG of a horizontal slice, borders between view cells");
   xt->add_option("--slice-z", ext.slice_z, "Height of the slice (default: middle of the view space)");
-  xt->add_option("--slice-width", ext.width, "Slice image width in pixels")->capture_default_str();
+  xt->add_option("--slice-width", ext.width, "Slice image width in pixels")->capture_default_str()->check(whole(16, 16384));
   xt->add_option("--scene", ext.scene, "Draw this scene's cross-section into the slice");
 
   CompressArgs cmp;
@@ -1471,16 +1559,18 @@ int run(int argc, char** argv) {
   pv->add_option("--scene", pva.scene, "The scene the hierarchy was built from")->required();
   pv->add_option("--objects", pva.objects, "Object grouping used when building")->capture_default_str();
   pv->add_option("--cells", pva.cells, "View cells cut from the merge history (default: every elementary cell)")
-      ->check(CLI::PositiveNumber);
+      ->check(whole(1, kMaxCells));
   pv->add_option("--pixel-error", pva.pixel_error,
-                 "Stop when the estimated pixel error (pixels of a 1024x1024 image that differ) is at most this");
-  pv->add_option("--time", pva.seconds, "Stop after this many seconds");
+                 "Stop when the estimated pixel error (pixels of a 1024x1024 image that differ) is at most this")
+      ->check(positive());
+  pv->add_option("--time", pva.seconds, "Stop after this many seconds")->check(positive());
   pv->add_option("--samples", pva.samples,
-                 "Stop after this many samples (checked between batches: a run may pass it by less than a batch)");
+                 "Stop after this many samples (checked between batches: a run may pass it by less than a batch)")
+      ->check(whole(1, kMaxSamples));
   pv->add_option("--method", pva.method, "agvs (adaptive mixture), sgvs (view space-direction only) or ref (per cell)")
       ->capture_default_str();
   pv->add_option("--seed", pva.seed, "Random seed")->capture_default_str();
-  pv->add_option("--batch", pva.batch, "Samples per batch")->capture_default_str()->check(CLI::PositiveNumber);
+  pv->add_option("--batch", pva.batch, "Samples per batch")->capture_default_str()->check(whole(1, 100'000'000));
   pv->add_flag("--fast", pva.fast, "Embree without robust mode");
   pv->add_option("--min-share", pva.min_share,
                  "AGVS: share of every batch kept for view space-direction samples whatever their weight; they are "
@@ -1489,7 +1579,8 @@ int run(int argc, char** argv) {
       ->check(CLI::Range(0.0, 1.0));
   pv->add_option("--measure-cameras", pva.measure_cameras,
                  "Also measure the pixel error: render this many random cameras by ray casting and count the "
-                 "pixels whose object is missing from the PVS");
+                 "pixels whose object is missing from the PVS")
+      ->check(whole(1, 1'000'000));
   pv->add_option("--save", pva.save, "Write the solver's state here at the end, to continue later with --resume");
   pv->add_option("--resume", pva.resume,
                  "Continue from a state written by --save (same scene, cells, method, seed and batch); --samples "
@@ -1530,12 +1621,11 @@ int run(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    std::cerr << "viewcells: error: " << e.what() << "\nRun with --help for more information.\n";
+    return e.get_exit_code();
   }
-  try {
-    // One setting for the whole process, read by every caster and file header (core/isa.h).
-    if (!isa.empty()) setenv("VIEWCELLS_EMBREE_ISA", checked_embree_isa(isa).c_str(), 1);
-    embree_isa();  // a bad VIEWCELLS_EMBREE_ISA fails here, before any work
+  auto run_command = [&]() -> int {
     if (*g) return run_generate(gen, common);
     if (*i) return run_info(info, common);
     if (*s) {
@@ -1563,6 +1653,17 @@ int run(int argc, char** argv) {
       }
       return 0;
     }
+    return 0;
+  };
+  try {
+    // One setting for the whole process, read by every caster and file header (core/isa.h).
+    if (!isa.empty()) setenv("VIEWCELLS_EMBREE_ISA", checked_embree_isa(isa).c_str(), 1);
+    embree_isa();  // a bad VIEWCELLS_EMBREE_ISA fails here, before any work
+    // Every file a command writes is renamed into place only when the whole command succeeded.
+    OutputBatch outputs;
+    const int rc = run_command();
+    if (rc == 0) outputs.commit();
+    return rc;
   } catch (const Error& e) {
     std::cerr << "viewcells: error: " << e.what() << '\n';
     return 1;
@@ -1570,7 +1671,6 @@ int run(int argc, char** argv) {
     std::cerr << "viewcells: error: " << e.what() << '\n';
     return 2;
   }
-  return 0;
 }
 
 }  // namespace viewcells::cli

@@ -312,6 +312,40 @@ cp a.json keep.json
 expect_error "nan.obj" "$VC" sample nan.obj -o a.vseg --report a.json
 cmp -s a.vseg keep.vseg && cmp -s a.json keep.json && ok || bad "a failed run changed existing outputs"
 expect_error "cannot" "$VC" generate office -o no/such/dir/x.obj
+# A run that fails at a later output (the report's directory does not exist) replaces none.
+expect_error "no/such" "$VC" sample office.obj --samples 2000 -q -o a.vseg --report no/such/r.json
+cmp -s a.vseg keep.vseg && ok || bad "a run failing at its report replaced -o"
+expect_error "no/such" "$VC" build office.obj --samples 3000 --max-cells 8 -q -o keep.vcells --mesh no/such/m.ply
+[ ! -e keep.vcells ] && ok || bad "a build failing at --mesh wrote -o"
+ls ./*.tmp.* >/dev/null 2>&1 && bad "temporary files left behind" || ok
+# Outputs onto inputs, onto each other, or onto what is not a regular file are refused up front.
+cp office.obj victim.obj
+expect_error "is an input" "$VC" sample victim.obj --samples 1000 -o victim.obj
+cmp -s office.obj victim.obj && ok || bad "-o onto the input scene changed it"
+expect_error "two outputs" "$VC" sample office.obj --samples 1000 -o same.json --report same.json
+expect_error "not a regular file" "$VC" sample office.obj --samples 1000 -o /dev/null
+[ -c /dev/null ] && ok || bad "/dev/null is no longer a device"
+mkfifo fifo.vseg && expect_error "not a regular file" "$VC" sample office.obj --samples 1000 -o fifo.vseg
+ln -sf keep.vseg link.vseg && expect_error "not a regular file" "$VC" sample office.obj --samples 1000 -o link.vseg
+# Options are checked before any work, with what is allowed.
+expect_error "whole number from 1" "$VC" sample office.obj --samples -1 -o x.vseg
+expect_error "whole number from 1" "$VC" build office.obj --max-cells 0 -o x.vcells
+expect_error "whole number from 16" "$VC" build office.obj --slice-png s.png --slice-width 0 -o x.vcells
+expect_error "outside the view space" "$VC" build office.obj --samples 2000 --slice-png s.png --slice-z 1000 -o x.vcells -q
+[ ! -e x.vcells ] && ok || bad "a build with a bad --slice-z wrote -o"
+expect_error "above 0" "$VC" pvs keep.vcells --scene office.obj --pixel-error 0 -o x.pvs
+expect_error "whole number from 1" "$VC" pvs keep.vcells --scene office.obj --samples 10 --measure-cameras 4294967295 -o x.pvs
+expect_error "unknown Embree ISA" "$VC" --embree-isa avx9 sample office.obj -o x.vseg
+# Rays Embree cannot take, and scenes single precision cannot resolve, are errors, not aborts.
+expect_error "invalid ray" "$VC" sample office.obj --samples 1000 -q --view-box 1e19,0,0,1.0000001e19,1,1 -o x.vseg
+{ cat office.obj; printf 'o stray\nv 1e7 0 0\nv 10000001 0 0\nv 1e7 1 0\nf -3 -2 -1\n'; } > stray.obj
+expect_error "object 'stray'" "$VC" sample stray.obj --samples 1000 -q -o x.vseg
+printf 'OFF\n3 1000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' > invented.off
+expect_error "1000 faces" "$VC" info invented.off
+# Reports and file headers say which Embree ISA cast the rays.
+expect_ok "$VC" --embree-isa sse4.2 sample office.obj --samples 2000 -q -o isa.vseg --report isa.json
+[ "$(json_get isa.json "['embree_isa']")" = "sse4.2" ] && ok || bad "the report lacks the Embree ISA"
+[ "$(od -An -tu1 -j6 -N1 isa.vseg | tr -d ' ')" = "2" ] && ok || bad "the .vseg header lacks the Embree ISA code"
 
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -404,7 +404,8 @@ void write_slice_png(const std::string& path, const Subdivision& s, double heigh
       }
     }
   }
-  const std::string tmp = path + ".tmp";
+  check_output_target(path);
+  const std::string tmp = temporary_for(path);
   FILE* fp = std::fopen(tmp.c_str(), "wb");
   if (!fp) throw Error(path, 0, "cannot open for writing");
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
@@ -422,10 +423,11 @@ void write_slice_png(const std::string& path, const Subdivision& s, double heigh
   for (int y = 0; y < h; ++y) png_write_row(png, &rgb[3 * static_cast<size_t>(y) * width]);
   png_write_end(png, nullptr);
   png_destroy_write_struct(&png, &info);
-  if (std::fclose(fp) != 0 || std::rename(tmp.c_str(), path.c_str()) != 0) {
+  if (std::fclose(fp) != 0) {
     std::remove(tmp.c_str());
     throw Error(path, 0, "cannot write PNG");
   }
+  install_file(tmp, path);
 }
 
 }  // namespace viewcells

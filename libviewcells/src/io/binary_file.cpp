@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 
 #include "viewcells/core/isa.h"
 
@@ -20,8 +21,87 @@ uint64_t fnv1a64(const std::string& bytes) {
   return h;
 }
 
+namespace {
+
+/// The open OutputBatch's staged files (tmp, target), or null when none is open.
+std::mutex g_batch_mutex;
+std::vector<std::pair<std::string, std::string>>* g_batch = nullptr;
+
+}  // namespace
+
+void check_output_target(const std::string& path) {
+  std::error_code ec;
+  const auto st = std::filesystem::symlink_status(path, ec);
+  if (ec || st.type() == std::filesystem::file_type::not_found || st.type() == std::filesystem::file_type::regular)
+    return;
+  throw Error(path, 0, "exists and is not a regular file (a directory, device, FIFO or symbolic link): outputs are "
+                       "replaced by new files, so viewcells will not write there");
+}
+
+std::string temporary_for(const std::string& path) { return path + ".tmp." + std::to_string(getpid()); }
+
+void install_file(const std::string& tmp, const std::string& path) {
+  {
+    std::lock_guard lock(g_batch_mutex);
+    if (g_batch) {
+      for (auto& [staged, target] : *g_batch)
+        if (target == path) {
+          if (staged != tmp) std::remove(staged.c_str());
+          staged = tmp;
+          return;
+        }
+      g_batch->push_back({tmp, path});
+      return;
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw Error(path, 0, "cannot replace file: " + ec.message());
+  }
+}
+
+std::string staged_path(const std::string& path) {
+  std::lock_guard lock(g_batch_mutex);
+  if (g_batch)
+    for (const auto& [staged, target] : *g_batch)
+      if (target == path) return staged;
+  return path;
+}
+
+OutputBatch::OutputBatch() {
+  std::lock_guard lock(g_batch_mutex);
+  VC_CHECK(g_batch == nullptr);
+  g_batch = &staged_;
+}
+
+OutputBatch::~OutputBatch() {
+  std::lock_guard lock(g_batch_mutex);
+  for (const auto& [staged, target] : staged_) std::remove(staged.c_str());
+  g_batch = nullptr;
+}
+
+void OutputBatch::commit() {
+  std::vector<std::pair<std::string, std::string>> files;
+  {
+    std::lock_guard lock(g_batch_mutex);
+    files.swap(staged_);
+    g_batch = nullptr;
+  }
+  for (size_t i = 0; i < files.size(); ++i) {
+    std::error_code ec;
+    std::filesystem::rename(files[i].first, files[i].second, ec);
+    if (ec) {
+      for (size_t j = i; j < files.size(); ++j) std::remove(files[j].first.c_str());
+      throw Error(files[i].second, 0, "cannot replace file: " + ec.message());
+    }
+  }
+}
+
 void write_text_file(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp." + std::to_string(getpid());
+  check_output_target(path);
+  const std::string tmp = temporary_for(path);
   {
     std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
     if (!out) throw Error(path, 0, "cannot open for writing");
@@ -32,12 +112,7 @@ void write_text_file(const std::string& path, const std::string& text) {
       throw Error(path, 0, "write failed (disk full?)");
     }
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    throw Error(path, 0, "cannot replace file: " + ec.message());
-  }
+  install_file(tmp, path);
 }
 
 void write_container(const std::string& path, const char (&magic)[5], uint32_t version,

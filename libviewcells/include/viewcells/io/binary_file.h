@@ -7,6 +7,7 @@
 #include <cstring>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "viewcells/core/error.h"
@@ -108,7 +109,35 @@ std::string read_container(const std::string& path, const char (&magic)[5], uint
 /// FNV-1a 64-bit hash of a byte string.
 uint64_t fnv1a64(const std::string& bytes);
 
-/// Writes `text` to `path` atomically; throws Error on failure.
+/// Writes `text` to `path` atomically (a temporary file, then install_file); throws Error on
+/// failure, or when `path` exists as something other than a regular file.
 void write_text_file(const std::string& path, const std::string& text);
+
+/// Throws Error when `path` exists and is not a regular file (a directory, device, FIFO or
+/// symbolic link): outputs replace files, and must not replace those.
+void check_output_target(const std::string& path);
+/// The temporary file a writer of `path` writes first (beside it, named by the process).
+std::string temporary_for(const std::string& path);
+/// Moves the finished temporary `tmp` onto `path`: at once, or, while an OutputBatch is open,
+/// when it commits.
+void install_file(const std::string& tmp, const std::string& path);
+/// Where the content of `path` is now: its staged temporary while a batch holds it, else path.
+std::string staged_path(const std::string& path);
+
+/// All outputs of one command: while it is open, files written through write_text_file,
+/// write_container or install_file stay temporary and are renamed onto their targets only by
+/// commit(). Destroyed without commit (the command failed), it removes them, so that a failing
+/// command leaves every earlier file as it was. One at a time per process.
+class OutputBatch {
+ public:
+  OutputBatch();
+  ~OutputBatch();
+  OutputBatch(const OutputBatch&) = delete;
+  OutputBatch& operator=(const OutputBatch&) = delete;
+  void commit();
+
+ private:
+  std::vector<std::pair<std::string, std::string>> staged_;
+};
 
 }  // namespace viewcells
