@@ -13,7 +13,7 @@ shift $(( $# > 0 ? 1 : 0 ))
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=(obj ply off stl bsp vseg vcells pvs vagvs)
 
-bash scripts/install-deps.sh
+bash scripts/install-deps.sh --fuzz
 CC=clang-14 CXX=clang++-14 bash scripts/build.sh build-fuzz RelWithDebInfo -DVIEWCELLS_FUZZ=ON -DVIEWCELLS_BUILD_TESTS=OFF
 bin=build-fuzz/tests/fuzz
 vc=build-fuzz/cli/viewcells

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs every build, test and plotting dependency of viewcells from Debian 12 packages.
 # Idempotent: packages already present are skipped, and apt is only asked when something is missing.
+# Usage: scripts/install-deps.sh [--fuzz]
 set -euo pipefail
 
 packages=(
@@ -16,6 +17,9 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev   # tests and micro-benchmarks
   gnuplot-nox                                  # plots of comparisons and studies (scripts/plot-*.sh)
 )
+
+# scripts/fuzz.sh also needs clang with libFuzzer's runtime.
+if [ "${1:-}" = "--fuzz" ]; then packages+=(clang-14 libclang-rt-14-dev); fi
 
 missing=()
 for p in "${packages[@]}"; do

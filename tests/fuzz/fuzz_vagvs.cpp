@@ -52,9 +52,11 @@ Fixture& fixture() {
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   // VIEWCELLS_FUZZ_SEED=PATH: write a state of this fixture (for the seed corpus) and stop.
   if (const char* seed = std::getenv("VIEWCELLS_FUZZ_SEED")) {
-    AgvsSolver solver(fixture().scene, *fixture().caster, fixture().cells, fixture().config);
-    solver.run();
-    solver.save(seed, kIdentity);
+    {
+      AgvsSolver solver(fixture().scene, *fixture().caster, fixture().cells, fixture().config);
+      solver.run();
+      solver.save(seed, kIdentity);
+    }  // destroyed before exit, so that LeakSanitizer sees it freed
     std::exit(0);
   }
   return 0;
