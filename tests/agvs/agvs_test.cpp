@@ -3,6 +3,8 @@
 // followed by resumed sampling, and the visibility filter.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <set>
@@ -12,6 +14,7 @@
 #include "viewcells/agvs/penumbra.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
+#include "viewcells/io/binary_file.h"
 #include "viewcells/scene/generators.h"
 
 namespace viewcells {
@@ -92,6 +95,49 @@ TEST(Agvs, PvsOnlyGrowsAndResumes) {
   // Every distribution was drawn from, the mutation once candidates existed.
   for (int d = 0; d < AgvsStats::kDistributions; ++d)
     EXPECT_GT(solver.stats().dist_samples[d], 0u) << to_string(AgvsDistribution(d));
+}
+
+/// A state with any one of its values replaced by 1e300, NaN or a huge count (a corrupt or
+/// hostile file whose checksum is right) is refused with an Error, or loads and then samples
+/// on without crashing: rays from such values once reached Embree and aborted.
+TEST(Agvs, HostileValuesInAValidStateAreRefusedOrHarmless) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
+  const CellLocator cells = office_cells(scene, 4);
+  const auto caster = make_embree_caster(scene);
+  AgvsConfig config = quiet(AgvsMethod::kAgvs, 600);
+  config.batch_size = 200;
+  config.mutation_buffer = 8;
+  AgvsSolver first(scene, *caster, cells, config);
+  first.run();
+  const std::string path = test::temp_path("hostile.vagvs");
+  first.save(path, 7);
+  uint32_t version = 0;
+  const std::string payload = read_container(path, "VAGS", 99, version);
+  ASSERT_GT(payload.size(), 64u);
+  const double huge = 1e300, nan = std::nan("");
+  const uint64_t count = uint64_t{1} << 62;
+  size_t loaded = 0, refused = 0;
+  for (size_t at = 8; at + 8 <= payload.size(); at += 4) {
+    for (const void* value : {static_cast<const void*>(&huge), static_cast<const void*>(&nan),
+                              static_cast<const void*>(&count)}) {
+      std::string bad = payload;
+      std::memcpy(bad.data() + at, value, 8);
+      const std::string bad_path = test::temp_path("hostile_bad.vagvs");
+      write_container(bad_path, "VAGS", version, bad);
+      AgvsSolver solver(scene, *caster, cells, config);
+      try {
+        solver.load(bad_path, 7);
+        ++loaded;
+        solver.set_limits(solver.stats().samples + 400, 0, 0);
+        solver.run();
+      } catch (const Error&) {
+        ++refused;
+      }
+    }
+  }
+  EXPECT_GT(refused, 0u);
+  std::printf("payload %zu bytes: %zu altered states loaded, %zu refused\n", payload.size(), loaded, refused);
+  EXPECT_GT(loaded, 0u) << "values that do not matter to sampling (timings, statistics) still load";
 }
 
 TEST(Agvs, IdenticalForOneAndTwoThreads) {

@@ -1,10 +1,7 @@
-// libFuzzer target: the PLY reader and the scene built from it.
-#include "fuzz_support.h"
-#include "viewcells/io/scene_io.h"
+// libFuzzer target: see entries.h.
+#include "entries.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  VIEWCELLS_FUZZ_BODY({
-    const std::string_view bytes(reinterpret_cast<const char*>(data), size);
-    viewcells::make_scene(viewcells::read_ply(bytes, "fuzz.ply"), viewcells::ObjectGrouping::kAuto, "fuzz.ply");
-  });
+  viewcells::fuzz::entry_ply(data, size);
+  return 0;
 }

@@ -1,7 +1,7 @@
-// libFuzzer target: .vseg segment files (payload inside a valid container).
-#include "fuzz_support.h"
-#include "viewcells/sampling/segments.h"
+// libFuzzer target: see entries.h.
+#include "entries.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  VIEWCELLS_FUZZ_BODY(viewcells::read_segments(viewcells::fuzz::container_file(data, size, "VSEG", 1, ".vseg")));
+  viewcells::fuzz::entry_vseg(data, size);
+  return 0;
 }

@@ -340,7 +340,10 @@ struct CandidateBuffer {
       w.put(c.origin), w.put(c.term), w.put(c.r_origin), w.put(c.r_term), w.put(c.object);
     }
   }
-  static CandidateBuffer load(ByteReader& r, size_t cap, size_t payload) {
+  /// `box`: where candidate ends may lie (a state's candidates come from segments in the view
+  /// box); `objects`: the scene's object count. Anything else is a corrupt state, refused here
+  /// rather than cast (rays from 1e300 once reached Embree and aborted).
+  static CandidateBuffer load(ByteReader& r, size_t cap, size_t payload, const Box3& box, uint32_t objects) {
     CandidateBuffer b;
     b.next_id = r.get<uint64_t>();
     const uint64_t n = r.get<uint64_t>();
@@ -351,6 +354,10 @@ struct CandidateBuffer {
       Candidate c;
       c.origin = r.get<Vec3>(), c.term = r.get<Vec3>(), c.r_origin = r.get<double>(), c.r_term = r.get<double>();
       c.object = r.get<uint32_t>();
+      const bool inside = box.contains(c.origin) && box.contains(c.term);  // false for NaN
+      if (!inside || !(c.r_origin >= 0 && c.r_origin < 1e300) || !(c.r_term >= 0 && c.r_term < 1e300) ||
+          (c.object != kNoObject && c.object >= objects))
+        r.fail("a mutation candidate lies outside the view space or names no object");
       if (id >= b.next_id || !b.candidates.emplace(id, c).second) r.fail("mutation candidate ids are inconsistent");
       b.count_of[id] = count;
       b.by_count.insert({count, id});
@@ -1282,8 +1289,20 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   const uint64_t last_calibration = r.get<uint64_t>();
   const bool calibrated = r.get<uint8_t>() != 0;
   const double error = r.get<double>();
-  CandidateBuffer two_point = CandidateBuffer::load(r, m.config.mutation_buffer, payload.size());
-  CandidateBuffer silhouette = CandidateBuffer::load(r, m.config.mutation_buffer, payload.size());
+  if (!(s.seconds >= 0 && s.seconds < 1e9)) r.fail("the time spent is out of range");
+  for (int d = 0; d < kDists; ++d)
+    if (!(weight[d] >= 0 && weight[d] < 1e300) || !(recent_c[d] >= 0 && recent_c[d] < 1e300) ||
+        !(recent_r[d] >= 0 && recent_r[d] < 1e300) || !(s.dist_probability[d] >= 0 && s.dist_probability[d] <= 1))
+      r.fail("mixture weights out of range");
+  // Candidate ends lie in the view box or on the scene; a little slack for rounding.
+  Box3 ends = m.cells.view_box();
+  ends.extend(m.scene_->bounds.lo);
+  ends.extend(m.scene_->bounds.hi);
+  const Vec3 slack = ends.extent() * 1e-6 + Vec3{1e-9, 1e-9, 1e-9};
+  ends.lo = ends.lo - slack, ends.hi = ends.hi + slack;
+  const uint32_t objects = m.pvs.object_count();
+  CandidateBuffer two_point = CandidateBuffer::load(r, m.config.mutation_buffer, payload.size(), ends, objects);
+  CandidateBuffer silhouette = CandidateBuffer::load(r, m.config.mutation_buffer, payload.size(), ends, objects);
   const uint64_t window_total = r.get<uint64_t>();
   const uint64_t windows = r.get<uint64_t>();
   if (windows > payload.size()) r.fail("estimator window too long");

@@ -215,7 +215,7 @@ SubdivisionFile read_subdivision(const std::string& path) {
     n.pvs_cost = r.get<double>();
   }
   const uint64_t splits = r.get<uint64_t>();
-  if (2 * splits + 1 != nodes) r.fail("split count does not match the node count");
+  if (splits > max_items || 2 * splits + 1 != nodes) r.fail("split count does not match the node count");
   s.splits.resize(splits);
   for (SplitRecord& rec : s.splits) {
     rec.node = r.get<int32_t>();

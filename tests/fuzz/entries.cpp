@@ -1,0 +1,138 @@
+#include "entries.h"
+
+#include <unistd.h>
+
+#include <memory>
+#include <sstream>
+#include <string_view>
+
+#include "support/test_scenes.h"
+#include "viewcells/agvs/agvs.h"
+#include "viewcells/bsp/subdivision.h"
+#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/core/error.h"
+#include "viewcells/io/binary_file.h"
+#include "viewcells/io/q3bsp.h"
+#include "viewcells/io/scene_io.h"
+#include "viewcells/pvs/pvs.h"
+#include "viewcells/raycast/ray_caster.h"
+#include "viewcells/sampling/segments.h"
+#include "viewcells/scene/generators.h"
+
+namespace viewcells::fuzz {
+namespace {
+
+std::string_view bytes_of(const uint8_t* data, size_t size) { return {reinterpret_cast<const char*>(data), size}; }
+
+/// A scratch path in /dev/shm (or /tmp), one per process.
+std::string scratch(const std::string& ext) {
+  const char* dir = access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp";
+  return std::string(dir) + "/viewcells_fuzz_" + std::to_string(getpid()) + ext;
+}
+
+/// The input as the payload of a valid container: the first byte picks the format version
+/// (1..max_version), the rest is the payload.
+std::string container_file(const uint8_t* data, size_t size, const char (&magic)[5], uint32_t max_version,
+                           const std::string& ext) {
+  const std::string path = scratch(ext);
+  const uint32_t version = size ? 1 + data[0] % max_version : 1;
+  write_container(path, magic, version, std::string(bytes_of(data, size).substr(size ? 1 : 0)));
+  return path;
+}
+
+template <class F>
+void expecting_errors(F&& body) {
+  try {
+    body();
+  } catch (const Error&) {
+  }
+}
+
+Scene scene_of(RawMesh mesh, const char* name) { return make_scene(std::move(mesh), ObjectGrouping::kAuto, name); }
+
+constexpr uint64_t kIdentity = 0x5eed;
+
+struct AgvsFixture {
+  Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
+  std::unique_ptr<RayCaster> caster = make_embree_caster(scene);
+  CellLocator cells = make_cells();
+  AgvsConfig config = make_config();
+
+  CellLocator make_cells() const {
+    SubdivisionConfig sc;
+    sc.strategy = SplitStrategy::kKdCycling;
+    sc.max_cells = 8;
+    sc.show_progress = false;
+    Subdivision s = subdivide(scene, test::sample_scene(scene, 2000, 3), CostModel{}, sc);
+    std::vector<int32_t> leaf_cell(s.nodes.size(), -1);
+    const std::vector<int32_t> leaves = s.leaves();
+    for (size_t i = 0; i < leaves.size(); ++i) leaf_cell[leaves[i]] = static_cast<int32_t>(i);
+    return CellLocator(std::move(s), std::move(leaf_cell), static_cast<uint32_t>(leaves.size()));
+  }
+  static AgvsConfig make_config() {
+    AgvsConfig c;
+    c.max_samples = 400;
+    c.batch_size = 200;
+    c.show_progress = false;
+    return c;
+  }
+};
+
+AgvsFixture& agvs_fixture() {
+  static AgvsFixture f;
+  return f;
+}
+
+}  // namespace
+
+void entry_obj(const uint8_t* data, size_t size) {
+  expecting_errors([&] {
+    std::istringstream in{std::string(bytes_of(data, size))};
+    scene_of(read_obj(in, "fuzz.obj"), "fuzz.obj");
+  });
+}
+void entry_ply(const uint8_t* data, size_t size) {
+  expecting_errors([&] { scene_of(read_ply(bytes_of(data, size), "fuzz.ply"), "fuzz.ply"); });
+}
+void entry_off(const uint8_t* data, size_t size) {
+  expecting_errors([&] { scene_of(read_off(bytes_of(data, size), "fuzz.off"), "fuzz.off"); });
+}
+void entry_stl(const uint8_t* data, size_t size) {
+  expecting_errors([&] { scene_of(read_stl(bytes_of(data, size), "fuzz.stl"), "fuzz.stl"); });
+}
+void entry_bsp(const uint8_t* data, size_t size) {
+  expecting_errors([&] { q3_world_mesh(parse_q3bsp(std::string(bytes_of(data, size)), "fuzz.bsp")); });
+}
+void entry_vseg(const uint8_t* data, size_t size) {
+  expecting_errors([&] { read_segments(container_file(data, size, "VSEG", 1, ".vseg")); });
+}
+void entry_vcells(const uint8_t* data, size_t size) {
+  expecting_errors([&] { read_subdivision(container_file(data, size, "VCEL", 3, ".vcells")); });
+}
+void entry_pvs(const uint8_t* data, size_t size) {
+  expecting_errors([&] {
+    const PvsFile f = read_pvs(container_file(data, size, "VPVS", 1, ".pvs"));
+    // Point location walks the BSP read from the file: a corrupt tree must not loop or run off.
+    f.locate(f.bsp.view_box.center());
+    f.locate(f.bsp.view_box.lo);
+  });
+}
+void entry_vagvs(const uint8_t* data, size_t size) {
+  AgvsFixture& f = agvs_fixture();
+  const std::string path = container_file(data, size, "VAGS", 3, ".vagvs");
+  expecting_errors([&] {
+    AgvsSolver solver(f.scene, *f.caster, f.cells, f.config);
+    solver.load(path, kIdentity);
+    solver.set_limits(solver.stats().samples + 400, 0, 0);
+    solver.run();
+  });
+}
+
+void write_vagvs_seed(const std::string& path) {
+  AgvsFixture& f = agvs_fixture();
+  AgvsSolver solver(f.scene, *f.caster, f.cells, f.config);
+  solver.run();
+  solver.save(path, kIdentity);
+}
+
+}  // namespace viewcells::fuzz
