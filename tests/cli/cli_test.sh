@@ -340,6 +340,14 @@ expect_error "unknown Embree ISA" "$VC" --embree-isa avx9 sample office.obj -o x
 expect_error "invalid ray" "$VC" sample office.obj --samples 1000 -q --view-box 1e19,0,0,1.0000001e19,1,1 -o x.vseg
 { cat office.obj; printf 'o stray\nv 1e7 0 0\nv 10000001 0 0\nv 1e7 1 0\nf -3 -2 -1\n'; } > stray.obj
 expect_error "object 'stray'" "$VC" sample stray.obj --samples 1000 -q -o x.vseg
+# The cells PLY that viewcells writes loads back as a scene; cut anywhere, it is an error.
+expect_ok "$VC" info cells.ply
+header=$(grep -abo end_header cells.ply | cut -d: -f1)
+for n in 1 4 12 30 60 $((header / 2)) $((header + 5)) $((header + 200)) $(( $(stat -c %s cells.ply) - 3 )); do
+  head -c "$n" cells.ply > cut.ply
+  expect_error "cut.ply" timeout 20 "$VC" -q info cut.ply
+  [ ! -s err.txt ] || [ "$(wc -l < err.txt)" -le 3 ] && ok || bad "a cut PLY floods stderr ($(wc -l < err.txt) lines)"
+done
 printf 'OFF\n3 1000 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' > invented.off
 expect_error "1000 faces" "$VC" info invented.off
 # Reports and file headers say which Embree ISA cast the rays.
