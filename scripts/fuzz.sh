@@ -42,7 +42,7 @@ obj_to_stl() {
        BEGIN{print "solid seed"} END{print "endsolid seed"}' "$1"
 }
 
-if [ ! -d "$corpus/done" ]; then
+if [ ! -f "$corpus/done" ]; then
   echo "fuzz: making seed corpora"
   rm -rf "$corpus"
   for t in obj ply off stl bsp vseg vcells pvs vagvs; do mkdir -p "$corpus/$t"; done

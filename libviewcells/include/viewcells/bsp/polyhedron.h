@@ -1,8 +1,10 @@
 #pragma once
 /// Convex polyhedra: the cells of the view space BSP. A boundary representation (vertices and
 /// faces, each face tagged with the plane it lies on) that splits by any plane, with volume,
-/// containment and segment clipping. Vertex sides are decided by Plane::side (exact), so a
-/// split never produces inconsistent topology; new vertices are computed in double.
+/// containment and segment clipping. Vertex sides are decided by Plane::side (exact), and a
+/// vertex within the rounding of the plane counts as on it, so a split never makes a vertex
+/// that nearly duplicates another (an edge of arbitrary direction); new vertices are computed
+/// in double, and those of the plane's section closer than the rounding are welded.
 #include <cstdint>
 #include <optional>
 #include <utility>
