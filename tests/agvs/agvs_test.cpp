@@ -21,18 +21,7 @@ namespace viewcells {
 namespace {
 
 /// A kd-tree of `n` cells over the office's bounds, each leaf its own view cell.
-CellLocator office_cells(const Scene& scene, uint32_t n) {
-  const SegmentSet segs = test::sample_scene(scene, 20000, 3);
-  SubdivisionConfig sc;
-  sc.strategy = SplitStrategy::kKdCycling;
-  sc.max_cells = n;
-  sc.show_progress = false;
-  Subdivision s = subdivide(scene, segs, CostModel{}, sc);
-  std::vector<int32_t> leaf_cell(s.nodes.size(), -1);
-  const std::vector<int32_t> leaves = s.leaves();
-  for (size_t i = 0; i < leaves.size(); ++i) leaf_cell[leaves[i]] = static_cast<int32_t>(i);
-  return CellLocator(std::move(s), std::move(leaf_cell), static_cast<uint32_t>(leaves.size()));
-}
+CellLocator office_cells(const Scene& scene, uint32_t n) { return test::kd_cells(scene, n); }
 
 AgvsConfig quiet(AgvsMethod method, uint64_t samples) {
   AgvsConfig c;

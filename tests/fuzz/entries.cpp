@@ -55,20 +55,9 @@ constexpr uint64_t kIdentity = 0x5eed;
 struct AgvsFixture {
   Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
   std::unique_ptr<RayCaster> caster = make_embree_caster(scene);
-  CellLocator cells = make_cells();
+  CellLocator cells = test::kd_cells(scene, 8, 2000);
   AgvsConfig config = make_config();
 
-  CellLocator make_cells() const {
-    SubdivisionConfig sc;
-    sc.strategy = SplitStrategy::kKdCycling;
-    sc.max_cells = 8;
-    sc.show_progress = false;
-    Subdivision s = subdivide(scene, test::sample_scene(scene, 2000, 3), CostModel{}, sc);
-    std::vector<int32_t> leaf_cell(s.nodes.size(), -1);
-    const std::vector<int32_t> leaves = s.leaves();
-    for (size_t i = 0; i < leaves.size(); ++i) leaf_cell[leaves[i]] = static_cast<int32_t>(i);
-    return CellLocator(std::move(s), std::move(leaf_cell), static_cast<uint32_t>(leaves.size()));
-  }
   static AgvsConfig make_config() {
     AgvsConfig c;
     c.max_samples = 400;

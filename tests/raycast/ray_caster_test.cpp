@@ -6,6 +6,7 @@
 
 #include "support/test_scenes.h"
 #include "viewcells/core/error.h"
+#include "viewcells/core/isa.h"
 #include "viewcells/core/rng.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/scene/generators.h"
@@ -70,12 +71,43 @@ TEST(RayCaster, HitsCarryObjectAndFace) {
   }
 }
 
+/// Every ISA this CPU runs can be asked for by name, and casts the same closest objects as
+/// the oracle on rays that graze nothing; unknown names and far-off rays are errors.
+TEST(RayCaster, EveryIsaByNameAndInvalidRaysRefused) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 2});
+  const auto oracle = make_brute_force_caster(scene);
+  const Vec3 c = scene.bounds.center();
+  for (const std::string& isa : supported_embree_isas()) {
+    EmbreeConfig config;
+    config.isa = isa;
+    const auto embree = make_embree_caster(scene, config);
+    EXPECT_NE(embree->name().find(isa), std::string::npos) << embree->name();
+    Rng rng(3);
+    int same = 0;
+    for (int i = 0; i < 500; ++i) {
+      const Vec3 d = normalize(Vec3{rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1)});
+      const Ray ray{c + Vec3{0.1, 0.2, 0.3}, d};
+      same += embree->intersect(ray).object == oracle->intersect(ray).object;
+    }
+    EXPECT_GE(same, 495) << isa;  // a ray may graze an edge between two objects
+  }
+  EmbreeConfig bad;
+  bad.isa = "avx9";
+  EXPECT_THROW(make_embree_caster(scene, bad), Error);
+  const auto embree = make_embree_caster(scene);
+  EXPECT_THROW(embree->intersect(Ray{{1e19, 0, 0}, {1, 0, 0}}), Error);
+  EXPECT_THROW(embree->intersect(Ray{c, {NAN, 0, 0}}), Error);
+  EXPECT_THROW(embree->intersect(Ray{c, {1, 0, 0}, 2.0, 1.0}), Error);
+}
+
 /// Rays aimed exactly at shared edges and vertices, from directions where every triangle
 /// meeting there faces the ray (so the surface continues on all sides and a miss is a leak),
 /// must not slip through in robust mode. The oracle is watertight by construction.
 TEST(RayCaster, NoLeaksThroughEdgesAndVertices) {
   const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 7, 2});
-  const auto embree = make_embree_caster(scene, EmbreeConfig{.robust = true});
+  EmbreeConfig robust;
+  robust.robust = true;
+  const auto embree = make_embree_caster(scene, robust);
   const auto oracle = make_brute_force_caster(scene);
   std::vector<std::vector<uint32_t>> incident(scene.vertices.size());
   for (uint32_t t = 0; t < scene.triangles.size(); ++t)

@@ -1,5 +1,6 @@
 #include "support/test_scenes.h"
 
+#include "viewcells/bsp/subdivision.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
 
@@ -62,6 +63,18 @@ SegmentSet sample_scene(const Scene& scene, uint64_t samples, uint64_t seed) {
   config.seed = seed;
   config.show_progress = false;
   return sample_segments(scene, *caster, config).segments;
+}
+
+CellLocator kd_cells(const Scene& scene, uint32_t n, uint64_t samples) {
+  SubdivisionConfig sc;
+  sc.strategy = SplitStrategy::kKdCycling;
+  sc.max_cells = n;
+  sc.show_progress = false;
+  Subdivision s = subdivide(scene, sample_scene(scene, samples, 3), CostModel{}, sc);
+  std::vector<int32_t> leaf_cell(s.nodes.size(), -1);
+  const std::vector<int32_t> leaves = s.leaves();
+  for (size_t i = 0; i < leaves.size(); ++i) leaf_cell[leaves[i]] = static_cast<int32_t>(i);
+  return CellLocator(std::move(s), std::move(leaf_cell), static_cast<uint32_t>(leaves.size()));
 }
 
 }  // namespace viewcells::test

@@ -2,6 +2,7 @@
 // Small scenes built in code for tests, and helpers shared by several test files.
 #include <string>
 
+#include "viewcells/agvs/agvs.h"
 #include "viewcells/sampling/segments.h"
 #include "viewcells/scene/scene.h"
 
@@ -13,6 +14,9 @@ void add_cube(RawMesh& mesh, const Vec3& lo, const Vec3& hi, const std::string& 
 Scene cube_grid(int n, double spacing = 3.0, double size = 1.0);
 /// Visibility segments of `samples` samples (Embree, default settings, no progress bar).
 SegmentSet sample_scene(const Scene& scene, uint64_t samples, uint64_t seed = 1);
+/// View cells for AGVS tests: the `n` leaves of a KD-CASM tree built from `samples` samples
+/// (seed 3), one cell each.
+CellLocator kd_cells(const Scene& scene, uint32_t n, uint64_t samples = 20000);
 /// A temporary directory unique to this test process; files are removed at exit.
 std::string temp_path(const std::string& name);
 /// Writes text to a file (for loader tests).

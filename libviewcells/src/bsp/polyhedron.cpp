@@ -23,7 +23,6 @@ ConvexPolyhedron ConvexPolyhedron::box(const Box3& b, int32_t first_plane_id) {
 std::optional<std::pair<ConvexPolyhedron, ConvexPolyhedron>> ConvexPolyhedron::split(const Plane& plane,
                                                                                       int32_t plane_id) const {
   const size_t nv = vertices_.size();
-  std::vector<int> side(nv);
   std::vector<double> dist(nv);
   // Vertices made by earlier cuts are rounded: one meant to lie on a face's plane can sit a
   // few ulps off it, so a face can be a hair non-planar. A vertex within that rounding of
@@ -38,8 +37,7 @@ std::optional<std::pair<ConvexPolyhedron, ConvexPolyhedron>> ConvexPolyhedron::s
   bool any_neg = false, any_pos = false;
   for (size_t i = 0; i < nv; ++i) {
     dist[i] = plane.distance(vertices_[i]);
-    side[i] = plane.side(vertices_[i]);
-    eside[i] = side[i] != 0 && std::abs(dist[i]) > eps ? side[i] : 0;
+    eside[i] = std::abs(dist[i]) > eps ? plane.side(vertices_[i]) : 0;
     any_neg |= eside[i] < 0;
     any_pos |= eside[i] > 0;
   }
