@@ -1097,10 +1097,12 @@ json number_or_null(double v) { return std::isnan(v) ? json(nullptr) : json(v); 
 int run_pvs(const PvsArgs& a, const Common& c) {
   {
     // --save may be the --resume state (continue and keep it up to date); nothing else may meet.
-    std::vector<std::string> inputs = {a.input, a.scene, a.edited_from};
+    std::error_code ec;
+    const bool save_is_resume = !a.save.empty() && !a.resume.empty() &&
+                                (a.save == a.resume || std::filesystem::equivalent(a.save, a.resume, ec));
+    std::vector<std::string> inputs = {a.input, a.scene, a.edited_from, save_is_resume ? "" : a.resume};
     inputs.insert(inputs.end(), a.references.begin(), a.references.end());
     check_files(inputs, {a.output, a.report, a.save});
-    check_files({}, {a.output, a.report, a.resume});
   }
   ThreadLimit threads(c.threads);
   AgvsConfig config;

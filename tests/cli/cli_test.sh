@@ -185,6 +185,10 @@ expect_error "these view cells" "$VC" pvs office.vcells --scene office.obj --cel
   -o x.pvs
 expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 20000 --save half.vagvs -o half.pvs -q
 expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 40000 --resume half.vagvs -o resumed.pvs -q
+# --save may be the --resume state (continue and keep it); -o onto it may not.
+cp half.vagvs again.vagvs
+expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 40000 --resume again.vagvs --save ./again.vagvs -o again.pvs -q
+expect_error "is an input" "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 40000 --resume half.vagvs -o half.vagvs -q
 cmp -s resumed.pvs agvs.pvs && ok || bad "20000 samples resumed to 40000 differ from 40000 in one run"
 expect_error "another scene or other view cells" "$VC" pvs office.vcells --scene office.obj --cells 8 --samples 10 \
   --resume half.vagvs -o x.pvs

@@ -107,8 +107,8 @@ TEST(BinaryFile, CorruptionIsRejected) {
   expect_rejected(test::temp_path("absent.bin"), "no such file");
   expect_rejected(std::filesystem::temp_directory_path().string(), "not a regular file");
 
-  // A header claiming far more bytes than zstd can expand the payload to is refused before
-  // anything is allocated (the checksum would only be checked afterwards).
+  // A header claiming 2^50 payload bytes is refused before anything is allocated (here
+  // because the zstd frame disagrees; a frame that agreed would meet the expansion bound).
   std::string huge = bytes;
   const uint64_t claim = uint64_t{1} << 50;
   std::memcpy(huge.data() + 8, &claim, 8);
