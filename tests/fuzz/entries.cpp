@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string_view>
 
@@ -15,6 +16,7 @@
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pvs/pvs.h"
+#include "viewcells/runtime.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/segments.h"
 #include "viewcells/scene/generators.h"
@@ -100,10 +102,29 @@ void entry_vcells(const uint8_t* data, size_t size) {
 }
 void entry_pvs(const uint8_t* data, size_t size) {
   expecting_errors([&] {
-    const PvsFile f = read_pvs(container_file(data, size, "VPVS", 1, ".pvs"));
+    const std::string path = container_file(data, size, "VPVS", 1, ".pvs");
+    // The engines' reader (runtime/) must accept exactly what the toolkit accepts, and then
+    // agree with it: the same cells and visible sets at the same points.
+    vc_pvs* runtime = nullptr;
+    const bool runtime_ok = vc_pvs_open(path.c_str(), &runtime, nullptr, 0) == 0;
+    std::unique_ptr<vc_pvs, void (*)(vc_pvs*)> owner(runtime, vc_pvs_close);
+    std::optional<PvsFile> read;
+    try {
+      read.emplace(read_pvs(path));
+    } catch (const Error&) {
+      if (runtime_ok) std::abort();
+      throw;
+    }
+    if (!runtime_ok) std::abort();
+    const PvsFile& f = *read;
     // Point location walks the BSP read from the file: a corrupt tree must not loop or run off.
-    f.locate(f.bsp.view_box.center());
-    f.locate(f.bsp.view_box.lo);
+    for (const Vec3& p : {f.bsp.view_box.center(), f.bsp.view_box.lo, f.bsp.view_box.hi}) {
+      const int32_t cell = f.locate(p);
+      if (vc_pvs_locate(runtime, p.x, p.y, p.z) != cell) std::abort();
+      const uint32_t* ids = nullptr;
+      const size_t n = vc_pvs_cell_objects(runtime, cell, &ids);
+      if (cell >= 0 && std::vector<uint32_t>(ids, ids + n) != f.pvs.cell_pvs(static_cast<uint32_t>(cell))) std::abort();
+    }
   });
 }
 void entry_vagvs(const uint8_t* data, size_t size) {

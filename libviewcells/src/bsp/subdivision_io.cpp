@@ -33,6 +33,9 @@ std::vector<Plane> get_planes(ByteReader& r, uint64_t max_items) {
     p.offset = r.get<double>();
     for (Vec3& q : p.points) q = r.get<Vec3>();
     if (p.axis < -1 || p.axis > 2 || !is_finite(p.normal) || !std::isfinite(p.offset)) r.fail("invalid plane");
+    // A geometry-aligned plane's side is decided exactly from its points: they must be numbers.
+    if (p.axis < 0 && !(is_finite(p.points[0]) && is_finite(p.points[1]) && is_finite(p.points[2])))
+      r.fail("invalid plane");
   }
   return planes;
 }

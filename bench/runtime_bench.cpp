@@ -1,0 +1,125 @@
+// Point location plus PVS lookup through the runtime reader (runtime/), as an engine does per
+// frame: VIEWCELLS_BENCH_PVS names the .pvs file (scripts/bench-runtime.sh makes a 50k-cell
+// city). Viewpoints are uniform in the view box, drawn once (seed 1); each query locates one
+// and reads its cell's visible set.
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "viewcells/runtime.hpp"
+
+namespace {
+
+struct Fixture {
+  std::unique_ptr<viewcells::runtime::PvsFile> pvs;
+  std::vector<double> points;  // x, y, z per viewpoint
+};
+
+Fixture& fixture() {
+  static Fixture f = [] {
+    Fixture out;
+    const char* path = std::getenv("VIEWCELLS_BENCH_PVS");
+    if (!path) {
+      std::fprintf(stderr, "runtime_bench: set VIEWCELLS_BENCH_PVS to a .pvs file\n");
+      std::exit(2);
+    }
+    out.pvs = std::make_unique<viewcells::runtime::PvsFile>(path);
+    double lo[3], hi[3];
+    vc_pvs_view_box(out.pvs->handle(), lo, hi);
+    std::mt19937_64 rng(1);
+    const size_t n = 1 << 20;
+    out.points.resize(3 * n);
+    for (size_t i = 0; i < n; ++i)
+      for (int k = 0; k < 3; ++k)
+        out.points[3 * i + k] = std::uniform_real_distribution<double>(lo[k], hi[k])(rng);
+    return out;
+  }();
+  return f;
+}
+
+void counters(benchmark::State& state) {
+  const Fixture& f = fixture();
+  state.SetItemsProcessed(state.iterations());
+  state.counters["cells"] = f.pvs->cell_count();
+  state.counters["objects"] = f.pvs->object_count();
+  state.counters["memory_MB"] = f.pvs->memory_bytes() / 1e6;
+}
+
+void BM_Locate(benchmark::State& state) {
+  const Fixture& f = fixture();
+  const size_t n = f.points.size() / 3;
+  size_t i = 0;
+  for (auto _ : state) {
+    const double* p = &f.points[3 * i];
+    benchmark::DoNotOptimize(f.pvs->locate(p[0], p[1], p[2]));
+    i = (i + 1) & (n - 1);
+  }
+  counters(state);
+}
+
+void BM_LocateAndList(benchmark::State& state) {
+  const Fixture& f = fixture();
+  const size_t n = f.points.size() / 3;
+  size_t i = 0, total = 0;
+  for (auto _ : state) {
+    const double* p = &f.points[3 * i];
+    const viewcells::runtime::ObjectList l = f.pvs->objects_at(p[0], p[1], p[2]);
+    total += l.size + (l.empty() ? 0 : l.data[l.size - 1]);  // touch the list's last entry
+    i = (i + 1) & (n - 1);
+  }
+  benchmark::DoNotOptimize(total);
+  counters(state);
+}
+
+/// A viewer walking: 1M steps of 0.2% of the view box's diagonal, turning at random and
+/// reflected at the box, as frames of a camera are (most steps stay in their cell).
+void BM_WalkAndList(benchmark::State& state) {
+  const Fixture& f = fixture();
+  double lo[3], hi[3], p[3], d[3] = {1, 0, 0};
+  vc_pvs_view_box(f.pvs->handle(), lo, hi);
+  const double step = 0.002 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
+  for (int k = 0; k < 3; ++k) p[k] = 0.5 * (lo[k] + hi[k]);
+  size_t i = 0, total = 0;
+  for (auto _ : state) {
+    const double* turn = &f.points[3 * i];  // uniform in the box: a direction change
+    for (int k = 0; k < 3; ++k) {
+      d[k] = 0.9 * d[k] + 0.1 * ((turn[k] - lo[k]) / (hi[k] - lo[k]) - 0.5);
+      p[k] += step * d[k];
+      if (p[k] < lo[k] || p[k] > hi[k]) d[k] = -d[k], p[k] = std::clamp(p[k], lo[k], hi[k]);
+    }
+    const viewcells::runtime::ObjectList l = f.pvs->objects_at(p[0], p[1], p[2]);
+    total += l.size + (l.empty() ? 0 : l.data[l.size - 1]);
+    i = (i + 1) & ((f.points.size() / 3) - 1);
+  }
+  benchmark::DoNotOptimize(total);
+  counters(state);
+}
+
+void BM_LocateAndBitRow(benchmark::State& state) {
+  const Fixture& f = fixture();
+  const size_t n = f.points.size() / 3;
+  std::vector<uint8_t> row(f.pvs->row_bytes());
+  size_t i = 0;
+  for (auto _ : state) {
+    const double* p = &f.points[3 * i];
+    vc_pvs_cell_bits(f.pvs->handle(), f.pvs->locate(p[0], p[1], p[2]), row.data(), row.size());
+    benchmark::DoNotOptimize(row.data());
+    i = (i + 1) & (n - 1);
+  }
+  counters(state);
+}
+
+}  // namespace
+
+BENCHMARK(BM_Locate);
+BENCHMARK(BM_LocateAndList);
+BENCHMARK(BM_WalkAndList);
+BENCHMARK(BM_LocateAndBitRow);
+BENCHMARK_MAIN();

@@ -1,0 +1,514 @@
+// The viewcells runtime reader (runtime.h): the .pvs container and payload as the toolkit
+// writes them (libviewcells/src/pvs/pvs.cpp, core/binary_file.cpp), read with zstd alone.
+// Every count and index is checked before it is used; nothing in a file can make the reader
+// read out of bounds, loop or allocate beyond what the file's own size implies.
+#include "viewcells/runtime.h"
+
+#include <zstd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <new>
+#include <stdexcept>
+#include <string>
+#include <sys/stat.h>
+#include <vector>
+
+namespace {
+
+struct Vec {
+  double v[3];
+};
+
+/// A BSP node as location walks it: 16 bytes, laid out in preorder so that the negative
+/// child follows its parent. `right` is the positive child, or 0 for a leaf (the root is
+/// never a child). An inner node compares coordinate `meta >> 30` (0-2) with `offset`, or
+/// when that is 3 asks the exact predicate of general plane `meta & kIndex`. A leaf's `meta`
+/// is its view cell, and `list` locates the cell's visible objects in the ids array.
+struct Node {
+  union {
+    double offset;
+    uint32_t list[2];  // first, count
+  };
+  uint32_t meta;
+  uint32_t right;
+};
+constexpr uint32_t kIndex = (1u << 30) - 1;
+
+struct GeneralPlane {
+  Vec a, b, c;  // the three points that define it (the toolkit's Plane::points)
+};
+
+class FileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+uint64_t fnv1a64(const std::string& bytes) {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char c : bytes) {
+    h ^= c;
+    h *= 0x100000001b3ULL;
+  }
+  return h;
+}
+
+/// Bounds-checked little-endian reads of a payload.
+class Reader {
+ public:
+  explicit Reader(const std::string& data) : data_(data) {}
+  template <class T>
+  T get() {
+    need(sizeof(T));
+    T v;
+    std::memcpy(&v, data_.data() + pos_, sizeof(T));
+    pos_ += sizeof(T);
+    return v;
+  }
+  std::string get_string() {
+    const uint64_t n = get<uint64_t>();
+    need(n);
+    std::string s = data_.substr(pos_, n);
+    pos_ += n;
+    return s;
+  }
+  template <class T>
+  std::vector<T> get_array(uint64_t max_count) {
+    const uint64_t n = get<uint64_t>();
+    if (n > max_count) throw FileError("corrupt file: an array larger than the file");
+    need(n * sizeof(T));
+    std::vector<T> v(n);
+    if (n) std::memcpy(v.data(), data_.data() + pos_, n * sizeof(T));
+    pos_ += n * sizeof(T);
+    return v;
+  }
+  uint32_t get_varint() {
+    uint32_t v = 0;
+    for (int shift = 0; shift < 35; shift += 7) {
+      const uint8_t b = get<uint8_t>();
+      v |= static_cast<uint32_t>(b & 0x7f) << shift;
+      if (!(b & 0x80)) return v;
+    }
+    throw FileError("corrupt file: malformed varint");
+  }
+  bool at_end() const { return pos_ == data_.size(); }
+
+ private:
+  void need(uint64_t n) const {
+    if (n > data_.size() - pos_) throw FileError("corrupt file: payload ends early");
+  }
+  const std::string& data_;
+  size_t pos_ = 0;
+};
+
+/// The container: magic, version (low 16 bits; the third byte names the writer's Embree
+/// ISA), payload size, FNV-1a checksum, compressed size, zstd frame.
+std::string read_container(const std::string& path) {
+  struct stat st;
+  if (stat(path.c_str(), &st) != 0) throw FileError("no such file");
+  if (!S_ISREG(st.st_mode)) throw FileError("not a regular file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw FileError("cannot open file");
+  const std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (file.size() < 32) throw FileError("not a .pvs file (too short)");
+  if (std::memcmp(file.data(), "VPVS", 4) != 0) throw FileError("not a .pvs file (wrong magic)");
+  Reader r(file);
+  r.get<uint32_t>();
+  const uint32_t tagged = r.get<uint32_t>();
+  if (tagged >> 24) throw FileError("corrupt file: malformed version field");
+  if ((tagged & 0xffff) != 1)
+    throw FileError("format version " + std::to_string(tagged & 0xffff) + " is not supported (this reader reads 1)");
+  const uint64_t raw_size = r.get<uint64_t>(), checksum = r.get<uint64_t>(), csize = r.get<uint64_t>();
+  if (csize != file.size() - 32) throw FileError("corrupt file: compressed size does not match (truncated?)");
+  if (ZSTD_getFrameContentSize(file.data() + 32, csize) != raw_size)
+    throw FileError("corrupt file: compressed frame does not match header");
+  if (raw_size > 65536 * (csize + 64)) throw FileError("corrupt file: impossible decompressed size");
+  std::string payload(raw_size, '\0');
+  const size_t got = ZSTD_decompress(payload.data(), raw_size, file.data() + 32, csize);
+  if (ZSTD_isError(got) || got != raw_size) throw FileError("corrupt file: decompression failed");
+  if (fnv1a64(payload) != checksum) throw FileError("corrupt file: checksum mismatch");
+  return payload;
+}
+
+// ------------------------------------------------------------ exact orientation predicate
+
+/// a + b = x + y exactly.
+inline void two_sum(double a, double b, double& x, double& y) {
+  x = a + b;
+  const double bv = x - a, av = x - bv;
+  y = (a - av) + (b - bv);
+}
+
+/// Adds b to the expansion e (components non-overlapping, increasing in magnitude, no
+/// zeros); Shewchuk's Grow-Expansion with zero elimination.
+void grow(std::vector<double>& e, double b) {
+  std::vector<double> h;
+  h.reserve(e.size() + 1);
+  double q = b;
+  for (double ei : e) {
+    double sum, err;
+    two_sum(q, ei, sum, err);
+    if (err != 0) h.push_back(err);
+    q = sum;
+  }
+  if (q != 0) h.push_back(q);
+  e.swap(h);
+}
+
+/// Adds s * x * y * z to e exactly (two products through fma).
+void add_triple(std::vector<double>& e, double s, double x, double y, double z) {
+  const double p = s * x * y;  // s is +-1: s * x is exact
+  const double pe = std::fma(s * x, y, -p);
+  const double p1 = p * z, e1 = std::fma(p, z, -p1);
+  const double p2 = pe * z, e2 = std::fma(pe, z, -p2);
+  for (double t : {e2, p2, e1, p1}) grow(e, t);
+}
+
+/// det [x; y; z] of three rows added to e with sign s, exactly.
+void add_det3(std::vector<double>& e, double s, const Vec& x, const Vec& y, const Vec& z) {
+  const double* X = x.v;
+  const double* Y = y.v;
+  const double* Z = z.v;
+  add_triple(e, s, X[0], Y[1], Z[2]);
+  add_triple(e, -s, X[0], Y[2], Z[1]);
+  add_triple(e, -s, X[1], Y[0], Z[2]);
+  add_triple(e, s, X[1], Y[2], Z[0]);
+  add_triple(e, s, X[2], Y[0], Z[1]);
+  add_triple(e, -s, X[2], Y[1], Z[0]);
+}
+
+/// Sign of det [b - a; c - a; d - a] (CGAL's orientation(a, b, c, d)): a floating-point
+/// filter with Shewchuk's error bound, and exact expansion arithmetic when it cannot decide.
+int orientation(const GeneralPlane& pl, const Vec& d) {
+  const double* a = pl.a.v;
+  const double* b = pl.b.v;
+  const double* c = pl.c.v;
+  const double adx = a[0] - d.v[0], bdx = b[0] - d.v[0], cdx = c[0] - d.v[0];
+  const double ady = a[1] - d.v[1], bdy = b[1] - d.v[1], cdy = c[1] - d.v[1];
+  const double adz = a[2] - d.v[2], bdz = b[2] - d.v[2], cdz = c[2] - d.v[2];
+  const double bdxcdy = bdx * cdy, cdxbdy = cdx * bdy, cdxady = cdx * ady, adxcdy = adx * cdy;
+  const double adxbdy = adx * bdy, bdxady = bdx * ady;
+  // det [a - d; b - d; c - d] = -det [b - a; c - a; d - a].
+  const double det = adz * (bdxcdy - cdxbdy) + bdz * (cdxady - adxcdy) + cdz * (adxbdy - bdxady);
+  const double permanent = (std::fabs(bdxcdy) + std::fabs(cdxbdy)) * std::fabs(adz) +
+                           (std::fabs(cdxady) + std::fabs(adxcdy)) * std::fabs(bdz) +
+                           (std::fabs(adxbdy) + std::fabs(bdxady)) * std::fabs(cdz);
+  constexpr double eps = 1.1102230246251565e-16;  // 2^-53
+  const double bound = 2 * (7.0 + 56.0 * eps) * eps * permanent;  // twice Shewchuk's A bound
+  if (det > bound) return -1;
+  if (-det > bound) return 1;
+  // det [a 1; b 1; c 1; d 1] = -det [b - a; c - a; d - a], as a sum of 24 exact triple products.
+  std::vector<double> e;
+  add_det3(e, -1, pl.b, pl.c, d);
+  add_det3(e, 1, pl.a, pl.c, d);
+  add_det3(e, -1, pl.a, pl.b, d);
+  add_det3(e, 1, pl.a, pl.b, pl.c);
+  if (e.empty()) return 0;
+  return e.back() > 0 ? -1 : 1;
+}
+
+}  // namespace
+
+struct vc_pvs {
+  uint64_t fingerprint = 0;
+  uint32_t object_count = 0;
+  uint32_t cell_count = 0;
+  std::vector<std::string> names;
+  std::string rule;
+  double lo[3], hi[3];
+  std::vector<Node> nodes;
+  std::vector<GeneralPlane> planes;
+  std::vector<uint64_t> offsets;  // per cell + 1, into ids
+  std::vector<uint32_t> ids;      // every cell's visible objects, sorted per cell
+};
+
+namespace {
+
+bool finite(const Vec& p) { return std::isfinite(p.v[0]) && std::isfinite(p.v[1]) && std::isfinite(p.v[2]); }
+
+Vec get_vec(Reader& r) {
+  Vec p;
+  for (double& x : p.v) x = r.get<double>();
+  return p;
+}
+
+/// Planes and nodes: every inner node has a valid plane and two later children, every node
+/// but the root one parent, every leaf a view cell.
+void read_bsp(Reader& r, vc_pvs& f, uint64_t max_items) {
+  std::vector<int32_t> leaf_cell;
+  const uint64_t plane_count = r.get<uint64_t>();
+  if (plane_count < 6 || plane_count > max_items) throw FileError("corrupt file: invalid plane count");
+  std::vector<int32_t> axis(plane_count), general(plane_count, -1);
+  std::vector<double> offset(plane_count);
+  for (uint64_t i = 0; i < plane_count; ++i) {
+    axis[i] = r.get<int32_t>();
+    const Vec normal = get_vec(r);
+    offset[i] = r.get<double>();
+    GeneralPlane g{get_vec(r), get_vec(r), get_vec(r)};
+    if (axis[i] < -1 || axis[i] > 2 || !finite(normal) || !std::isfinite(offset[i]))
+      throw FileError("corrupt file: invalid plane");
+    if (axis[i] < 0) {
+      if (!finite(g.a) || !finite(g.b) || !finite(g.c)) throw FileError("corrupt file: invalid plane");
+      general[i] = static_cast<int32_t>(f.planes.size());
+      f.planes.push_back(g);
+    }
+  }
+  const uint64_t count = r.get<uint64_t>();
+  if (count == 0 || count > max_items || count % 2 == 0 || count >= kIndex)
+    throw FileError("corrupt file: invalid node count");
+  if (f.planes.size() > kIndex) throw FileError("corrupt file: invalid plane count");
+  struct Raw {
+    int32_t plane, child[2];
+  };
+  std::vector<Raw> raw(count);
+  leaf_cell.resize(count);
+  std::vector<int> parents(count, 0);
+  for (uint64_t n = 0; n < count; ++n) {
+    Raw& b = raw[n];
+    b.plane = r.get<int32_t>();
+    b.child[0] = r.get<int32_t>();
+    b.child[1] = r.get<int32_t>();
+    leaf_cell[n] = r.get<int32_t>();
+    if (b.plane < 0) {
+      if (b.child[0] != -1 || b.child[1] != -1)
+        throw FileError("corrupt file: BSP leaf " + std::to_string(n) + " has children");
+      continue;
+    }
+    if (static_cast<uint64_t>(b.plane) >= plane_count || leaf_cell[n] != -1)
+      throw FileError("corrupt file: BSP node " + std::to_string(n) + " is invalid");
+    for (int32_t ch : b.child) {
+      if (ch <= static_cast<int64_t>(n) || static_cast<uint64_t>(ch) >= count)
+        throw FileError("corrupt file: BSP node " + std::to_string(n) + " has a bad child");
+      ++parents[ch];
+    }
+  }
+  for (uint64_t n = 1; n < count; ++n)
+    if (parents[n] != 1) throw FileError("corrupt file: BSP node " + std::to_string(n) + " is not in the tree once");
+  // Preorder layout (a tree, checked above): the negative child right after its parent.
+  f.nodes.reserve(count);
+  std::vector<std::pair<int32_t, int64_t>> stack = {{0, -1}};  // (file node, parent's slot for `right`)
+  while (!stack.empty()) {
+    const auto [old, slot] = stack.back();
+    stack.pop_back();
+    const uint32_t me = static_cast<uint32_t>(f.nodes.size());
+    if (slot >= 0) f.nodes[slot].right = me;
+    Node node{};
+    node.right = 0;
+    const Raw& b = raw[old];
+    if (b.plane < 0) {
+      node.meta = static_cast<uint32_t>(leaf_cell[old]);  // checked against the cell count later
+      node.list[0] = node.list[1] = 0;
+      f.nodes.push_back(node);
+      continue;
+    }
+    node.offset = offset[b.plane];
+    node.meta = axis[b.plane] >= 0 ? static_cast<uint32_t>(axis[b.plane]) << 30
+                                   : (3u << 30) | static_cast<uint32_t>(general[b.plane]);
+    f.nodes.push_back(node);
+    stack.push_back({b.child[1], me});
+    stack.push_back({b.child[0], -1});  // popped next: lands at me + 1
+  }
+}
+
+/// Decodes the kept lists of the hierarchy and expands every cell's visible set.
+void read_lists(Reader& r, vc_pvs& f, uint64_t max_items) {
+  f.cell_count = r.get<uint32_t>();
+  const std::vector<int32_t> parent = r.get_array<int32_t>(max_items);
+  const std::vector<uint32_t> mht = r.get_array<uint32_t>(max_items);
+  const std::string lists = r.get_string();
+  if (!r.at_end()) throw FileError("corrupt file: trailing bytes");
+  const size_t total = parent.size();
+  if (f.cell_count == 0 || f.cell_count > total || mht.size() != f.cell_count)
+    throw FileError("corrupt file: invalid view cell count");
+  for (size_t n = 0; n < total; ++n)
+    if (parent[n] != -1 && (parent[n] <= static_cast<int64_t>(n) || static_cast<size_t>(parent[n]) >= total))
+      throw FileError("corrupt file: hierarchy node " + std::to_string(n) + " has a bad parent");
+  Reader lr(lists);
+  std::vector<std::vector<uint32_t>> stored(total);
+  for (auto& ids : stored) {
+    const uint32_t n = lr.get_varint();
+    if (n > f.object_count) throw FileError("corrupt file: a list holds more entries than there are objects");
+    ids.resize(n);
+    uint64_t previous = 0;
+    for (uint32_t i = 0; i < n; ++i) {
+      const uint64_t id = (i ? previous + 1 : 0) + lr.get_varint();
+      if (id >= f.object_count) throw FileError("corrupt file: object id out of range");
+      ids[i] = static_cast<uint32_t>(id);
+      previous = id;
+    }
+  }
+  if (!lr.at_end()) throw FileError("corrupt file: trailing bytes after the PVS lists");
+  // Size first: a path may not repeat an object, so a cell holds at most object_count.
+  uint64_t expanded = 0;
+  for (uint32_t c = 0; c < f.cell_count; ++c) {
+    uint64_t here = 0;
+    for (int32_t n = static_cast<int32_t>(c); n >= 0; n = parent[n]) here += stored[n].size();
+    if (here > f.object_count) throw FileError("corrupt file: cell " + std::to_string(c) + " repeats an object");
+    expanded += here;
+  }
+  if (expanded > (uint64_t{1} << 31))
+    throw FileError("the expanded visible sets hold " + std::to_string(expanded) + " entries, more than 2^31");
+  f.offsets.reserve(f.cell_count + 1);
+  f.ids.reserve(expanded);
+  f.offsets.push_back(0);
+  for (uint32_t c = 0; c < f.cell_count; ++c) {
+    const size_t first = f.ids.size();
+    for (int32_t n = static_cast<int32_t>(c); n >= 0; n = parent[n])
+      f.ids.insert(f.ids.end(), stored[n].begin(), stored[n].end());
+    std::sort(f.ids.begin() + first, f.ids.end());
+    if (std::adjacent_find(f.ids.begin() + first, f.ids.end()) != f.ids.end())
+      throw FileError("corrupt file: cell " + std::to_string(c) + " repeats an object");
+    f.offsets.push_back(f.ids.size());
+  }
+}
+
+void read_file(const std::string& path, vc_pvs& f) {
+  const std::string payload = read_container(path);
+  Reader r(payload);
+  const uint64_t max_items = payload.size();
+  f.fingerprint = r.get<uint64_t>();
+  f.object_count = r.get<uint32_t>();
+  const uint64_t names = r.get<uint64_t>();
+  if (names != 0 && names != f.object_count) throw FileError("corrupt file: object names do not match the object count");
+  for (uint64_t i = 0; i < names; ++i) f.names.push_back(r.get_string());
+  f.rule = r.get_string();
+  for (double& x : f.lo) x = r.get<double>();
+  for (double& x : f.hi) x = r.get<double>();
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(f.lo[k]) || !std::isfinite(f.hi[k]) || !(f.lo[k] < f.hi[k]))
+      throw FileError("corrupt file: invalid view box");
+  read_bsp(r, f, max_items);
+  read_lists(r, f, max_items);
+  for (Node& n : f.nodes) {
+    if (n.right != 0) continue;
+    if (n.meta >= f.cell_count) throw FileError("corrupt file: a BSP leaf has no view cell");
+    n.list[0] = static_cast<uint32_t>(f.offsets[n.meta]);
+    n.list[1] = static_cast<uint32_t>(f.offsets[n.meta + 1] - f.offsets[n.meta]);
+  }
+}
+
+void put_error(char* error, size_t size, const std::string& text) {
+  if (!error || size == 0) return;
+  std::snprintf(error, size, "%s", text.c_str());
+}
+
+}  // namespace
+
+extern "C" {
+
+int vc_pvs_open(const char* path, vc_pvs** out, char* error, size_t error_size) {
+  if (out) *out = nullptr;
+  if (!path || !out) {
+    put_error(error, error_size, "vc_pvs_open: path and out must not be NULL");
+    return 1;
+  }
+  vc_pvs* f = nullptr;
+  try {
+    f = new vc_pvs;
+    read_file(path, *f);
+  } catch (const FileError& e) {
+    delete f;
+    put_error(error, error_size, std::string(path) + ": " + e.what());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    delete f;
+    put_error(error, error_size, std::string(path) + ": out of memory");
+    return 3;
+  } catch (const std::exception& e) {
+    delete f;
+    put_error(error, error_size, std::string(path) + ": " + e.what());
+    return 4;
+  }
+  *out = f;
+  return 0;
+}
+
+void vc_pvs_close(vc_pvs* pvs) { delete pvs; }
+
+uint32_t vc_pvs_cell_count(const vc_pvs* pvs) { return pvs->cell_count; }
+uint32_t vc_pvs_object_count(const vc_pvs* pvs) { return pvs->object_count; }
+size_t vc_pvs_row_bytes(const vc_pvs* pvs) { return (static_cast<size_t>(pvs->object_count) + 7) / 8; }
+uint64_t vc_pvs_scene_fingerprint(const vc_pvs* pvs) { return pvs->fingerprint; }
+const char* vc_pvs_rule(const vc_pvs* pvs) { return pvs->rule.c_str(); }
+
+void vc_pvs_view_box(const vc_pvs* pvs, double lo[3], double hi[3]) {
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = pvs->lo[k];
+    hi[k] = pvs->hi[k];
+  }
+}
+
+const char* vc_pvs_object_name(const vc_pvs* pvs, uint32_t object) {
+  return object < pvs->names.size() ? pvs->names[object].c_str() : "";
+}
+
+size_t vc_pvs_memory_bytes(const vc_pvs* pvs) {
+  size_t n = sizeof(vc_pvs) + pvs->rule.capacity();
+  for (const std::string& s : pvs->names) n += sizeof(s) + s.capacity();
+  return n + pvs->nodes.capacity() * sizeof(Node) + pvs->planes.capacity() * sizeof(GeneralPlane) +
+         pvs->offsets.capacity() * sizeof(uint64_t) + pvs->ids.capacity() * sizeof(uint32_t);
+}
+
+namespace {
+
+/// The leaf holding p, or null outside the view box (NaN coordinates included).
+inline const Node* leaf_at(const vc_pvs* pvs, double x, double y, double z) {
+  const Vec p{{x, y, z}};
+  for (int k = 0; k < 3; ++k)
+    if (!(p.v[k] >= pvs->lo[k] && p.v[k] <= pvs->hi[k])) return nullptr;
+  const Node* nodes = pvs->nodes.data();
+  const Node* n = nodes;
+  while (n->right) {
+    const uint32_t axis = n->meta >> 30;
+    const bool positive = axis < 3 ? p.v[axis] > n->offset : orientation(pvs->planes[n->meta & kIndex], p) > 0;
+    n = positive ? nodes + n->right : n + 1;
+  }
+  return n;
+}
+
+}  // namespace
+
+int32_t vc_pvs_locate(const vc_pvs* pvs, double x, double y, double z) {
+  const Node* n = leaf_at(pvs, x, y, z);
+  return n ? static_cast<int32_t>(n->meta) : -1;
+}
+
+int32_t vc_pvs_locate_objects(const vc_pvs* pvs, double x, double y, double z, const uint32_t** objects,
+                              size_t* count) {
+  const Node* n = leaf_at(pvs, x, y, z);
+  if (objects) *objects = n ? pvs->ids.data() + n->list[0] : nullptr;
+  if (count) *count = n ? n->list[1] : 0;
+  return n ? static_cast<int32_t>(n->meta) : -1;
+}
+
+size_t vc_pvs_cell_objects(const vc_pvs* pvs, int32_t cell, const uint32_t** objects) {
+  if (cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count) {
+    if (objects) *objects = nullptr;
+    return 0;
+  }
+  const uint64_t first = pvs->offsets[cell], last = pvs->offsets[cell + 1];
+  if (objects) *objects = pvs->ids.data() + first;
+  return static_cast<size_t>(last - first);
+}
+
+int vc_pvs_cell_bits(const vc_pvs* pvs, int32_t cell, uint8_t* row, size_t row_bytes) {
+  if (cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count || !row || row_bytes < vc_pvs_row_bytes(pvs))
+    return -1;
+  std::memset(row, 0, row_bytes);
+  for (uint64_t i = pvs->offsets[cell]; i < pvs->offsets[cell + 1]; ++i)
+    row[pvs->ids[i] >> 3] = static_cast<uint8_t>(row[pvs->ids[i] >> 3] | (1u << (pvs->ids[i] & 7)));
+  return 0;
+}
+
+int vc_pvs_cell_sees(const vc_pvs* pvs, int32_t cell, uint32_t object) {
+  if (cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count) return 0;
+  const uint32_t* first = pvs->ids.data() + pvs->offsets[cell];
+  const uint32_t* last = pvs->ids.data() + pvs->offsets[cell + 1];
+  return std::binary_search(first, last, object) ? 1 : 0;
+}
+
+}  // extern "C"

@@ -1,0 +1,37 @@
+#!/usr/bin/env bash
+# Installs the build into a temporary prefix, configures examples/consumer against it with
+# find_package(viewcells), builds it and checks that its answers are the CLI's:
+#   install_test.sh BUILD_DIR VIEWCELLS WORK
+set -euo pipefail
+build="$1"; vc="$2"; work="$3"
+src="$(cd "$(dirname "$0")/../.." && pwd)"
+rm -rf "$work"; mkdir -p "$work"
+cmake --install "$build" --prefix "$work/prefix" >/dev/null
+test -f "$work/prefix/lib/cmake/viewcells/viewcellsConfig.cmake"
+test -f "$work/prefix/include/viewcells/runtime.h"
+cmake -S "$src/examples/consumer" -B "$work/consumer" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
+cmake --build "$work/consumer" >/dev/null
+
+# A small level, made and queried by the CLI.
+"$vc" -q generate office --size 1 -o "$work/office.obj"
+"$vc" -q build "$work/office.obj" --samples 20000 --max-cells 60 -o "$work/office.vcells"
+"$vc" -q compress "$work/office.vcells" --count 20 -o "$work/office.pvs"
+for point in "2 2 1.5" "7.5 3.1 1.2" "1 9 2.5"; do
+  # shellcheck disable=SC2086
+  cli=$("$vc" query "$work/office.pvs" $point --json | python3 -c 'import json,sys; j=json.load(sys.stdin); print(j["cell"], " ".join(str(o["id"]) for o in j["pvs"]))')
+  # shellcheck disable=SC2086
+  ours=$("$work/consumer/pvs_lookup" "$work/office.pvs" $point | python3 -c 'import sys; l=sys.stdin.read().splitlines(); print(l[0].split()[1], " ".join(x.split()[0] for x in l[1:]))')
+  if [ "$cli" != "$ours" ]; then
+    echo "FAIL at $point: viewcells query says '$cli', the installed runtime '$ours'"; exit 1
+  fi
+done
+# The consumer refuses what is not a .pvs file, with a message.
+if "$work/consumer/pvs_lookup" "$work/office.obj" 0 0 0 2>"$work/err"; then echo "FAIL: accepted an OBJ"; exit 1; fi
+grep -q "office.obj" "$work/err"
+# The toolkit component links and runs too.
+"$work/consumer/scene_stats" "$work/office.obj" | grep -q "triangles"
+# The runtime library links nothing of the toolkit's dependencies.
+if ldd "$work/consumer/pvs_lookup" | grep -Ei "embree|tbb|cgal|gmp|boost|png"; then
+  echo "FAIL: the runtime consumer links toolkit dependencies"; exit 1
+fi
+echo "install test passed: find_package(viewcells) consumers agree with viewcells query"

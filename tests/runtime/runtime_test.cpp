@@ -1,0 +1,199 @@
+// The runtime reader for engines (runtime/) against the toolkit's own reading of the same
+// .pvs files: same cells, same visible sets, same point location, also for points on and a
+// few ulps off geometry-aligned planes, where only an exact predicate gets the side right.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "support/test_scenes.h"
+#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/core/rng.h"
+#include "viewcells/merge/merge.h"
+#include "viewcells/pvs/pvs.h"
+#include "viewcells/runtime.hpp"
+#include "viewcells/scene/generators.h"
+
+namespace viewcells {
+namespace {
+
+/// A .pvs of `count` view cells of a rotated office (its planes are not axis-aligned).
+struct Level {
+  PvsFile file;
+  std::string path;
+};
+
+const Level& level() {
+  static const Level l = [] {
+    const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 1});
+    const SegmentSet segs = test::sample_scene(scene, 20000);
+    SubdivisionConfig config;
+    config.max_cells = 150;
+    config.show_progress = false;
+    config.geometry_aligned = GeometryAlignedMode::kOn;
+    const Subdivision s = subdivide(scene, segs, CostModel{}, config);
+    const auto leaf = leaf_pvs(s, segs);
+    MergeConfig mc;
+    mc.show_progress = false;
+    const MergeHistory h = merge_cells(scene, partition_from_subdivision(s, leaf), CostModel{}, mc);
+    Level out;
+    out.file = make_pvs_file(s, leaf, h, extract_by_count(h, 40).cells);
+    out.file.object_count = static_cast<uint32_t>(scene.object_count());
+    for (const ObjectInfo& o : scene.objects) out.file.object_names.push_back(o.name);
+    out.file.scene_fingerprint = scene.fingerprint();
+    out.file.rule = "40 cells (count)";
+    out.path = test::temp_path("runtime.pvs");
+    write_pvs(out.path, out.file);
+    return out;
+  }();
+  return l;
+}
+
+TEST(Runtime, ReadsWhatTheToolkitWrites) {
+  const Level& l = level();
+  const runtime::PvsFile r(l.path);
+  ASSERT_EQ(r.cell_count(), l.file.pvs.cell_count);
+  EXPECT_EQ(r.object_count(), l.file.object_count);
+  EXPECT_EQ(r.scene_fingerprint(), l.file.scene_fingerprint);
+  EXPECT_EQ(r.rule(), "40 cells (count)");
+  EXPECT_EQ(r.row_bytes(), (l.file.object_count + 7) / 8);
+  for (uint32_t o = 0; o < l.file.object_count; ++o) EXPECT_EQ(r.object_name(o), l.file.object_names[o]);
+  EXPECT_EQ(r.object_name(l.file.object_count), "");
+  for (uint32_t c = 0; c < r.cell_count(); ++c) {
+    const std::vector<uint32_t> want = l.file.pvs.cell_pvs(c);
+    const runtime::ObjectList got = r.objects(static_cast<int32_t>(c));
+    EXPECT_EQ(std::vector<uint32_t>(got.begin(), got.end()), want) << "cell " << c;
+    const std::vector<uint8_t> bits = r.bits(static_cast<int32_t>(c));
+    for (uint32_t o = 0; o < l.file.object_count; ++o) {
+      const bool in = std::binary_search(want.begin(), want.end(), o);
+      EXPECT_EQ(((bits[o >> 3] >> (o & 7)) & 1) != 0, in);
+      EXPECT_EQ(r.sees(static_cast<int32_t>(c), o), in);
+    }
+  }
+  EXPECT_TRUE(r.objects(-1).empty());
+  EXPECT_TRUE(r.objects(static_cast<int32_t>(r.cell_count())).empty());
+  EXPECT_THROW(r.bits(-1), std::out_of_range);
+  uint8_t small = 0;
+  EXPECT_EQ(vc_pvs_cell_bits(r.handle(), 0, &small, 0), -1);
+  EXPECT_GT(r.memory_bytes(), 4 * l.file.pvs.stored_entries());
+}
+
+TEST(Runtime, LocatesLikeTheToolkitOnAndNearEveryPlane) {
+  const Level& l = level();
+  const runtime::PvsFile r(l.path);
+  const Box3& box = l.file.bsp.view_box;
+  Rng rng(5);
+  for (int k = 0; k < 20000; ++k) {
+    const Vec3 p{rng.uniform(box.lo.x, box.hi.x), rng.uniform(box.lo.y, box.hi.y), rng.uniform(box.lo.z, box.hi.z)};
+    const int32_t cell = l.file.locate(p);
+    ASSERT_EQ(r.locate(p.x, p.y, p.z), cell) << p.x << " " << p.y << " " << p.z;
+    int32_t at = -2;
+    const runtime::ObjectList seen = r.objects_at(p.x, p.y, p.z, &at);
+    ASSERT_EQ(at, cell);
+    ASSERT_EQ(seen.data, r.objects(cell).data);
+    ASSERT_EQ(seen.size, r.objects(cell).size);
+  }
+  int32_t outside = 0;
+  EXPECT_TRUE(r.objects_at(box.lo.x - 1, box.lo.y, box.lo.z, &outside).empty());
+  EXPECT_EQ(outside, -1);
+  // Points on each plane (rounded onto it), and a few ulps to either side: the float filter
+  // cannot decide these, and the exact fallback must agree with CGAL's predicate.
+  size_t general = 0, checked = 0;
+  for (const Plane& pl : l.file.bsp.planes) {
+    if (pl.is_axis_aligned()) {
+      const Vec3 c = box.center();
+      for (double d : {0.0, 1e-12, -1e-12}) {
+        Vec3 p = c;
+        p[pl.axis] = pl.offset + d;
+        if (!box.contains(p)) continue;
+        ASSERT_EQ(r.locate(p.x, p.y, p.z), l.file.locate(p));
+      }
+      continue;
+    }
+    ++general;
+    const auto& q = pl.points;
+    for (int k = 0; k < 200; ++k) {
+      const double s = rng.uniform(-2, 2), t = rng.uniform(-2, 2);
+      Vec3 p = q[0] + s * (q[1] - q[0]) + t * (q[2] - q[0]);
+      for (int ulps = -3; ulps <= 3; ++ulps) {
+        Vec3 v = p;
+        for (int i = 0; i < std::abs(ulps); ++i) v.x = std::nextafter(v.x, ulps > 0 ? 1e300 : -1e300);
+        if (!box.contains(v)) continue;
+        ++checked;
+        ASSERT_EQ(r.locate(v.x, v.y, v.z), l.file.locate(v)) << "plane point " << v.x << " " << v.y << " " << v.z;
+      }
+    }
+    for (const Vec3& v : q) {
+      if (!box.contains(v)) continue;
+      ASSERT_EQ(r.locate(v.x, v.y, v.z), l.file.locate(v));
+    }
+  }
+  EXPECT_GT(general, 0u) << "the rotated office should need geometry-aligned planes";
+  EXPECT_GT(checked, 100u);
+  EXPECT_EQ(r.locate(box.hi.x + 1, box.lo.y, box.lo.z), -1);
+  EXPECT_EQ(r.locate(NAN, box.lo.y, box.lo.z), -1);
+  EXPECT_EQ(r.locate(box.lo.x, box.lo.y, box.lo.z), l.file.locate(box.lo));
+  EXPECT_EQ(r.locate(box.hi.x, box.hi.y, box.hi.z), l.file.locate(box.hi));
+}
+
+/// vc_pvs_open's answer for a file: 0, or the code with the message checked to name the file.
+int open_code(const std::string& path) {
+  vc_pvs* p = nullptr;
+  char error[256] = "untouched";
+  const int code = vc_pvs_open(path.c_str(), &p, error, sizeof error);
+  if (code == 0) {
+    vc_pvs_close(p);
+  } else {
+    EXPECT_EQ(p, nullptr);
+    EXPECT_NE(std::string(error).find(path), std::string::npos) << error;
+  }
+  return code;
+}
+
+TEST(Runtime, RefusesWhatIsNotAValidPvsFile) {
+  const Level& l = level();
+  std::ifstream in(l.path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string bad = test::temp_path("bad.pvs");
+  EXPECT_NE(open_code(test::temp_path("missing.pvs")), 0);
+  std::filesystem::create_directories(test::temp_path("a_directory.pvs"));
+  EXPECT_NE(open_code(test::temp_path("a_directory.pvs")), 0);
+  for (size_t keep : {size_t{0}, size_t{10}, size_t{32}, bytes.size() / 2, bytes.size() - 1}) {
+    test::write_file(bad, bytes.substr(0, keep));
+    EXPECT_NE(open_code(bad), 0) << "truncated to " << keep;
+  }
+  for (size_t at : {size_t{0}, size_t{5}, size_t{40}, bytes.size() / 2, bytes.size() - 1}) {
+    std::string flipped = bytes;
+    flipped[at] = static_cast<char>(flipped[at] ^ 0x21);
+    test::write_file(bad, flipped);
+    EXPECT_NE(open_code(bad), 0) << "flipped byte " << at;
+  }
+  // Well-formed containers whose content is inconsistent: the toolkit refuses them, so must we.
+  auto refused = [&](PvsFile f) {
+    write_pvs(bad, f);
+    EXPECT_THROW(read_pvs(bad), Error);
+    return open_code(bad) != 0;
+  };
+  PvsFile f = l.file;
+  f.pvs.parent[0] = 0;
+  EXPECT_TRUE(refused(f));
+  f = l.file;
+  f.pvs.stored.back().push_back(f.object_count + 3);
+  EXPECT_TRUE(refused(f));
+  f = l.file;
+  *std::find_if(f.leaf_cell.begin(), f.leaf_cell.end(), [](int32_t c) { return c >= 0; }) = 999;
+  EXPECT_TRUE(refused(f));
+  f = l.file;
+  f.bsp.nodes[0].child[1] = f.bsp.nodes[0].child[0];
+  EXPECT_TRUE(refused(f));
+  f = l.file;
+  for (Plane& pl : f.bsp.planes)
+    if (!pl.is_axis_aligned()) pl.points[1].y = NAN;
+  EXPECT_TRUE(refused(f));
+  EXPECT_THROW(runtime::PvsFile{bad}, std::runtime_error);
+  EXPECT_NE(vc_pvs_open(nullptr, nullptr, nullptr, 0), 0);
+}
+
+}  // namespace
+}  // namespace viewcells
