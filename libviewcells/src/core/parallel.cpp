@@ -19,4 +19,8 @@ ThreadLimit::~ThreadLimit() = default;
 
 int hardware_threads() { return tbb::info::default_concurrency(); }
 
+int worker_threads() {
+  return static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+}
+
 }  // namespace viewcells

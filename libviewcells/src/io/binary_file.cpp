@@ -70,6 +70,17 @@ std::string staged_path(const std::string& path) {
   return path;
 }
 
+UnbatchedWrites::UnbatchedWrites() {
+  std::lock_guard lock(g_batch_mutex);
+  saved_ = g_batch;
+  g_batch = nullptr;
+}
+
+UnbatchedWrites::~UnbatchedWrites() {
+  std::lock_guard lock(g_batch_mutex);
+  g_batch = saved_;
+}
+
 OutputBatch::OutputBatch() {
   std::lock_guard lock(g_batch_mutex);
   VC_CHECK(g_batch == nullptr);

@@ -24,5 +24,7 @@ class ThreadLimit {
 
 /// Number of hardware threads.
 int hardware_threads();
+/// Threads parallel stages use now (the innermost ThreadLimit's, else all hardware threads).
+int worker_threads();
 
 }  // namespace viewcells

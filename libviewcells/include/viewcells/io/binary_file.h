@@ -124,6 +124,19 @@ void install_file(const std::string& tmp, const std::string& path);
 /// Where the content of `path` is now: its staged temporary while a batch holds it, else path.
 std::string staged_path(const std::string& path);
 
+/// While alive, files are installed at once even when an OutputBatch is open: for a work
+/// directory's checkpoints, which must survive a command that fails or is cut off later.
+class UnbatchedWrites {
+ public:
+  UnbatchedWrites();
+  ~UnbatchedWrites();
+  UnbatchedWrites(const UnbatchedWrites&) = delete;
+  UnbatchedWrites& operator=(const UnbatchedWrites&) = delete;
+
+ private:
+  std::vector<std::pair<std::string, std::string>>* saved_;
+};
+
 /// All outputs of one command: while it is open, files written through write_text_file,
 /// write_container or install_file stay temporary and are renamed onto their targets only by
 /// commit(). Destroyed without commit (the command failed), it removes them, so that a failing

@@ -1,0 +1,82 @@
+// compare: view cells by several methods, scored on independent samples.
+#include <memory>
+
+#include "options.h"
+#include "viewcells/core/parallel.h"
+#include "viewcells/pipeline/compare.h"
+
+namespace viewcells::cli {
+
+namespace {
+
+struct CompareArgs {
+  SamplingOptions sampling;
+  std::string methods = "av-m,av-s,kd-casm,kd-lasm,kd-vt,kd-vt-star,bsp";
+  bool methods_given = false;
+  uint32_t max_cells = 1000;
+  bool max_cells_given = false;
+  uint64_t eval_samples = 0;
+  uint64_t eval_seed = 0;
+  uint32_t histogram_cells = 0;
+  double cost_a = 100, cost_b = 1;
+  bool no_ga = false;
+  uint32_t axis_candidates = 200;
+  uint32_t ga_candidates = 150;
+  std::string output;
+};
+
+int run_compare(const CompareArgs& a, const Common& c) {
+  ThreadLimit threads(c.threads);
+  pipeline::CompareRunConfig config;
+  config.scene = a.sampling.source();
+  if (a.methods_given || !pipeline::is_q3_map(a.sampling.scene)) config.methods = split_list(a.methods);
+  config.max_cells = a.max_cells_given ? a.max_cells : 0;
+  config.construction = a.sampling.sampler(c);
+  config.evaluation_samples = a.eval_samples;
+  config.evaluation_seed = a.eval_seed;
+  config.histogram_cells = a.histogram_cells;
+  config.model.a = a.cost_a;
+  config.model.b = a.cost_b;
+  config.subdivision.max_axis_candidates = a.axis_candidates;
+  config.subdivision.ga_candidates = a.ga_candidates;
+  config.geometry_aligned_off = a.no_ga;
+  config.output_dir = a.output;
+  pipeline::compare(config, c.logger());
+  return 0;
+}
+
+}  // namespace
+
+void add_compare_command(CLI::App& app, const Common& common, Commands& commands) {
+  auto a = std::make_shared<CompareArgs>();
+  auto* cm = app.add_subcommand("compare",
+                                "Build view cells with several methods from the same samples and score them all on "
+                                "independent evaluation samples (paper, section 6)");
+  add_sampling_options(cm, a->sampling);
+  cm->add_option("--methods", a->methods,
+                 "Comma-separated: av-m, av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp, and q3-clusters (the clusters "
+                 "q3map2 compiled into a Quake 3 map; the default on a .bsp with visibility data, with av-m,av-s,kd-casm)")
+      ->capture_default_str()
+      ->each([a](const std::string&) { a->methods_given = true; });
+  cm->add_option("--max-cells", a->max_cells, "Cells per method at most (on a Quake 3 map: 3 x its clusters)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber)
+      ->each([a](const std::string&) { a->max_cells_given = true; });
+  cm->add_option("--eval-samples", a->eval_samples, "Evaluation samples (default: 4 x --samples)")
+      ->check(whole(1, kMaxSamples));
+  cm->add_option("--eval-seed", a->eval_seed, "Evaluation seed (default: --seed + 1000003)");
+  cm->add_option("--histogram-cells", a->histogram_cells, "Cell count of the cost histograms (default: --max-cells)");
+  cm->add_option("--cost-a", a->cost_a, "Render cost model: minimum cost of an object")->capture_default_str();
+  cm->add_option("--cost-b", a->cost_b, "Render cost model: cost per triangle")->capture_default_str();
+  cm->add_flag("--no-ga", a->no_ga, "AV-S/AV-M without geometry-aligned candidates");
+  cm->add_option("--axis-candidates", a->axis_candidates, "AV-S/AV-M: axis-aligned positions per axis and cell")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cm->add_option("--ga-candidates", a->ga_candidates, "AV-S/AV-M: geometry-aligned planes per cell")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cm->add_option("-o,--output", a->output, "Directory for curves.csv, histogram.csv, summary.json")->required();
+  commands.push_back({cm, [a, &common] { return run_compare(*a, common); }});
+}
+
+}  // namespace viewcells::cli

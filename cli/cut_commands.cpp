@@ -1,0 +1,112 @@
+// extract, compress, query: view cells cut from the merge history, their PVSs, a viewpoint.
+#include <iostream>
+#include <memory>
+
+#include "options.h"
+#include "viewcells/core/error.h"
+#include "viewcells/pipeline/cut.h"
+#include "viewcells/pipeline/report.h"
+
+namespace viewcells::cli {
+
+namespace {
+
+struct ExtractArgs {
+  std::string input, output, scene;
+  CutOptions cut;
+  pipeline::ViewsConfig views;
+};
+
+int run_extract(const ExtractArgs& e, const Common& c) {
+  check_files({e.input, e.scene}, {e.output, e.views.mesh, e.views.slice_png});
+  pipeline::ExtractConfig config;
+  config.hierarchy_path = e.input;
+  config.cut = e.cut.rule();
+  config.scene_path = e.scene;
+  config.views = e.views;
+  const pipeline::ExtractResult result = pipeline::extract(config, c.logger());
+  if (!e.output.empty()) {
+    pipeline::write_report(e.output, result);
+    c.log("viewcells: view cells -> " + e.output);
+  }
+  if (e.output.empty() && !e.views.any()) std::cout << pipeline::report_json(result);
+  return 0;
+}
+
+struct CompressArgs {
+  std::string input, output, flat, report;
+  CutOptions cut;
+};
+
+int run_compress(const CompressArgs& a, const Common& c) {
+  check_files({a.input}, {a.output, a.flat, a.report});
+  pipeline::CompressConfig config;
+  config.hierarchy_path = a.input;
+  config.cut = a.cut.rule();
+  config.output = a.output;
+  config.flat = a.flat;
+  const pipeline::CompressResult result = pipeline::compress(config, c.logger());
+  if (!a.report.empty()) {
+    pipeline::write_report(a.report, result);
+    c.log("viewcells: report -> " + a.report);
+  }
+  return 0;
+}
+
+struct QueryArgs {
+  std::string input;
+  std::vector<double> point;
+  bool json_out = false;
+};
+
+int run_query(const QueryArgs& q) {
+  const PvsFile f = read_pvs(q.input);
+  if (q.point.size() != 3) throw Error("query needs a point: X Y Z");
+  const Vec3 p{q.point[0], q.point[1], q.point[2]};
+  if (!is_finite(p)) throw Error("query point has non-finite coordinates");
+  const int32_t cell = f.locate(p);
+  if (cell < 0)
+    throw Error("(" + fmt(p.x, 3) + ", " + fmt(p.y, 3) + ", " + fmt(p.z, 3) + ") is outside the view space");
+  if (q.json_out) {
+    std::cout << pipeline::query_json(f, p, cell);
+    return 0;
+  }
+  const std::vector<uint32_t> pvs = f.pvs.cell_pvs(static_cast<uint32_t>(cell));
+  std::cout << "cell " << cell << " of " << f.pvs.cell_count << " (" << f.rule << "): " << pvs.size() << " of "
+            << f.object_count << " objects visible\n";
+  for (uint32_t o : pvs) std::cout << "  " << o << (f.object_names.empty() ? "" : "  " + f.object_names[o]) << '\n';
+  return 0;
+}
+
+}  // namespace
+
+void add_cut_commands(CLI::App& app, const Common& common, Commands& commands) {
+  auto e = std::make_shared<ExtractArgs>();
+  auto* xt = app.add_subcommand("extract", "Cut view cells from the merge history of a built hierarchy");
+  xt->add_option("cells", e->input, "Hierarchy file (.vcells, built with merging)")->required();
+  add_cut_options(xt, e->cut);
+  xt->add_option("-o,--output", e->output, "JSON file of the view cells (default: printed)");
+  add_view_options(xt, e->views, "PLY of the BSP leaves coloured by their view cell's render cost",
+                   "PNG of a horizontal slice, borders between view cells");
+  xt->add_option("--scene", e->scene, "Draw this scene's cross-section into the slice");
+  commands.push_back({xt, [e, &common] { return run_extract(*e, common); }});
+
+  auto cmp = std::make_shared<CompressArgs>();
+  auto* cp = app.add_subcommand("compress",
+                                "Write the view cells' PVSs, compressed through the hierarchy, as a .pvs file");
+  cp->add_option("cells", cmp->input, "Hierarchy file (.vcells, built with merging)")->required();
+  add_cut_options(cp, cmp->cut);
+  cp->add_option("-o,--output", cmp->output, "The .pvs file to write")->required();
+  cp->add_option("--flat", cmp->flat, "Also write Quake-style run-length coded bit rows, to compare sizes");
+  cp->add_option("--report", cmp->report, "JSON report: entries and bytes before and after");
+  commands.push_back({cp, [cmp, &common] { return run_compress(*cmp, common); }});
+
+  auto q = std::make_shared<QueryArgs>();
+  auto* qy = app.add_subcommand("query", "Print the view cell containing a point and its PVS");
+  qy->add_option("pvs", q->input, "A .pvs file (from compress, pvs or bake)")->required();
+  qy->add_option("point", q->point, "X Y Z")->required()->expected(3);
+  qy->add_flag("--json", q->json_out, "Print JSON");
+  commands.push_back({qy, [q] { return run_query(*q); }});
+}
+
+}  // namespace viewcells::cli

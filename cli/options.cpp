@@ -1,0 +1,281 @@
+#include "options.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include "viewcells/core/error.h"
+#include "viewcells/io/binary_file.h"
+
+namespace viewcells::cli {
+
+void Common::log(const std::string& s) const {
+  if (!quiet) std::cerr << s << '\n';
+}
+
+pipeline::Log Common::logger() const {
+  const bool q = quiet;
+  return [q](const std::string& s) {
+    if (!q) std::cerr << s << '\n';
+  };
+}
+
+std::string fmt(double v, int precision) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(precision);
+  os << v;
+  return os.str();
+}
+
+CLI::Validator whole(uint64_t lo, uint64_t hi) {
+  return CLI::Validator(
+      [lo, hi](const std::string& text) -> std::string {
+        uint64_t v = 0;
+        const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+        if (text.empty() || ec != std::errc() || ptr != text.data() + text.size() || v < lo || v > hi)
+          return "'" + text + "' is not allowed: give a whole number from " + std::to_string(lo) + " to " +
+                 std::to_string(hi);
+        return "";
+      },
+      "INT in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+}
+
+CLI::Validator positive() {
+  return CLI::Validator(
+      [](const std::string& text) -> std::string {
+        try {
+          size_t used = 0;
+          const double v = std::stod(text, &used);
+          if (used == text.size() && std::isfinite(v) && v > 0) return "";
+        } catch (const std::exception&) {
+        }
+        return "'" + text + "' is not allowed: give a number above 0";
+      },
+      "NUMBER > 0");
+}
+
+std::vector<double> parse_numbers(const std::string& text, const std::string& option) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    try {
+      size_t used = 0;
+      v.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw Error(option + ": '" + item + "' is not a number");
+    }
+    if (!std::isfinite(v.back())) throw Error(option + ": '" + item + "' is not finite");
+  }
+  return v;
+}
+
+Box3 parse_box(const std::string& text) {
+  const std::vector<double> v = parse_numbers(text, "--view-box");
+  if (v.size() != 6) throw Error("--view-box needs six numbers: xmin,ymin,zmin,xmax,ymax,zmax");
+  Box3 b{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
+  if (!(b.volume() > 0)) throw Error("--view-box must have min < max on every axis");
+  return b;
+}
+
+uint64_t parse_bytes(const std::string& text) {
+  size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  std::string unit = text.substr(used);
+  double scale = 1;
+  if (unit == "K" || unit == "k" || unit == "KB") scale = 1024.0;
+  else if (unit == "M" || unit == "MB") scale = 1024.0 * 1024;
+  else if (unit == "G" || unit == "GB") scale = 1024.0 * 1024 * 1024;
+  else if (!unit.empty() && unit != "B") used = 0;
+  if (used == 0 || !(v >= 0) || !std::isfinite(v * scale) || v * scale > 1e18)
+    throw Error("--memory needs a size in bytes, e.g. 65536, 64K, 2M or 1G (got '" + text + "')");
+  return static_cast<uint64_t>(v * scale);
+}
+
+std::vector<std::string> split_list(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+void check_files(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs) {
+  namespace fs = std::filesystem;
+  auto key = [](const std::string& p) {
+    std::error_code ec;
+    const fs::path k = fs::weakly_canonical(fs::absolute(p), ec);
+    return ec ? fs::absolute(p).lexically_normal().string() : k.string();
+  };
+  std::vector<std::pair<std::string, std::string>> seen;  // (canonical, as given)
+  for (const std::string& in : inputs)
+    if (!in.empty()) seen.push_back({key(in), in});
+  const size_t input_count = seen.size();
+  for (const std::string& out : outputs) {
+    if (out.empty()) continue;
+    check_output_target(out);
+    const std::string k = key(out);
+    for (size_t i = 0; i < seen.size(); ++i)
+      if (seen[i].first == k)
+        throw Error(out + ": is " + (i < input_count ? "an input of this command" : "given for two outputs") +
+                    " (" + seen[i].second + "); write it elsewhere");
+    seen.push_back({k, out});
+  }
+}
+
+pipeline::SceneSource SamplingOptions::source() const {
+  pipeline::SceneSource s;
+  s.path = scene;
+  s.grouping = parse_grouping(objects);
+  s.robust = !fast;
+  return s;
+}
+
+SamplerConfig SamplingOptions::sampler(const Common& c) const {
+  SamplerConfig config;
+  config.samples = samples;
+  config.target_segments = segments;
+  config.seed = seed;
+  config.empty_space = parse_empty_space_mode(empty_space);
+  config.max_recasts = max_recasts;
+  config.show_progress = !c.quiet;
+  if (!view_box.empty()) config.view_box = parse_box(view_box);
+  return config;
+}
+
+void add_sampling_options(CLI::App* cmd, SamplingOptions& a) {
+  cmd->add_option("scene", a.scene, "Scene file (.obj, .ply, .off, .stl, or a Quake 3 .bsp)")->required();
+  auto* samples_opt = cmd->add_option("--samples", a.samples, "Number of samples (two rays each)")
+                          ->capture_default_str()
+                          ->check(whole(1, kMaxSamples));
+  cmd->add_option("--segments", a.segments, "Sample until this many valid segments exist (instead of --samples)")
+      ->check(whole(1, kMaxSamples))
+      ->excludes(samples_opt);
+  cmd->add_option("--seed", a.seed, "Random seed (same seed, same result for any --threads)")->capture_default_str();
+  cmd->add_option("--objects", a.objects, "Object grouping: auto | groups | components | triangles")
+      ->capture_default_str();
+  cmd->add_option("--view-box", a.view_box, "View space box xmin,ymin,zmin,xmax,ymax,zmax (default: scene bounds)");
+  cmd->add_option("--empty-space", a.empty_space,
+                  "Empty view space detection: auto (only for closed, outward-oriented scenes) | on | off")
+      ->capture_default_str();
+  cmd->add_option("--max-recasts", a.max_recasts, "Re-casts per sample when empty space detection is on")
+      ->capture_default_str();
+  cmd->add_flag("--fast", a.fast, "Embree without robust mode (faster, may leak through edges)");
+}
+
+namespace {
+
+void parse_screen(const std::string& text, CostModel& model) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
+    throw Error("--screen needs WIDTHxHEIGHT, e.g. 1024x768 (got '" + text + "')");
+  model.screen_width = w;
+  model.screen_height = h;
+}
+
+HeightBandDensity parse_density_band(const std::string& text) {
+  HeightBandDensity d;
+  if (text.empty()) return d;
+  const std::vector<double> v = parse_numbers(text, "--density-band");
+  if (v.size() < 2 || v.size() > 3) throw Error("--density-band needs zlo,zhi[,outside_weight]");
+  d.enabled = true;
+  d.lo = v[0];
+  d.hi = v[1];
+  if (v.size() == 3) d.outside = v[2];
+  if (!(d.lo < d.hi) || !(d.outside >= 0)) throw Error("--density-band needs zlo < zhi and outside_weight >= 0");
+  return d;
+}
+
+}  // namespace
+
+CostModel CellOptions::model() const {
+  CostModel m;
+  m.a = cost_a;
+  m.b = cost_b;
+  m.c = cost_c;
+  parse_screen(screen, m);
+  m.fov_degrees = fov;
+  m.validate();
+  return m;
+}
+
+SubdivisionConfig CellOptions::subdivision(const Common& c, uint64_t seed) const {
+  SubdivisionConfig config;
+  config.max_cells = max_cells;
+  config.geometry_aligned = no_ga ? GeometryAlignedMode::kOff : (ga ? GeometryAlignedMode::kOn : GeometryAlignedMode::kAuto);
+  config.ga_candidates = ga_candidates;
+  config.max_axis_candidates = axis_candidates;
+  config.min_reduction = min_reduction;
+  config.density = parse_density_band(density_band);
+  config.seed = seed;
+  config.show_progress = !c.quiet;
+  return config;
+}
+
+void add_cell_options(CLI::App* cmd, CellOptions& a, const std::string& max_cells_help) {
+  if (!max_cells_help.empty())
+    cmd->add_option("--max-cells", a.max_cells, max_cells_help)->capture_default_str()->check(whole(1, kMaxCells));
+  auto* no_ga = cmd->add_flag("--no-ga", a.no_ga, "No geometry-aligned split candidates");
+  cmd->add_flag("--ga", a.ga, "Geometry-aligned candidates even for mostly axis-aligned scenes")->excludes(no_ga);
+  cmd->add_option("--ga-candidates", a.ga_candidates, "Geometry-aligned planes tried per cell at most")
+      ->capture_default_str();
+  cmd->add_option("--axis-candidates", a.axis_candidates, "Axis-aligned positions tried per axis and cell at most")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--min-reduction", a.min_reduction,
+                  "Stop when splits reduce the cost by less than this share of the initial cost for 50 splits running")
+      ->capture_default_str();
+  cmd->add_option("--cost-a", a.cost_a, "Render cost model: minimum cost of an object (r = max(a, b * triangles))")
+      ->capture_default_str();
+  cmd->add_option("--cost-b", a.cost_b, "Render cost model: cost per triangle")->capture_default_str();
+  cmd->add_option("--cost-c", a.cost_c,
+                  "Render cost model: cost per projected pixel, estimated per cell from its corners and centre "
+                  "(0: no pixel term, nothing estimated)")
+      ->capture_default_str();
+  cmd->add_option("--screen", a.screen, "Screen WIDTHxHEIGHT the pixel term assumes (with --cost-c)")
+      ->capture_default_str();
+  cmd->add_option("--fov", a.fov, "Horizontal field of view in degrees the pixel term assumes (with --cost-c)")
+      ->capture_default_str();
+  cmd->add_option("--density-band", a.density_band,
+                  "Viewpoint density zlo,zhi[,outside]: weight 1 between the heights, outside (default 0.1) elsewhere");
+}
+
+pipeline::CutRule CutOptions::rule() const {
+  pipeline::CutRule r;
+  r.count = count;
+  r.memory_given = !memory.empty();
+  if (r.memory_given) r.memory = parse_bytes(memory);
+  r.cost_ratio = cost_ratio;
+  return r;
+}
+
+void add_cut_options(CLI::App* app, CutOptions& a) {
+  app->add_option("--count", a.count, "Exactly this many view cells")->check(whole(1, kMaxCells));
+  app->add_option("--memory", a.memory,
+                  "The most view cells whose approximate PVS storage fits this budget (bytes; K, M, G allowed)");
+  app->add_option("--cost-ratio", a.cost_ratio,
+                  "The fewest view cells whose render cost is within this ratio (>= 1) of the elementary cells'");
+}
+
+void add_view_options(CLI::App* app, pipeline::ViewsConfig& v, const std::string& mesh_help,
+                      const std::string& png_help) {
+  app->add_option("--mesh", v.mesh, mesh_help);
+  app->add_option("--slice-png", v.slice_png, png_help);
+  app->add_option("--slice-z", v.slice_z, "Height of the slice (default: middle of the view space)");
+  app->add_option("--slice-width", v.slice_width, "Slice image width in pixels")
+      ->capture_default_str()
+      ->check(whole(16, 16384));
+}
+
+}  // namespace viewcells::cli

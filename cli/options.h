@@ -1,0 +1,112 @@
+#pragma once
+// What the subcommands share: global options, option parsers and validators, the scene and
+// sampling options, cut rules, and the check of input and output files before any work.
+#include <CLI/CLI.hpp>
+
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "viewcells/core/vec3.h"
+#include "viewcells/pipeline/cut.h"
+#include "viewcells/pipeline/sampling.h"
+
+namespace viewcells::cli {
+
+constexpr uint64_t kMaxSamples = uint64_t{1} << 40;  // a trillion rays: beyond any one machine's memory
+constexpr uint64_t kMaxCells = 10'000'000;
+
+/// Global options.
+struct Common {
+  int threads = 0;
+  bool quiet = false;
+  void log(const std::string& s) const;
+  /// The pipeline's log: lines on stderr unless --quiet.
+  pipeline::Log logger() const;
+};
+
+/// A subcommand and what runs it once its options are parsed.
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+using Commands = std::vector<Command>;
+
+/// v with `precision` decimals.
+std::string fmt(double v, int precision = 3);
+
+/// A whole number from lo to hi, written without sign or exponent (CLI11 alone reads "-1" into
+/// an unsigned option as 2^64 - 1).
+CLI::Validator whole(uint64_t lo, uint64_t hi);
+/// A finite number above zero.
+CLI::Validator positive();
+
+/// Comma-separated numbers of option `option`; throws Error naming the option.
+std::vector<double> parse_numbers(const std::string& text, const std::string& option);
+Box3 parse_box(const std::string& text);
+/// "123", "64K", "2M", "1G" (powers of 1024) -> bytes.
+uint64_t parse_bytes(const std::string& text);
+std::vector<std::string> split_list(const std::string& text);
+
+/// Before any work: refuses an output that is also an input or another output, or that exists
+/// as something other than a regular file. Empty names are options not given.
+void check_files(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
+
+/// Scene and sampling options shared by sample, build, compare and bake.
+struct SamplingOptions {
+  std::string scene;
+  std::string objects = "auto";
+  uint64_t samples = 1'000'000;
+  uint64_t segments = 0;
+  uint64_t seed = 1;
+  std::string view_box;
+  std::string empty_space = "auto";
+  bool fast = false;
+  int max_recasts = 8;
+
+  pipeline::SceneSource source() const;
+  SamplerConfig sampler(const Common& c) const;
+};
+void add_sampling_options(CLI::App* cmd, SamplingOptions& a);
+
+/// Render cost model and subdivision options shared by build and bake.
+struct CellOptions {
+  uint32_t max_cells = 1000;
+  bool no_ga = false, ga = false;
+  uint32_t ga_candidates = 150;
+  uint32_t axis_candidates = 200;
+  double min_reduction = 1e-6;
+  double cost_a = 100, cost_b = 1, cost_c = 0;
+  std::string screen = "1024x768";
+  double fov = 90;
+  std::string density_band;
+
+  CostModel model() const;
+  SubdivisionConfig subdivision(const Common& c, uint64_t seed) const;
+};
+/// `max_cells_help` empty: no --max-cells option.
+void add_cell_options(CLI::App* cmd, CellOptions& a, const std::string& max_cells_help);
+
+/// --count, --memory, --cost-ratio.
+struct CutOptions {
+  uint32_t count = 0;
+  std::string memory;
+  double cost_ratio = 0;
+  pipeline::CutRule rule() const;
+};
+void add_cut_options(CLI::App* app, CutOptions& a);
+
+/// --mesh, --slice-png, --slice-z, --slice-width.
+void add_view_options(CLI::App* app, pipeline::ViewsConfig& v, const std::string& mesh_help,
+                      const std::string& png_help);
+
+/// The subcommands, by file.
+void add_scene_commands(CLI::App& app, const Common& common, Commands& commands);    // generate, info, sample, isa
+void add_build_commands(CLI::App& app, const Common& common, Commands& commands);    // build, export
+void add_cut_commands(CLI::App& app, const Common& common, Commands& commands);      // extract, compress, query
+void add_pvs_commands(CLI::App& app, const Common& common, Commands& commands);      // pvs, bake
+void add_compare_command(CLI::App& app, const Common& common, Commands& commands);   // compare
+
+}  // namespace viewcells::cli

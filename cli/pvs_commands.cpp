@@ -1,0 +1,225 @@
+// pvs, bake: potentially visible sets by adaptive global visibility sampling.
+#include <filesystem>
+#include <memory>
+
+#include "options.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/parallel.h"
+#include "viewcells/pipeline/bake.h"
+#include "viewcells/pipeline/pvs.h"
+#include "viewcells/pipeline/report.h"
+
+namespace viewcells::cli {
+
+namespace {
+
+/// When AGVS stops, and how it samples.
+struct AgvsOptions {
+  double pixel_error = 0, seconds = 0;
+  uint64_t samples = 0, seed = 1;
+  uint32_t batch = 20000;
+  double min_share = 0.25;
+  std::string method = "agvs";
+
+  AgvsConfig config(const Common& c) const {
+    AgvsConfig a;
+    a.method = parse_agvs_method(method);
+    a.seed = seed;
+    a.batch_size = batch;
+    a.min_share = min_share;
+    a.max_samples = samples;
+    a.max_seconds = seconds;
+    a.pixel_error = pixel_error;
+    a.show_progress = !c.quiet;
+    return a;
+  }
+};
+
+void add_agvs_options(CLI::App* cmd, AgvsOptions& a, bool with_method, const std::string& samples_name) {
+  cmd->add_option("--pixel-error", a.pixel_error,
+                  "Stop when the estimated pixel error (pixels of a 1024x1024 image that differ) is at most this")
+      ->check(positive());
+  cmd->add_option("--time", a.seconds, "Stop after this many seconds")->check(positive());
+  cmd->add_option(samples_name, a.samples,
+                  "Stop after this many AGVS samples (checked between batches: a run may pass it by less than a batch)")
+      ->check(whole(1, kMaxSamples));
+  if (with_method)
+    cmd->add_option("--method", a.method, "agvs (adaptive mixture), sgvs (view space-direction only) or ref (per cell)")
+        ->capture_default_str();
+  cmd->add_option("--batch", a.batch, "Samples per batch")->capture_default_str()->check(whole(1, 100'000'000));
+  cmd->add_option("--min-share", a.min_share,
+                  "AGVS: share of every batch kept for view space-direction samples whatever their weight; they are "
+                  "the pixel error estimator's camera rays (more: a finer estimate, fewer samples for the mutations)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+}
+
+struct PvsArgs {
+  std::string input, scene, output, report, objects = "auto";
+  uint32_t cells = 0;
+  AgvsOptions agvs;
+  bool fast = false;
+  uint32_t measure_cameras = 0;
+  uint32_t measure_size = 1024;
+  std::string save, resume, edited_from;
+  std::vector<std::string> references;
+  bool filter = false;
+  double filter_k = 1.0;
+  uint32_t filter_neighbours = 0;
+};
+
+int run_pvs(const PvsArgs& a, const Common& c) {
+  {
+    // --save may be the --resume state (continue and keep it up to date); nothing else may meet.
+    std::error_code ec;
+    const bool save_is_resume = !a.save.empty() && !a.resume.empty() &&
+                                (a.save == a.resume || std::filesystem::equivalent(a.save, a.resume, ec));
+    std::vector<std::string> inputs = {a.input, a.scene, a.edited_from, save_is_resume ? "" : a.resume};
+    inputs.insert(inputs.end(), a.references.begin(), a.references.end());
+    check_files(inputs, {a.output, a.report, a.save});
+  }
+  ThreadLimit threads(c.threads);
+  pipeline::PvsConfig config;
+  config.hierarchy_path = a.input;
+  config.scene_path = a.scene;
+  config.grouping = parse_grouping(a.objects);
+  config.robust = !a.fast;
+  config.cells = a.cells;
+  config.agvs = a.agvs.config(c);
+  config.filter.k = a.filter_k;
+  config.filter.view_neighbours = a.filter_neighbours;
+  config.filter_object_space = a.filter;
+  config.measure_cameras = a.measure_cameras;
+  config.measure_size = a.measure_size;
+  config.save = a.save;
+  config.resume = a.resume;
+  config.edited_from = a.edited_from;
+  config.references = a.references;
+  config.output = a.output;
+  const pipeline::PvsResult result = pipeline::compute_pvs(config, c.logger());
+  if (!a.report.empty()) {
+    pipeline::write_report(a.report, result);
+    c.log("viewcells: report -> " + a.report);
+  }
+  return 0;
+}
+
+void add_pvs_command(CLI::App& app, const Common& common, Commands& commands) {
+  auto a = std::make_shared<PvsArgs>();
+  auto* pv = app.add_subcommand("pvs",
+                                "Compute the view cells' PVSs by adaptive global visibility sampling (AGVS) and write "
+                                "them, compressed, as a .pvs file");
+  pv->add_option("cells", a->input, "Hierarchy file (.vcells, built with merging)")->required();
+  pv->add_option("--scene", a->scene, "The scene the hierarchy was built from")->required();
+  pv->add_option("--objects", a->objects, "Object grouping used when building")->capture_default_str();
+  pv->add_option("--cells", a->cells, "View cells cut from the merge history (default: every elementary cell)")
+      ->check(whole(1, kMaxCells));
+  add_agvs_options(pv, a->agvs, true, "--samples");
+  pv->add_option("--seed", a->agvs.seed, "Random seed")->capture_default_str();
+  pv->add_flag("--fast", a->fast, "Embree without robust mode");
+  pv->add_option("--measure-cameras", a->measure_cameras,
+                 "Also measure the pixel error: render this many random cameras by ray casting and count the "
+                 "pixels whose object is missing from the PVS")
+      ->check(whole(1, 1'000'000));
+  pv->add_option("--save", a->save, "Write the solver's state here at the end, to continue later with --resume");
+  pv->add_option("--resume", a->resume,
+                 "Continue from a state written by --save (same scene, cells, method, seed and batch); --samples "
+                 "and --time count from the start of the computation, the saved part included");
+  pv->add_flag("--filter", a->filter,
+               "Write PVSs extended by the object space visibility filter: objects near the PVS's objects, within "
+               "a distance that shrinks as the sampling gets denser (sampling itself goes on unfiltered)");
+  pv->add_option("--filter-k", a->filter_k, "The filter's factor k: larger is more conservative")
+      ->capture_default_str();
+  pv->add_option("--filter-neighbours", a->filter_neighbours,
+                 "View space filter: merge each cell's PVS with those of this many neighbouring cells with the most "
+                 "similar PVSs");
+  pv->add_option("--edited-from", a->edited_from,
+                 "Dynamic edit: --scene is an edited version of this scene (the one the hierarchy and the --resume "
+                 "state were computed on). Objects are matched by name and geometry; deleted ones leave the PVSs, "
+                 "and what inserted ones may hide is removed before sampling resumes");
+  pv->add_option("--reference", a->references,
+                 "A .pvs of the same cells (another method's result; up to 2): the report's curve counts the "
+                 "entries found so far that it has too")
+      ->expected(1, AgvsPoint::kReferences)
+      ->check(CLI::ExistingFile);
+  pv->add_option("--measure-size", a->measure_size, "Width and height of the measuring cameras, in pixels")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  pv->add_option("-o,--output", a->output, "The .pvs file to write")->required();
+  pv->add_option("--report", a->report, "JSON report: samples, rays, mean PVS size, estimated pixel error, curve");
+  commands.push_back({pv, [a, &common] { return run_pvs(*a, common); }});
+}
+
+struct BakeArgs {
+  SamplingOptions sampling;
+  CellOptions cells;
+  uint32_t view_cells = 0;
+  std::string memory;
+  AgvsOptions agvs;
+  uint64_t agvs_seed = 1;
+  std::string output, report, work;
+};
+
+int run_bake(BakeArgs a, const Common& c) {
+  check_files({a.sampling.scene}, {a.output, a.report});
+  ThreadLimit threads(c.threads);
+  pipeline::BakeConfig config;
+  config.model = a.cells.model();
+  config.subdivision = a.cells.subdivision(c, a.sampling.seed);
+  config.scene = a.sampling.source();
+  config.sampling = a.sampling.sampler(c);
+  config.cells = a.view_cells;
+  config.memory = a.memory.empty() ? 0 : parse_bytes(a.memory);
+  if (!a.agvs.samples && !(a.agvs.seconds > 0) && !(a.agvs.pixel_error > 0)) a.agvs.pixel_error = 10;
+  config.agvs = a.agvs.config(c);
+  config.agvs.seed = a.sampling.seed;
+  config.output = a.output;
+  config.work_dir = a.work;
+  const pipeline::BakeResult result = pipeline::bake(config, c.logger());
+  if (!a.report.empty()) {
+    pipeline::write_report(a.report, result);
+    c.log("viewcells: report -> " + a.report);
+  }
+  return 0;
+}
+
+void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
+  auto a = std::make_shared<BakeArgs>();
+  a->cells.max_cells = 0;
+  a->sampling.samples = 1'000'000;
+  auto* bk = app.add_subcommand(
+      "bake",
+      "The whole chain in one command: sample, subdivide and merge, cut view cells under the budget, compute "
+      "their PVSs by AGVS to the pixel error asked for, compress and write a .pvs file for the engine");
+  add_sampling_options(bk, a->sampling);
+  auto* cells = bk->add_option("--cells", a->view_cells, "Budget: this many view cells")->check(whole(1, kMaxCells));
+  bk->add_option("--memory", a->memory,
+                 "Budget: a .pvs file of at most this many bytes (K, M, G allowed); the file written is measured, "
+                 "and the cells are merged further until it fits")
+      ->excludes(cells);
+  bk->add_option("--max-cells", a->cells.max_cells,
+                 "Elementary cells to build before merging (default: 4 x --cells, or 4096 with --memory)")
+      ->check(whole(1, kMaxCells));
+  add_cell_options(bk, a->cells, "");
+  add_agvs_options(bk, a->agvs, false, "--agvs-samples");
+  bk->add_option("--work", a->work,
+                 "Work directory: keeps the hierarchy and the AGVS state, so that a rerun with the same scene and "
+                 "settings skips the hierarchy and continues sampling (e.g. with a smaller --pixel-error)");
+  bk->add_option("-o,--output", a->output, "The .pvs file to write")->required();
+  bk->add_option("--report", a->report, "JSON report: budget, cells, file bytes, pixel error, samples, timings");
+  bk->footer("Without --pixel-error, --time or --agvs-samples, AGVS runs to an estimated pixel error of 10 (of 1024x1024).");
+  commands.push_back({bk, [a, &common] {
+                        if (a->view_cells == 0 && a->memory.empty())
+                          throw Error("bake needs a budget: --cells N or --memory BYTES");
+                        return run_bake(*a, common);
+                      }});
+}
+
+}  // namespace
+
+void add_pvs_commands(CLI::App& app, const Common& common, Commands& commands) {
+  add_pvs_command(app, common, commands);
+  add_bake_command(app, common, commands);
+}
+
+}  // namespace viewcells::cli

@@ -1,0 +1,164 @@
+// generate, info, sample, isa: scenes and the rays through them.
+#include <iostream>
+
+#include "options.h"
+#include "viewcells/core/isa.h"
+#include "viewcells/core/parallel.h"
+#include "viewcells/core/progress.h"
+#include "viewcells/io/scene_io.h"
+#include "viewcells/pipeline/report.h"
+#include "viewcells/scene/generators.h"
+
+namespace viewcells::cli {
+
+namespace {
+
+struct GenerateArgs {
+  std::string kind;
+  uint64_t seed = 1;
+  int size = 1;
+  std::string output;
+};
+
+int run_generate(const GenerateArgs& a, const Common& c) {
+  check_files({}, {a.output});
+  GeneratorConfig config;
+  config.kind = parse_generator_kind(a.kind);
+  config.seed = a.seed;
+  config.size = a.size;
+  Stopwatch sw;
+  const Scene scene = generate_scene(config);
+  write_obj(scene, a.output);
+  c.log("viewcells: generated " + std::string(to_string(config.kind)) + " (size " + std::to_string(a.size) +
+        ", seed " + std::to_string(a.seed) + "): " + std::to_string(scene.object_count()) + " objects, " +
+        std::to_string(scene.triangle_count()) + " triangles -> " + a.output + " in " + fmt(sw.seconds(), 2) + " s");
+  return 0;
+}
+
+struct InfoArgs {
+  std::string scene;
+  std::string objects = "auto";
+  bool list = false;
+  std::string json_path;
+};
+
+std::string describe_box(const Box3& b) {
+  return "[" + fmt(b.lo.x, 3) + ", " + fmt(b.lo.y, 3) + ", " + fmt(b.lo.z, 3) + "] - [" + fmt(b.hi.x, 3) + ", " +
+         fmt(b.hi.y, 3) + ", " + fmt(b.hi.z, 3) + "]";
+}
+
+void print_map(const pipeline::MapInfo& m) {
+  const Q3Map& map = m.map;
+  const Q3MeshStats& st = m.mesh;
+  std::cout << "quake 3 map:        IBSP version " << map.version << ", " << map.shaders.size() << " shaders, "
+            << map.nodes.size() << " nodes, " << map.leaves.size() << " leaves (" << m.solid_leaves << " solid)\n"
+            << "world surfaces:     " << st.surfaces[0] << " opaque, " << st.surfaces[1]
+            << " sky (they close the map for rays but are not rendered: no render cost), " << st.surfaces[2]
+            << " water/fog/translucent (rendered, seen through: they stop no ray), " << st.surfaces[3]
+            << " nodraw/hint/skip/flare (left out); " << st.patches << " patches tessellated at level 4\n"
+            << "solid brushes:      " << st.brush_hulls << " of " << map.world_brush_count
+            << " as hulls 0.5 units inside their sides (occlude, not rendered)\n"
+            << "visibility:         "
+            << (map.has_visibility() ? std::to_string(map.cluster_count) + " clusters, rows of " +
+                                           std::to_string(map.cluster_bytes) + " bytes (q3map2's PVS)"
+                                     : std::string("none (the map was not vis-compiled)"))
+            << "\nspawn points:       " << st.spawn_points << '\n';
+}
+
+int run_info(const InfoArgs& a, const Common& c) {
+  check_files({a.scene}, {a.json_path});
+  const pipeline::SceneInfo info = pipeline::scene_info(a.scene, parse_grouping(a.objects));
+  const Scene& scene = info.scene;
+  std::cout << "scene:              " << a.scene << '\n'
+            << "triangles:          " << scene.triangle_count() << " (" << scene.degenerate_dropped
+            << " degenerate dropped)\n"
+            << "objects:            " << scene.object_count() << " (grouping: " << to_string(scene.grouping) << ")\n"
+            << "bounds:             " << describe_box(scene.bounds) << '\n'
+            << "closed objects:     " << info.closed_objects << '\n'
+            << "solid objects:      " << info.solid_objects << " (closed, consistently oriented, outward)\n"
+            << "empty space detect: " << info.empty_space.reason << '\n'
+            << "non-axis-aligned:   " << fmt(100.0 * scene.non_axis_aligned_share(), 2) << "% of "
+            << fmt(scene.surface_area, 1) << " surface area\n";
+  if (info.map) print_map(*info.map);
+  if (a.list) {
+    std::cout << "\n#id\ttriangles\tclosed\toriented\tsolid\tname\n";
+    for (size_t i = 0; i < scene.objects.size(); ++i) {
+      const ObjectInfo& o = scene.objects[i];
+      std::cout << i << '\t' << o.triangle_count << '\t' << o.closed << '\t' << o.oriented << '\t' << o.solid()
+                << '\t' << o.name << '\n';
+    }
+  }
+  if (!a.json_path.empty()) {
+    pipeline::write_report(a.json_path, info);
+    c.log("viewcells: wrote " + a.json_path);
+  }
+  return 0;
+}
+
+struct SampleArgs {
+  SamplingOptions sampling;
+  std::string output, report;
+  bool measure_raw = false;
+};
+
+int run_sample(const SampleArgs& a, const Common& c) {
+  check_files({a.sampling.scene}, {a.output, a.report});
+  ThreadLimit threads(c.threads);
+  pipeline::SampleConfig config;
+  config.scene = a.sampling.source();
+  config.sampling = a.sampling.sampler(c);
+  config.segments_path = a.output;
+  config.measure_raw = a.measure_raw;
+  const pipeline::SampleResult result = pipeline::sample(config, c.logger());
+  if (!a.report.empty()) {
+    pipeline::write_report(a.report, result);
+    c.log("viewcells: report -> " + a.report);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_scene_commands(CLI::App& app, const Common& common, Commands& commands) {
+  auto gen = std::make_shared<GenerateArgs>();
+  auto* g = app.add_subcommand("generate", "Write a generated test scene as OBJ (one group per object)");
+  g->add_option("kind", gen->kind, "office | city | rotated-office")->required();
+  g->add_option("--seed", gen->seed, "Random seed (same seed, same scene)")->capture_default_str();
+  g->add_option("--size", gen->size,
+                "Scale >= 1: office rooms and floors, city blocks per side (city 20 ~ 1M triangles)")
+      ->capture_default_str();
+  g->add_option("-o,--output", gen->output, "Output .obj file")->required();
+  commands.push_back({g, [gen, &common] { return run_generate(*gen, common); }});
+
+  auto info = std::make_shared<InfoArgs>();
+  auto* i = app.add_subcommand("info", "Describe a scene: objects, triangles, bounds, closedness, axis alignment");
+  i->add_option("scene", info->scene, "Scene file (.obj, .ply, .off, .stl, or a Quake 3 .bsp)")->required();
+  i->add_option("--objects", info->objects, "Object grouping: auto | groups | components | triangles")
+      ->capture_default_str();
+  i->add_flag("--list", info->list, "List every object");
+  i->add_option("--json", info->json_path, "Also write the description as JSON");
+  commands.push_back({i, [info, &common] { return run_info(*info, common); }});
+
+  auto smp = std::make_shared<SampleArgs>();
+  auto* s = app.add_subcommand("sample", "Cast visibility segments through the view space (paper section 4.1)");
+  add_sampling_options(s, smp->sampling);
+  s->add_option("-o,--output", smp->output, "Segment file to write (.vseg)");
+  s->add_option("--report", smp->report, "JSON report: settings, effects enabled and why, counts, timings");
+  s->add_flag("--measure-raw", smp->measure_raw,
+              "Also cast the same rays (re-casts included) through Embree alone; report raw_rays_per_second");
+  commands.push_back({s, [smp, &common] { return run_sample(*smp, common); }});
+
+  auto supported = std::make_shared<bool>(false);
+  auto* is = app.add_subcommand("isa", "Print the Embree ISA that ray casting would use (see --embree-isa)");
+  is->add_flag("--supported", *supported, "Print every ISA this CPU runs instead, one per line, best last");
+  commands.push_back({is, [supported] {
+                        if (*supported) {
+                          for (const std::string& name : supported_embree_isas()) std::cout << name << '\n';
+                        } else {
+                          std::cout << embree_isa() << '\n';
+                        }
+                        return 0;
+                      }});
+}
+
+}  // namespace viewcells::cli

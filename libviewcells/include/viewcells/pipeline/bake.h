@@ -1,0 +1,53 @@
+#pragma once
+/// `viewcells bake`: the whole chain for a shippable result in one call. Sample visibility,
+/// subdivide the view space and merge the cells into a history, cut the view cells under the
+/// budget, compute their PVSs by AGVS to the pixel error asked for, compress them through
+/// the hierarchy and write the .pvs. With a memory budget, the cut is made coarser until the
+/// file actually written fits (the AGVS PVSs of merged cells are the unions of their parts).
+/// With a work directory, a rerun with the same settings reuses the hierarchy and continues
+/// the AGVS state instead of starting over.
+#include <cstdint>
+#include <string>
+
+#include "viewcells/agvs/agvs.h"
+#include "viewcells/pipeline/build.h"
+
+namespace viewcells::pipeline {
+
+struct BakeConfig {
+  SceneSource scene;
+  SamplerConfig sampling;          ///< construction samples
+  CostModel model;
+  SubdivisionConfig subdivision;   ///< max_cells 0: derived from the budget
+  uint32_t cells = 0;              ///< budget: this many view cells ...
+  uint64_t memory = 0;             ///< ... or a .pvs file of at most this many bytes
+  AgvsConfig agvs;                 ///< stopping rule (pixel error, time, samples), seed, batch
+  std::string output;              ///< .pvs
+  std::string work_dir;            ///< empty: nothing kept between runs
+};
+
+struct BakeResult {
+  BakeConfig config;
+  uint64_t scene_fingerprint = 0;
+  uint32_t object_count = 0;
+  // The hierarchy.
+  bool hierarchy_reused = false;
+  uint32_t elementary_cells = 0;
+  double hierarchy_seconds = 0;
+  SamplingStats sampling;  ///< of the construction samples (zeros when reused)
+  // The cut and the PVSs.
+  uint32_t cells = 0;          ///< view cells in the file written
+  uint32_t agvs_cells = 0;     ///< view cells AGVS sampled (more when the budget then coarsened them)
+  std::string rule;
+  AgvsStats agvs;
+  double pixel_error = 0, pixel_error_bound = 0;  ///< NaN: not known
+  bool agvs_resumed = false;
+  uint64_t pvs_entries = 0, file_bytes = 0;
+  double mean_pvs = 0;
+  double seconds = 0;
+  int threads = 1;
+};
+
+BakeResult bake(const BakeConfig& config, const Log& log);
+
+}  // namespace viewcells::pipeline

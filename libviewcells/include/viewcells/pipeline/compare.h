@@ -1,0 +1,46 @@
+#pragma once
+/// `viewcells compare`: view cells by several methods from the same construction samples,
+/// scored on independent evaluation samples (paper, section 6); on a Quake 3 map also
+/// against the clusters q3map2 compiled into it. Writes curves.csv, histogram.csv,
+/// excluded.csv (maps) and summary.json into a directory.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "viewcells/eval/compare.h"
+#include "viewcells/pipeline/sampling.h"
+#include "viewcells/q3/compare.h"
+
+namespace viewcells::pipeline {
+
+struct CompareRunConfig {
+  SceneSource scene;
+  /// Methods as in eval/compare.h, plus "q3-clusters" (a map's own clusters). Empty: all of
+  /// eval's methods, or on a map av-m, av-s, kd-casm and q3-clusters.
+  std::vector<std::string> methods;
+  uint32_t max_cells = 0;  ///< 0: 1000, or on a map three times its clusters
+  SamplerConfig construction;
+  uint64_t evaluation_samples = 0;  ///< 0: four times the construction samples
+  uint64_t evaluation_seed = 0;     ///< 0: the construction seed + 1000003
+  uint32_t histogram_cells = 0;
+  CostModel model;
+  SubdivisionConfig subdivision;
+  bool geometry_aligned_off = false;
+  std::string output_dir;
+};
+
+struct CompareRunResult {
+  CompareRunConfig config;
+  CompareConfig compared;  ///< as run (methods, counts, samplers)
+  LoadedScene loaded;
+  Comparison plain;
+  std::optional<Q3Comparison> q3;
+  int threads = 1;
+  const Comparison& comparison() const { return q3 ? q3->ours : plain; }
+};
+
+/// Runs the comparison and writes the directory's files (report.h writes summary.json).
+CompareRunResult compare(const CompareRunConfig& config, const Log& log);
+
+}  // namespace viewcells::pipeline

@@ -1,0 +1,69 @@
+#pragma once
+/// Cutting view cells from a merge history: `viewcells extract` (the cells, as JSON and
+/// pictures) and `viewcells compress` (their PVSs, compressed through the hierarchy, as .pvs).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/merge/merge.h"
+#include "viewcells/pipeline/build.h"
+#include "viewcells/pvs/pvs.h"
+
+namespace viewcells::pipeline {
+
+/// Which view cells: at most one rule; none means every elementary cell where allowed.
+struct CutRule {
+  uint32_t count = 0;        ///< exactly this many
+  bool memory_given = false;
+  uint64_t memory = 0;       ///< the most cells whose approximate PVS storage fits
+  double cost_ratio = 0;     ///< the fewest cells within this ratio of the elementary cells' cost
+};
+
+/// The view cells `rule` asks for; `fallback_all` takes every elementary cell when no rule is
+/// given, else a rule is required (Error).
+ViewCellSet choose_cells(const MergeHistory& h, const CutRule& rule, bool fallback_all);
+
+/// Reads a hierarchy file that holds a merge history (Error naming the file otherwise).
+SubdivisionFile read_merged(const std::string& path);
+
+/// The .pvs file of the view cells `set` of a built hierarchy, PVSs from its samples.
+PvsFile pvs_file_for(const SubdivisionFile& file, const ViewCellSet& set);
+
+/// Writes the .pvs file, then reads it back: every cell's PVS must come back as `lists`.
+void write_pvs_checked(const std::string& path, const PvsFile& pf, const std::vector<std::vector<uint32_t>>& lists);
+
+struct ExtractConfig {
+  std::string hierarchy_path;
+  CutRule cut;
+  std::string scene_path;  ///< drawn into the slice when given
+  ViewsConfig views;
+};
+
+struct ExtractResult {
+  std::string input;
+  SubdivisionFile file;
+  ViewCellSet set;
+};
+
+ExtractResult extract(const ExtractConfig& config, const Log& log);
+
+struct CompressConfig {
+  std::string hierarchy_path;
+  CutRule cut;
+  std::string output;  ///< .pvs
+  std::string flat;    ///< Quake-style run-length rows (.vflt); empty: none
+};
+
+struct CompressResult {
+  std::string input, output, flat, rule;
+  uint32_t cells = 0, objects = 0;
+  uint64_t hierarchy_nodes = 0, entries_before = 0, entries_after = 0;
+  uint64_t varint_bytes_before = 0, varint_bytes_after = 0, file_bytes = 0;
+  uint64_t flat_bit_row_bytes = 0, flat_run_length_bytes = 0, flat_file_bytes = 0;
+  double seconds = 0;
+};
+
+CompressResult compress(const CompressConfig& config, const Log& log);
+
+}  // namespace viewcells::pipeline

@@ -1,0 +1,52 @@
+#pragma once
+/// `viewcells pvs`: the view cells' PVSs by adaptive global visibility sampling (AGVS, or its
+/// SGVS and REF variants), optionally continued from a saved state, across a dynamic edit of
+/// the scene, filtered, measured by cameras; written compressed as .pvs.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "viewcells/agvs/agvs.h"
+#include "viewcells/pipeline/cut.h"
+
+namespace viewcells::pipeline {
+
+struct PvsConfig {
+  std::string hierarchy_path;
+  std::string scene_path;
+  ObjectGrouping grouping = ObjectGrouping::kAuto;
+  bool robust = true;
+  uint32_t cells = 0;  ///< view cells cut from the history; 0: every elementary cell
+  AgvsConfig agvs;     ///< method, seed, batch, stopping rule; filter_statistics is derived
+  VisibilityFilter filter;
+  bool filter_object_space = false;
+  uint32_t measure_cameras = 0;
+  uint32_t measure_size = 1024;
+  std::string save, resume, edited_from;
+  std::vector<std::string> references;
+  std::string output;
+};
+
+/// The identity a saved AGVS state carries: the scene's fingerprint and the view cells.
+uint64_t pvs_state_identity(uint64_t scene_fingerprint, const PvsFile& cells);
+
+struct PvsResult {
+  PvsConfig config;
+  std::string rule;
+  uint32_t cells = 0;
+  AgvsStats stats;
+  AgvsConfig agvs;  ///< as run (resolution, window, filter statistics)
+  bool filtering = false;
+  double mean_pvs = 0, mean_written = 0;
+  uint64_t pvs_entries = 0;
+  double pixel_error = 0, pixel_error_bound = 0;  ///< NaN: not known
+  double setup_seconds = 0;
+  int threads = 1;
+  std::optional<PixelErrorMeasure> measured, measured_unfiltered;
+  std::optional<AgvsEditStats> edit;
+};
+
+PvsResult compute_pvs(const PvsConfig& config, const Log& log);
+
+}  // namespace viewcells::pipeline

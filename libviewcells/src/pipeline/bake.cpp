@@ -1,0 +1,200 @@
+#include "viewcells/pipeline/bake.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "text.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/parallel.h"
+#include "viewcells/core/progress.h"
+#include "viewcells/io/binary_file.h"
+#include "viewcells/pipeline/cut.h"
+#include "viewcells/pipeline/pvs.h"
+
+namespace viewcells::pipeline {
+
+namespace {
+
+/// Everything the hierarchy depends on, as text: a work directory's hierarchy is reused only
+/// when this is unchanged (and the scene's fingerprint matches).
+std::string hierarchy_key(const BakeConfig& c, uint32_t max_cells) {
+  const SamplerConfig& s = c.sampling;
+  const SubdivisionConfig& d = c.subdivision;
+  std::ostringstream k;
+  k.precision(17);
+  k << "viewcells bake hierarchy v1\nscene " << c.scene.path << " grouping " << to_string(c.scene.grouping)
+    << " robust " << c.scene.robust << "\nsamples " << s.samples << " segments " << s.target_segments << " seed "
+    << s.seed << " recasts " << s.max_recasts << " empty " << static_cast<int>(s.empty_space) << "\nview box "
+    << s.view_box.lo.x << ' ' << s.view_box.lo.y << ' ' << s.view_box.lo.z << ' ' << s.view_box.hi.x << ' '
+    << s.view_box.hi.y << ' ' << s.view_box.hi.z << "\ncost " << c.model.a << ' ' << c.model.b << ' ' << c.model.c
+    << ' ' << c.model.screen_width << ' ' << c.model.screen_height << ' ' << c.model.fov_degrees << "\ncells "
+    << max_cells << " ga " << static_cast<int>(d.geometry_aligned) << ' ' << d.ga_candidates << ' '
+    << d.max_axis_candidates << " min reduction " << d.min_reduction << " density " << d.density.enabled << ' '
+    << d.density.lo << ' ' << d.density.hi << ' ' << d.density.outside << '\n';
+  return k.str();
+}
+
+std::string read_text(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+/// The hierarchy: from the work directory when it holds one built with these settings for
+/// this scene, else built (and kept there).
+SubdivisionFile hierarchy(const BakeConfig& c, const LoadedScene& loaded, uint32_t max_cells, BakeResult& out,
+                          const Log& log) {
+  const std::string key = hierarchy_key(c, max_cells);
+  const std::string dir = c.work_dir, vcells = dir + "/hierarchy.vcells", key_path = dir + "/hierarchy.key";
+  if (!dir.empty() && std::filesystem::is_regular_file(key_path) && read_text(key_path) == key) {
+    SubdivisionFile file = read_merged(vcells);
+    if (file.scene_fingerprint == loaded.scene->fingerprint()) {
+      out.hierarchy_reused = true;
+      log("viewcells: bake: hierarchy of " + std::to_string(file.history->leaf_count) + " cells reused from " + vcells);
+      return file;
+    }
+    log("viewcells: bake: " + vcells + " belongs to another version of the scene: building again");
+  }
+  BuildConfig b;
+  b.scene = c.scene;
+  b.sampling = c.sampling;
+  b.model = c.model;
+  b.subdivision = c.subdivision;
+  b.subdivision.max_cells = max_cells;
+  BuildResult built = build(b, log);
+  out.sampling = built.sampling.result.stats;
+  if (!dir.empty()) {
+    const UnbatchedWrites now;  // a checkpoint: kept even when a later stage fails
+    std::filesystem::create_directories(dir);
+    write_subdivision(vcells, built.file);
+    write_text_file(key_path, key);
+    log("viewcells: bake: hierarchy -> " + vcells);
+  }
+  return std::move(built.file);
+}
+
+/// The AGVS PVSs of the view cells `set`, continued from the work directory's state when it
+/// belongs to them, and saved there.
+std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, const LoadedScene& loaded, const PvsFile& pf,
+                                              BakeResult& out, const Log& log) {
+  const CellLocator cells(pf.bsp, pf.leaf_cell, pf.pvs.cell_count);
+  AgvsSolver solver(*loaded.scene, *loaded.caster, cells, c.agvs);
+  const uint64_t identity = pvs_state_identity(loaded.scene->fingerprint(), pf);
+  const std::string state = c.work_dir.empty() ? std::string() : c.work_dir + "/pvs.vagvs";
+  if (!state.empty() && std::filesystem::is_regular_file(state)) {
+    try {
+      solver.load(state, identity);
+      out.agvs_resumed = true;
+      log("viewcells: bake: AGVS continues from " + state + " after " + std::to_string(solver.stats().samples) +
+          " samples");
+    } catch (const Error& e) {
+      log(std::string("viewcells: bake: not continuing from the saved state: ") + e.what());
+    }
+  }
+  log("viewcells: bake: PVSs of " + std::to_string(cells.cell_count()) + " view cells by AGVS");
+  solver.run();
+  if (!state.empty()) {
+    const UnbatchedWrites now;
+    solver.save(state, identity);
+  }
+  out.agvs = solver.stats();
+  out.pixel_error = solver.pixel_error();
+  out.pixel_error_bound = solver.pixel_error_bound();
+  std::vector<std::vector<uint32_t>> lists(cells.cell_count());
+  for (uint32_t i = 0; i < cells.cell_count(); ++i) lists[i] = solver.pvs().list(i);
+  return lists;
+}
+
+/// The view cells of `coarse` (a cut above `fine`) with the unions of their fine cells' PVSs.
+std::vector<std::vector<uint32_t>> coarsen(const MergeHistory& h, const std::vector<int32_t>& fine,
+                                           const std::vector<std::vector<uint32_t>>& fine_lists,
+                                           const std::vector<int32_t>& coarse) {
+  std::vector<int32_t> slot(h.nodes.size(), -1);
+  for (size_t i = 0; i < coarse.size(); ++i) slot[coarse[i]] = static_cast<int32_t>(i);
+  std::vector<std::vector<uint32_t>> lists(coarse.size());
+  for (size_t i = 0; i < fine.size(); ++i) {
+    int32_t n = fine[i];
+    while (n >= 0 && slot[n] < 0) n = h.nodes[n].parent;
+    VC_CHECK(n >= 0);
+    auto& l = lists[slot[n]];
+    l.insert(l.end(), fine_lists[i].begin(), fine_lists[i].end());
+  }
+  for (auto& l : lists) {
+    std::sort(l.begin(), l.end());
+    l.erase(std::unique(l.begin(), l.end()), l.end());
+  }
+  return lists;
+}
+
+/// Writes the .pvs of `set` with `lists`; returns its size in bytes.
+uint64_t write_cut(const std::string& path, const SubdivisionFile& file, const ViewCellSet& set,
+                   const std::vector<std::vector<uint32_t>>& lists) {
+  PvsFile pf = pvs_file_for(file, set);
+  pf.rule += "; PVS by agvs";
+  pf.pvs = compress_pvs(*file.history, set.cells, lists);
+  write_pvs_checked(path, pf, lists);
+  return std::filesystem::file_size(staged_path(path));
+}
+
+}  // namespace
+
+BakeResult bake(const BakeConfig& c, const Log& log) {
+  if ((c.cells > 0) == (c.memory > 0)) throw Error("bake needs one budget: --cells N or --memory BYTES");
+  if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0))
+    throw Error("give when the PVSs are good enough: --pixel-error, --time or --samples");
+  Stopwatch total;
+  BakeResult out;
+  out.config = c;
+  out.threads = worker_threads();
+  const uint32_t max_cells = c.subdivision.max_cells ? c.subdivision.max_cells : (c.cells ? 4 * c.cells : 4096);
+  LoadedScene loaded = load_scene_for_rays(c.scene, log);
+  SubdivisionFile file = hierarchy(c, loaded, max_cells, out, log);
+  const MergeHistory& h = *file.history;
+  out.hierarchy_seconds = total.seconds();
+  out.elementary_cells = static_cast<uint32_t>(h.leaf_count);
+  out.scene_fingerprint = file.scene_fingerprint;
+  out.object_count = file.object_count;
+  const ViewCellSet set = c.cells ? extract_by_count(h, std::min<size_t>(c.cells, h.leaf_count))
+                                  : extract_by_memory(h, c.memory);
+  const std::vector<std::vector<uint32_t>> lists = sample_pvs(c, loaded, pvs_file_for(file, set), out, log);
+  out.agvs_cells = static_cast<uint32_t>(set.cells.size());
+  ViewCellSet written = set;
+  std::vector<std::vector<uint32_t>> written_lists = lists;
+  out.file_bytes = write_cut(c.output, file, set, lists);
+  if (c.memory && out.file_bytes > c.memory) {
+    // The estimate came from the construction samples; the file holds AGVS's PVSs. The largest
+    // coarser cut whose file fits (file size grows with the cells; each size is measured).
+    log("viewcells: bake: " + std::to_string(out.file_bytes) + " bytes for " + std::to_string(set.cells.size()) +
+        " cells exceed the budget of " + std::to_string(c.memory) + ": coarsening");
+    size_t lo = h.min_cells(), hi = set.cells.size() - 1, best = 0;
+    while (lo <= hi) {
+      const size_t mid = lo + (hi - lo) / 2;
+      const ViewCellSet cut = extract_by_count(h, mid);
+      const uint64_t bytes = write_cut(c.output, file, cut, coarsen(h, set.cells, lists, cut.cells));
+      if (bytes <= c.memory) best = mid, lo = mid + 1;
+      else if (mid == 0) break;
+      else hi = mid - 1;
+    }
+    if (best == 0)
+      throw Error(c.output, 0, "not even " + std::to_string(h.min_cells()) + " view cell(s) fit in " +
+                                   std::to_string(c.memory) + " bytes");
+    written = extract_by_count(h, best);
+    written_lists = coarsen(h, set.cells, lists, written.cells);
+    out.file_bytes = write_cut(c.output, file, written, written_lists);
+  }
+  out.cells = static_cast<uint32_t>(written.cells.size());
+  out.rule = written.rule + "; PVS by agvs";
+  for (const auto& l : written_lists) out.pvs_entries += l.size();
+  out.mean_pvs = static_cast<double>(out.pvs_entries) / out.cells;
+  out.seconds = total.seconds();
+  log("viewcells: bake: " + std::to_string(out.cells) + " view cells, mean PVS " + fmt(out.mean_pvs, 1) +
+      " objects, estimated pixel error " +
+      (std::isnan(out.pixel_error) ? std::string("not known") : fmt(out.pixel_error, 2)) + "; " + c.output + ": " +
+      std::to_string(out.file_bytes) + " bytes in " + fmt(out.seconds, 1) + " s");
+  return out;
+}
+
+}  // namespace viewcells::pipeline

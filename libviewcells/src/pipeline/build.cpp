@@ -1,0 +1,93 @@
+#include "viewcells/pipeline/build.h"
+
+#include "text.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/progress.h"
+#include "viewcells/merge/merge.h"
+#include "viewcells/q3/view_space.h"
+
+namespace viewcells::pipeline {
+
+void write_views(const Subdivision& s, const Scene* scene, const ViewsConfig& views, const Log& log,
+                 const CellView* view) {
+  if (!views.mesh.empty()) {
+    write_cells_ply(views.mesh, s, view);
+    log("viewcells: cells -> " + views.mesh + " (coloured by render cost)");
+  }
+  if (!views.slice_png.empty()) {
+    const double z = std::isnan(views.slice_z) ? 0.5 * (s.view_box.lo.z + s.view_box.hi.z) : views.slice_z;
+    write_slice_png(views.slice_png, s, z, views.slice_width, scene, view);
+    log("viewcells: slice at z = " + fmt(z, 3) + " -> " + views.slice_png);
+  }
+}
+
+namespace {
+
+/// Subdivides the sampled view space (AV-S), weighting cells by a map's view space.
+Subdivision subdivide_sampled(const SamplingRun& s, const CostModel& model, SubdivisionConfig& config,
+                              const Log& log) {
+  std::string ga_reason;
+  use_geometry_aligned(*s.loaded.scene, config, ga_reason);
+  log("viewcells: subdividing to at most " + std::to_string(config.max_cells) + " cells; geometry-aligned candidates " +
+      ga_reason);
+  log("viewcells: pixel cost term " + model.describe_pixel_term());
+  Subdivision sub = subdivide(*s.loaded.scene, s.result.segments, model, config);
+  log("viewcells: " + std::to_string(sub.leaf_count()) + " cells in " + fmt(sub.stats.seconds, 2) +
+      " s, render cost " + fmt(sub.initial_cost, 1) + " -> " + fmt(sub.cost(), 1) + " (" + sub.stats.stop_reason +
+      ")");
+  if (s.loaded.map && !config.density.enabled) {
+    // p(i) over the map's non-solid space: merging, extraction and the file use these weights.
+    weight_by_view_space(sub, q3_subdivision(*s.loaded.map, sub.view_box));
+    log("viewcells: cells weighted by their volume in the map's non-solid space");
+  }
+  return sub;
+}
+
+}  // namespace
+
+BuildResult build(const BuildConfig& config, const Log& log) {
+  config.model.validate();  // before the sampling, not after
+  BuildResult out;
+  out.model = config.model;
+  out.merge = config.merge;
+  out.sampling = load_and_sample(config.scene, config.sampling, log);
+  const SamplingRun& s = out.sampling;
+  const Box3& box = s.result.segments.view_box;
+  if (!std::isnan(config.views.slice_z) && !(config.views.slice_z >= box.lo.z && config.views.slice_z <= box.hi.z))
+    throw Error("--slice-z " + fmt(config.views.slice_z) + " lies outside the view space (z from " + fmt(box.lo.z) +
+                " to " + fmt(box.hi.z) + ")");
+  out.subdivision_config = config.subdivision;
+  Subdivision sub = subdivide_sampled(s, config.model, out.subdivision_config, log);
+
+  SubdivisionFile& file = out.file;
+  file.leaf_pvs = leaf_pvs(sub, s.result.segments);
+  if (config.merge) {
+    MergeConfig mc;
+    mc.show_progress = config.subdivision.show_progress;
+    log("viewcells: merging " + std::to_string(sub.leaf_count()) + " cells into a merge history");
+    file.history = merge_cells(*s.loaded.scene, partition_from_subdivision(sub, file.leaf_pvs), config.model, mc);
+    log("viewcells: merged in " + fmt(file.history->stats.seconds, 2) + " s (" +
+        std::to_string(file.history->stats.evaluations) + " pair costs, " +
+        std::to_string(file.history->stats.stale) + " stale queue entries skipped)");
+  }
+  file.cost_model = config.model;
+  file.scene_fingerprint = s.loaded.scene->fingerprint();
+  file.object_count = static_cast<uint32_t>(s.loaded.scene->object_count());
+  for (const ObjectInfo& o : s.loaded.scene->objects) file.object_names.push_back(o.name);
+  Stopwatch sw;
+  write_views(sub, &*s.loaded.scene, config.views, log);
+  out.export_seconds = sw.seconds();
+  // The file keeps the tree, not the cells' polyhedra or per-leaf segment lists.
+  file.subdivision = std::move(sub);
+  file.subdivision.segments.clear();
+  file.subdivision.cells.clear();
+  sw.restart();
+  if (!config.hierarchy_path.empty()) {
+    write_subdivision(config.hierarchy_path, file);
+    log("viewcells: hierarchy -> " + config.hierarchy_path);
+  }
+  out.write_seconds = sw.seconds();
+  return out;
+}
+
+}  // namespace viewcells::pipeline

@@ -1,0 +1,107 @@
+#include "viewcells/pipeline/cut.h"
+
+#include <filesystem>
+#include <memory>
+
+#include "text.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/progress.h"
+#include "viewcells/io/binary_file.h"
+#include "viewcells/io/scene_io.h"
+
+namespace viewcells::pipeline {
+
+ViewCellSet choose_cells(const MergeHistory& h, const CutRule& rule, bool fallback_all) {
+  const int rules = (rule.count > 0) + rule.memory_given + (rule.cost_ratio != 0);
+  if (rules > 1) throw Error("give only one of --count, --memory and --cost-ratio");
+  if (rule.count > 0) return extract_by_count(h, rule.count);
+  if (rule.memory_given) return extract_by_memory(h, rule.memory);
+  if (rule.cost_ratio != 0) return extract_by_cost_ratio(h, rule.cost_ratio);
+  if (!fallback_all) throw Error("say which cells: --count N, --memory BYTES or --cost-ratio R");
+  return extract_by_count(h, h.leaf_count);
+}
+
+SubdivisionFile read_merged(const std::string& path) {
+  SubdivisionFile file = read_subdivision(path);
+  if (!file.history)
+    throw Error(path, 0, "no merge history in this file (it was built with --no-merge, or by an older version)");
+  return file;
+}
+
+PvsFile pvs_file_for(const SubdivisionFile& file, const ViewCellSet& set) {
+  PvsFile pf = make_pvs_file(file.subdivision, file.leaf_pvs, *file.history, set.cells);
+  pf.object_count = file.object_count;
+  pf.object_names = file.object_names;
+  pf.scene_fingerprint = file.scene_fingerprint;
+  pf.rule = set.rule;
+  return pf;
+}
+
+void write_pvs_checked(const std::string& path, const PvsFile& pf, const std::vector<std::vector<uint32_t>>& lists) {
+  write_pvs(path, pf);
+  const PvsFile back = read_pvs(staged_path(path));  // a command's outputs are renamed at its end
+  for (uint32_t i = 0; i < back.pvs.cell_count; ++i)
+    if (back.pvs.cell_pvs(i) != lists[i]) throw Error(path, 0, "read-back check failed for cell " + std::to_string(i));
+}
+
+ExtractResult extract(const ExtractConfig& config, const Log& log) {
+  ExtractResult out;
+  out.input = config.hierarchy_path;
+  out.file = read_merged(config.hierarchy_path);
+  const MergeHistory& h = *out.file.history;
+  out.set = choose_cells(h, config.cut, false);
+  log("viewcells: " + std::to_string(out.set.cells.size()) + " view cells (" + out.set.rule + "), render cost " +
+      fmt(out.set.cost, 1) + " (elementary cells: " + fmt(h.initial_cost, 1) + "), approximate PVS " +
+      std::to_string(out.set.pvs_bytes) + " bytes");
+  if (config.views.any()) {
+    Subdivision s = out.file.subdivision;
+    rebuild_cells(s);
+    const CellView view = merged_cell_view(s, h, out.set.cells);
+    std::unique_ptr<Scene> scene;
+    if (!config.scene_path.empty()) scene = std::make_unique<Scene>(load_scene(config.scene_path));
+    write_views(s, scene.get(), config.views, log, &view);
+  }
+  return out;
+}
+
+CompressResult compress(const CompressConfig& config, const Log& log) {
+  const SubdivisionFile file = read_merged(config.hierarchy_path);
+  const ViewCellSet set = choose_cells(*file.history, config.cut, true);
+  CompressResult out;
+  out.input = config.hierarchy_path;
+  out.output = config.output;
+  out.flat = config.flat;
+  out.rule = set.rule;
+  Stopwatch sw;
+  const PvsFile pf = pvs_file_for(file, set);
+  out.seconds = sw.seconds();
+  // Sizes before (every cell lists its whole PVS) and after (each node keeps its part).
+  std::vector<std::vector<uint32_t>> flat(pf.pvs.cell_count);
+  for (uint32_t i = 0; i < pf.pvs.cell_count; ++i) {
+    flat[i] = pf.pvs.cell_pvs(i);
+    out.entries_before += flat[i].size();
+  }
+  out.cells = pf.pvs.cell_count;
+  out.objects = pf.object_count;
+  out.hierarchy_nodes = pf.pvs.node_count();
+  out.entries_after = pf.pvs.stored_entries();
+  out.varint_bytes_before = varint_bytes(flat);
+  out.varint_bytes_after = varint_bytes(pf.pvs.stored);
+  write_pvs_checked(config.output, pf, flat);
+  out.file_bytes = std::filesystem::file_size(staged_path(config.output));
+  log("viewcells: " + std::to_string(out.cells) + " view cells (" + set.rule + "): " +
+      std::to_string(out.entries_before) + " PVS entries -> " + std::to_string(out.entries_after) + " kept in " +
+      std::to_string(out.hierarchy_nodes) + " hierarchy nodes (" +
+      fmt(out.entries_before ? double(out.entries_after) / out.entries_before : 1.0, 3) + "); " + config.output +
+      ": " + std::to_string(out.file_bytes) + " bytes");
+  if (!config.flat.empty()) {
+    out.flat_run_length_bytes = write_flat_rows(config.flat, pf);
+    out.flat_bit_row_bytes = static_cast<uint64_t>(pf.pvs.cell_count) * ((pf.object_count + 7) / 8);
+    out.flat_file_bytes = std::filesystem::file_size(staged_path(config.flat));
+    log("viewcells: flat rows -> " + config.flat + ": " + std::to_string(out.flat_bit_row_bytes) +
+        " bytes of bit rows, " + std::to_string(out.flat_run_length_bytes) + " run-length coded (Quake style)");
+  }
+  return out;
+}
+
+}  // namespace viewcells::pipeline

@@ -1,0 +1,196 @@
+#include "viewcells/pipeline/pvs.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "text.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/parallel.h"
+#include "viewcells/core/progress.h"
+#include "viewcells/io/binary_file.h"
+#include "viewcells/io/scene_io.h"
+
+namespace viewcells::pipeline {
+
+uint64_t pvs_state_identity(uint64_t scene_fingerprint, const PvsFile& cells) {
+  ByteWriter id;
+  id.put(scene_fingerprint);
+  id.put_array(cells.leaf_cell);
+  id.put_array(cells.cell_mht_node);
+  return fnv1a64(id.data());
+}
+
+namespace {
+
+void check_config(const PvsConfig& c) {
+  if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0))
+    throw Error("give when to stop: --pixel-error, --time or --samples");
+  if (!(c.filter.k >= 0) || !std::isfinite(c.filter.k)) throw Error("--filter-k must be a finite number >= 0");
+  if (c.filter.k != 1.0 && !c.filter_object_space)
+    throw Error("--filter-k sets the object space filter's factor: add --filter");
+  if (!c.edited_from.empty() && c.resume.empty())
+    throw Error("--edited-from needs --resume: the state computed on that scene, to carry over to --scene");
+}
+
+/// The scenes: the one sampled, and before an edit the one the hierarchy was built from.
+struct Scenes {
+  Scene scene;
+  std::optional<Scene> before;
+  std::unique_ptr<RayCaster> caster, caster_before;
+};
+
+void load_scenes(const PvsConfig& c, const SubdivisionFile& file, Scenes& s) {
+  s.scene = load_scene(c.scene_path, c.grouping);
+  // Dynamic edits: the hierarchy and the state belong to the scene before the edit.
+  if (!c.edited_from.empty()) {
+    s.before.emplace(load_scene(c.edited_from, c.grouping));
+    if (s.before->fingerprint() != file.scene_fingerprint)
+      throw Error(c.edited_from, 0, "is not the scene " + c.hierarchy_path + " was built from (fingerprints differ)");
+  } else if (s.scene.fingerprint() != file.scene_fingerprint) {
+    throw Error(c.scene_path, 0,
+                "is not the scene " + c.hierarchy_path + " was built from (fingerprints differ; after editing the "
+                "scene, give the original with --edited-from)");
+  }
+  EmbreeConfig ec;
+  ec.robust = c.robust;
+  s.caster = make_embree_caster(s.scene, ec);
+}
+
+/// The solver, fresh, resumed, or resumed on the scene before an edit and then edited.
+void make_solver(const PvsConfig& c, Scenes& s, const CellLocator& cells, const PvsFile& pf, const AgvsConfig& config,
+                 std::optional<AgvsSolver>& solver, std::optional<AgvsEditStats>& edit, const Log& log) {
+  const uint64_t identity = pvs_state_identity(s.scene.fingerprint(), pf);
+  if (s.before && AgvsSolver::state_identity(c.resume) != identity) {
+    // The state describes the scene before the edit: load it there, then edit.
+    EmbreeConfig ec;
+    ec.robust = c.robust;
+    s.caster_before = make_embree_caster(*s.before, ec);
+    solver.emplace(*s.before, *s.caster_before, cells, config);
+    solver->load(c.resume, pvs_state_identity(s.before->fingerprint(), pf));
+    log("viewcells: resumed from " + c.resume + " after " + std::to_string(solver->stats().samples) +
+        " samples on " + c.edited_from);
+    edit = solver->edit(s.scene, *s.caster, match_objects(*s.before, s.scene));
+    log("viewcells: edit: " + std::to_string(edit->deleted) + " objects deleted (" +
+        std::to_string(edit->removed_deleted) + " PVS entries), " + std::to_string(edit->inserted) + " inserted (" +
+        std::to_string(edit->removed_penumbra) + " entries in their penumbrae removed, " +
+        std::to_string(edit->cells_cleared) + " cells they touch emptied)");
+    return;
+  }
+  solver.emplace(s.scene, *s.caster, cells, config);
+  if (!c.resume.empty()) {
+    solver->load(c.resume, identity);
+    log("viewcells: resumed from " + c.resume + " after " + std::to_string(solver->stats().samples) + " samples");
+  }
+}
+
+void add_references(const PvsConfig& c, const PvsFile& pf, AgvsSolver& solver) {
+  for (const std::string& path : c.references) {
+    const PvsFile ref = read_pvs(path);
+    if (ref.pvs.cell_count != pf.pvs.cell_count || ref.object_count != pf.object_count ||
+        ref.scene_fingerprint != pf.scene_fingerprint || ref.leaf_cell != pf.leaf_cell)
+      throw Error(path, 0, "is not a .pvs of these view cells of this scene");
+    std::vector<std::vector<uint32_t>> lists(ref.pvs.cell_count);
+    for (uint32_t i = 0; i < ref.pvs.cell_count; ++i) lists[i] = ref.pvs.cell_pvs(i);
+    solver.add_reference(GlobalPvs::from_lists(pf.object_count, lists));
+  }
+}
+
+/// Measures the pixel error of the PVSs written (and of the unfiltered ones, when filtered).
+void measure(const PvsConfig& c, const Scenes& s, const CellLocator& cells, const AgvsSolver& solver,
+             const GlobalPvs& written, PvsResult& out, const Log& log) {
+  Stopwatch ms;
+  auto run = [&](const GlobalPvs& pvs) {
+    return measure_pixel_error(s.scene, *s.caster, cells, pvs, c.measure_cameras, c.measure_size, c.measure_size,
+                               90.0, c.agvs.seed + 17, out.stats.empty_space.enabled, out.agvs.resolution);
+  };
+  out.measured = run(written);
+  if (out.filtering) out.measured_unfiltered = run(solver.pvs());
+  log("viewcells: measured pixel error " + fmt(out.measured->pixels, 2) +
+      (out.filtering ? " (unfiltered " + fmt(out.measured_unfiltered->pixels, 2) + ")" : std::string()) + " of " +
+      std::to_string(out.agvs.resolution) + " pixels (" + std::to_string(out.measured->cameras) + " cameras of " +
+      std::to_string(c.measure_size) + "x" + std::to_string(c.measure_size) + ", " + fmt(ms.seconds(), 1) + " s)");
+}
+
+std::string describe_stop(const PvsConfig& c) {
+  const AgvsConfig& a = c.agvs;
+  return (a.pixel_error > 0 ? "an estimated pixel error of " + fmt(a.pixel_error, 2) + " " : std::string()) +
+         (a.max_seconds > 0 ? fmt(a.max_seconds, 1) + " s " : std::string()) +
+         (a.max_samples ? std::to_string(a.max_samples) + " samples" : std::string());
+}
+
+}  // namespace
+
+PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
+  check_config(c);
+  PvsResult out;
+  out.config = c;
+  out.threads = worker_threads();
+  out.agvs = c.agvs;
+  out.agvs.filter_statistics = c.filter_object_space || c.filter.view_neighbours > 0;
+  out.filtering = out.agvs.filter_statistics;
+  const SubdivisionFile file = read_merged(c.hierarchy_path);
+  const MergeHistory& h = *file.history;
+  CutRule cut;
+  cut.count = c.cells;
+  const ViewCellSet set = choose_cells(h, cut, true);
+  Stopwatch sw;
+  Scenes scenes;
+  load_scenes(c, file, scenes);
+  PvsFile pf = pvs_file_for(file, set);
+  pf.rule += "; PVS by " + std::string(to_string(c.agvs.method));
+  // The PVSs name the objects of the scene sampled (the edited one, after an edit).
+  pf.object_count = static_cast<uint32_t>(scenes.scene.object_count());
+  pf.object_names.clear();
+  for (const ObjectInfo& o : scenes.scene.objects) pf.object_names.push_back(o.name);
+  pf.scene_fingerprint = scenes.scene.fingerprint();
+  const CellLocator cells(pf.bsp, pf.leaf_cell, pf.pvs.cell_count);
+  out.setup_seconds = sw.seconds();
+  out.rule = set.rule;
+  out.cells = cells.cell_count();
+  log("viewcells: " + std::to_string(cells.cell_count()) + " view cells (" + set.rule + "), PVS by " +
+      to_string(c.agvs.method) + " until " + describe_stop(c));
+  std::optional<AgvsSolver> solver;
+  make_solver(c, scenes, cells, pf, out.agvs, solver, out.edit, log);
+  add_references(c, pf, *solver);
+  solver->run();
+  if (!c.save.empty()) {
+    solver->save(c.save, pvs_state_identity(scenes.scene.fingerprint(), pf));
+    log("viewcells: state -> " + c.save + " (continue with --resume)");
+  }
+  out.stats = solver->stats();
+  // The sampled PVSs (filtered, when asked) replace the construction ones, compressed through
+  // the hierarchy.
+  VisibilityFilter filter = c.filter;
+  filter.object_space = c.filter_object_space;
+  std::vector<std::vector<uint32_t>> lists(cells.cell_count());
+  if (out.filtering) {
+    lists = solver->filtered_pvs(filter);
+  } else {
+    for (uint32_t i = 0; i < cells.cell_count(); ++i) lists[i] = solver->pvs().list(i);
+  }
+  const GlobalPvs written = GlobalPvs::from_lists(pf.object_count, lists);
+  out.mean_pvs = solver->mean_pvs();
+  out.mean_written = static_cast<double>(written.entries()) / cells.cell_count();
+  out.pvs_entries = solver->pvs().entries();
+  if (out.filtering)
+    log("viewcells: visibility filter (" +
+        std::string(c.filter_object_space ? "object space, k = " + fmt(c.filter.k, 2) : "") +
+        (c.filter_object_space && c.filter.view_neighbours ? ", " : "") +
+        (c.filter.view_neighbours ? "view space, " + std::to_string(c.filter.view_neighbours) + " neighbours" : "") +
+        "): mean PVS " + fmt(out.mean_pvs, 1) + " -> " + fmt(out.mean_written, 1) + " objects");
+  pf.pvs = compress_pvs(h, set.cells, lists);
+  write_pvs_checked(c.output, pf, lists);
+  out.pixel_error = solver->pixel_error();
+  out.pixel_error_bound = solver->pixel_error_bound();
+  if (c.measure_cameras) measure(c, scenes, cells, *solver, written, out, log);
+  const double err = out.pixel_error, bound = out.pixel_error_bound;
+  log("viewcells: " + std::to_string(out.stats.samples) + " samples (" + std::to_string(out.stats.rays) + " rays) in " +
+      fmt(out.stats.seconds, 2) + " s; mean PVS " + fmt(out.mean_pvs, 1) + " objects; estimated pixel error " +
+      (!std::isnan(err)     ? fmt(err, 2)
+       : !std::isnan(bound) ? "below " + fmt(bound, 2) + " (90% bound: too few wrong camera rays for an estimate)"
+                            : std::string("not yet known")) +
+      " (" + out.stats.stop_reason + "); -> " + c.output);
+  return out;
+}
+
+}  // namespace viewcells::pipeline

@@ -1,0 +1,105 @@
+#include "viewcells/pipeline/sampling.h"
+
+#include <cctype>
+#include <filesystem>
+
+#include "text.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/parallel.h"
+#include "viewcells/core/progress.h"
+#include "viewcells/io/scene_io.h"
+#include "viewcells/q3/view_space.h"
+#include "viewcells/sampling/segments.h"
+
+namespace viewcells::pipeline {
+
+bool is_q3_map(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return ext == ".bsp";
+}
+
+LoadedScene load_scene_for_rays(const SceneSource& source, const Log& log) {
+  LoadedScene out;
+  out.source = source;
+  Stopwatch sw;
+  out.scene = std::make_unique<const Scene>(load_scene(source.path, source.grouping));
+  if (is_q3_map(source.path)) out.map = std::make_shared<const Q3Map>(read_q3bsp(source.path));
+  out.load_seconds = sw.seconds();
+  log("viewcells: " + source.path + ": " + std::to_string(out.scene->object_count()) + " objects, " +
+      std::to_string(out.scene->triangle_count()) + " triangles, loaded in " + fmt(out.load_seconds, 2) + " s");
+  sw.restart();
+  EmbreeConfig ec;
+  ec.robust = source.robust;
+  out.caster = make_embree_caster(*out.scene, ec);
+  out.bvh_seconds = sw.seconds();
+  return out;
+}
+
+void use_map_view_space(LoadedScene& s, SamplerConfig& config) {
+  if (!s.map) return;
+  std::shared_ptr<const Q3Map> map = s.map;
+  config.view_space = [map](const Vec3& p) { return q3_in_view_space(*map, p); };
+  if (config.view_box.empty()) config.view_box = q3_view_box(*map);
+  size_t open = 0;
+  for (const Q3Leaf& l : map->leaves) open += l.cluster >= 0;
+  s.view_space = "the map's non-solid space (" + std::to_string(open) + " of " + std::to_string(map->leaves.size()) +
+                 " leaves): sample origins in solid leaves are drawn again";
+}
+
+SamplingRun load_and_sample(const SceneSource& source, const SamplerConfig& config, const Log& log) {
+  if (config.samples == 0 && config.target_segments == 0) throw Error("--samples must be positive");
+  SamplingRun out;
+  out.config = config;
+  out.view_box_given = !config.view_box.empty();
+  out.threads = worker_threads();
+  out.loaded = load_scene_for_rays(source, log);
+  use_map_view_space(out.loaded, out.config);
+  const SamplerConfig& c = out.config;
+  const EmptySpaceDecision esd = decide_empty_space(*out.loaded.scene, c.empty_space);
+  log("viewcells: sampling " +
+      (c.target_segments ? "until " + std::to_string(c.target_segments) + " segments"
+                         : std::to_string(c.samples) + " samples") +
+      ", seed " + std::to_string(c.seed) + ", " + std::to_string(out.threads) + " threads, " +
+      out.loaded.caster->name() + "; view box " + (c.view_box.empty() ? "= scene bounds" : describe_box(c.view_box)) +
+      "; view space " + out.loaded.view_space + "; empty space detection " + esd.reason);
+  out.result = sample_segments(*out.loaded.scene, *out.loaded.caster, c);
+  const SamplingStats& st = out.result.stats;
+  log("viewcells: " + std::to_string(st.valid_segments) + " valid segments of " + std::to_string(st.samples) +
+      " samples (" + std::to_string(st.rays) + " rays) in " + fmt(st.seconds, 2) + " s: " +
+      fmt(st.valid_segments / st.seconds / 1e6, 3) + " M segments/s");
+  return out;
+}
+
+SampleResult sample(const SampleConfig& config, const Log& log) {
+  SampleResult out;
+  out.run = load_and_sample(config.scene, config.sampling, log);
+  const SamplingRun& s = out.run;
+  const SamplingStats& st = s.result.stats;
+  Stopwatch sw;
+  if (!config.segments_path.empty()) {
+    SegmentFileHeader header;
+    header.seed = s.config.seed;
+    header.samples = st.samples;
+    header.scene_fingerprint = s.loaded.scene->fingerprint();
+    header.object_count = static_cast<uint32_t>(s.loaded.scene->object_count());
+    header.empty_space_detection = st.empty_space.enabled;
+    write_segments(config.segments_path, s.result.segments, header);
+    log("viewcells: segments -> " + config.segments_path);
+  }
+  out.write_seconds = sw.seconds();
+  if (config.measure_raw) {
+    SamplerConfig same = s.config;  // every ray of exactly the samples drawn, re-casts included
+    same.samples = st.samples;
+    same.target_segments = 0;
+    const std::vector<Ray> rays = sampled_rays(*s.loaded.scene, *s.loaded.caster, same);
+    out.raw = RawRayTiming{rays.size(), s.loaded.caster->time_raw(rays)};
+    const double raw_rate = out.raw->rays / out.raw->seconds;
+    const double seg_rate = st.valid_segments / st.seconds;
+    log("viewcells: raw Embree: " + fmt(raw_rate / 1e6, 3) + " M rays/s on the same " + std::to_string(rays.size()) +
+        " rays; segments/s over half of that: " + fmt(seg_rate / (0.5 * raw_rate), 3));
+  }
+  return out;
+}
+
+}  // namespace viewcells::pipeline

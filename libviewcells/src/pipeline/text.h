@@ -1,0 +1,23 @@
+#pragma once
+// Number formatting for the pipeline's log lines and files (internal to src/pipeline).
+#include <sstream>
+#include <string>
+
+#include "viewcells/core/vec3.h"
+
+namespace viewcells::pipeline {
+
+inline std::string fmt(double v, int precision = 3) {
+  std::ostringstream os;
+  os.setf(std::ios::fixed);
+  os.precision(precision);
+  os << v;
+  return os.str();
+}
+
+inline std::string describe_box(const Box3& b) {
+  return "[" + fmt(b.lo.x) + ", " + fmt(b.lo.y) + ", " + fmt(b.lo.z) + "] - [" + fmt(b.hi.x) + ", " +
+         fmt(b.hi.y) + ", " + fmt(b.hi.z) + "]";
+}
+
+}  // namespace viewcells::pipeline
