@@ -28,7 +28,7 @@ json_get() { python3 -c "import json,sys; d=json.load(open('$1')); print(eval('d
 
 # --help explains every subcommand.
 expect_ok "$VC" --help
-for sub in generate info sample build export extract compress pvs query compare; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
+for sub in generate info sample build export extract compress pvs query compare bake; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
 expect_ok "$VC" sample --help
 grep -q -- "--measure-raw" out.txt && ok || bad "sample --help lacks --measure-raw"
 
@@ -358,6 +358,32 @@ expect_error "1000 faces" "$VC" info invented.off
 expect_ok "$VC" --embree-isa sse4.2 sample office.obj --samples 2000 -q -o isa.vseg --report isa.json
 [ "$(json_get isa.json "['embree_isa']")" = "sse4.2" ] && ok || bad "the report lacks the Embree ISA"
 [ "$(od -An -tu1 -j6 -N1 isa.vseg | tr -d ' ')" = "2" ] && ok || bad "the .vseg header lacks the Embree ISA code"
+
+# bake: the whole chain under a budget; the file written holds the budget, and a viewpoint is
+# looked up in it. Threads do not change it; a rerun with a work directory reuses the hierarchy.
+expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --agvs-samples 100000 -o bake1.pvs --report bake.json \
+  --threads 1 --work bakework -q
+expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --agvs-samples 100000 -o bake2.pvs --threads 2 -q
+cmp -s bake1.pvs bake2.pvs && ok || bad "bake differs between 1 and 2 threads"
+[ "$(json_get bake.json "['cells']")" = "12" ] && ok || bad "bake wrote $(json_get bake.json "['cells']") cells, not 12"
+[ "$(json_get bake.json "['file_bytes']")" = "$(stat -c %s bake1.pvs)" ] && ok || bad "bake.json file_bytes is not the file's size"
+expect_ok "$VC" query bake1.pvs 2 2 1.5
+grep -q "of 12 (exactly 12 cells; PVS by agvs)" out.txt && ok || bad "query on a baked file: $(head -1 out.txt)"
+expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --agvs-samples 200000 -o bake3.pvs --report bake3.json \
+  --work bakework -q
+[ "$(json_get bake3.json "['effects']['hierarchy_reused']['enabled']")" = "True" ] && ok || bad "bake did not reuse the work directory's hierarchy"
+[ "$(json_get bake3.json "['effects']['agvs_resumed']['enabled']")" = "True" ] && ok || bad "bake did not continue the saved AGVS state"
+for budget in 3000 6K 20000; do
+  expect_ok "$VC" bake office.obj --memory "$budget" --samples 20000 --agvs-samples 50000 -o mem.pvs -q --report mem.json
+  bytes=$(stat -c %s mem.pvs)
+  limit=$(python3 -c "print(int(float('$budget'.rstrip('K')) * (1024 if '$budget'.endswith('K') else 1)))")
+  [ "$bytes" -le "$limit" ] && ok || bad "bake --memory $budget wrote $bytes bytes"
+done
+cp bake1.pvs keep.pvs
+expect_error "not even 1 view cell" "$VC" bake office.obj --memory 50 --samples 20000 --agvs-samples 50000 -o keep.pvs -q
+cmp -s bake1.pvs keep.pvs && ok || bad "a failing bake replaced its output"
+expect_error "needs a budget" "$VC" bake office.obj -o x.pvs
+expect_error "excludes" "$VC" bake office.obj --cells 4 --memory 1M -o x.pvs
 
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

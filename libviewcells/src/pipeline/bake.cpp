@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <set>
 #include <sstream>
 
@@ -108,7 +109,8 @@ std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, const LoadedS
   return lists;
 }
 
-/// The view cells of `coarse` (a cut above `fine`) with the unions of their fine cells' PVSs.
+}  // namespace
+
 std::vector<std::vector<uint32_t>> coarsen(const MergeHistory& h, const std::vector<int32_t>& fine,
                                            const std::vector<std::vector<uint32_t>>& fine_lists,
                                            const std::vector<int32_t>& coarse) {
@@ -129,6 +131,15 @@ std::vector<std::vector<uint32_t>> coarsen(const MergeHistory& h, const std::vec
   return lists;
 }
 
+namespace {
+
+/// Every cell's PVS of a .pvs file, as sorted lists.
+std::vector<std::vector<uint32_t>> cells_pvs(const PvsFile& pf) {
+  std::vector<std::vector<uint32_t>> lists(pf.pvs.cell_count);
+  for (uint32_t i = 0; i < pf.pvs.cell_count; ++i) lists[i] = pf.pvs.cell_pvs(i);
+  return lists;
+}
+
 /// Writes the .pvs of `set` with `lists`; returns its size in bytes.
 uint64_t write_cut(const std::string& path, const SubdivisionFile& file, const ViewCellSet& set,
                    const std::vector<std::vector<uint32_t>>& lists) {
@@ -137,6 +148,41 @@ uint64_t write_cut(const std::string& path, const SubdivisionFile& file, const V
   pf.pvs = compress_pvs(*file.history, set.cells, lists);
   write_pvs_checked(path, pf, lists);
   return std::filesystem::file_size(staged_path(path));
+}
+
+/// The most view cells, from lo to hi, whose file of `bytes_of(count)` bytes fits in `memory`
+/// (a bisection: the file grows with the cells, each size measured); 0 when none does.
+size_t largest_fitting(size_t lo, size_t hi, uint64_t memory, const std::function<uint64_t(size_t)>& bytes_of) {
+  size_t best = 0;
+  while (lo <= hi) {
+    const size_t mid = lo + (hi - lo) / 2;
+    if (bytes_of(mid) <= memory) {
+      best = mid;
+      lo = mid + 1;
+    } else {
+      if (mid == 0) break;
+      hi = mid - 1;
+    }
+  }
+  return best;
+}
+
+/// The view cells to sample: the count asked for, or under a memory budget the most cells
+/// whose file holds within it with the construction samples' PVSs (the BSP that locates the
+/// cells takes its share of the bytes, not only the PVSs).
+ViewCellSet first_cut(const BakeConfig& c, const SubdivisionFile& file, const Log& log) {
+  const MergeHistory& h = *file.history;
+  if (c.cells) return extract_by_count(h, std::min<size_t>(c.cells, h.leaf_count));
+  const size_t n = largest_fitting(h.min_cells(), h.leaf_count, c.memory, [&](size_t count) {
+    const ViewCellSet cut = extract_by_count(h, count);
+    return write_cut(c.output, file, cut, cells_pvs(pvs_file_for(file, cut)));
+  });
+  if (n == 0)
+    throw Error(c.output, 0, "not even " + std::to_string(h.min_cells()) + " view cell(s) fit in " +
+                                 std::to_string(c.memory) + " bytes");
+  log("viewcells: bake: " + std::to_string(n) + " view cells fit in " + std::to_string(c.memory) +
+      " bytes with the construction samples' PVSs");
+  return extract_by_count(h, n);
 }
 
 }  // namespace
@@ -157,31 +203,25 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   out.elementary_cells = static_cast<uint32_t>(h.leaf_count);
   out.scene_fingerprint = file.scene_fingerprint;
   out.object_count = file.object_count;
-  const ViewCellSet set = c.cells ? extract_by_count(h, std::min<size_t>(c.cells, h.leaf_count))
-                                  : extract_by_memory(h, c.memory);
+  const ViewCellSet set = first_cut(c, file, log);
   const std::vector<std::vector<uint32_t>> lists = sample_pvs(c, loaded, pvs_file_for(file, set), out, log);
   out.agvs_cells = static_cast<uint32_t>(set.cells.size());
   ViewCellSet written = set;
   std::vector<std::vector<uint32_t>> written_lists = lists;
   out.file_bytes = write_cut(c.output, file, set, lists);
   if (c.memory && out.file_bytes > c.memory) {
-    // The estimate came from the construction samples; the file holds AGVS's PVSs. The largest
-    // coarser cut whose file fits (file size grows with the cells; each size is measured).
+    // AGVS found more than the construction samples: the largest coarser cut that fits, with
+    // the unions of the sampled PVSs.
     log("viewcells: bake: " + std::to_string(out.file_bytes) + " bytes for " + std::to_string(set.cells.size()) +
         " cells exceed the budget of " + std::to_string(c.memory) + ": coarsening");
-    size_t lo = h.min_cells(), hi = set.cells.size() - 1, best = 0;
-    while (lo <= hi) {
-      const size_t mid = lo + (hi - lo) / 2;
-      const ViewCellSet cut = extract_by_count(h, mid);
-      const uint64_t bytes = write_cut(c.output, file, cut, coarsen(h, set.cells, lists, cut.cells));
-      if (bytes <= c.memory) best = mid, lo = mid + 1;
-      else if (mid == 0) break;
-      else hi = mid - 1;
-    }
-    if (best == 0)
+    const size_t n = largest_fitting(h.min_cells(), set.cells.size() - 1, c.memory, [&](size_t count) {
+      const ViewCellSet cut = extract_by_count(h, count);
+      return write_cut(c.output, file, cut, coarsen(h, set.cells, lists, cut.cells));
+    });
+    if (n == 0)
       throw Error(c.output, 0, "not even " + std::to_string(h.min_cells()) + " view cell(s) fit in " +
                                    std::to_string(c.memory) + " bytes");
-    written = extract_by_count(h, best);
+    written = extract_by_count(h, n);
     written_lists = coarsen(h, set.cells, lists, written.cells);
     out.file_bytes = write_cut(c.output, file, written, written_lists);
   }
@@ -190,9 +230,13 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   for (const auto& l : written_lists) out.pvs_entries += l.size();
   out.mean_pvs = static_cast<double>(out.pvs_entries) / out.cells;
   out.seconds = total.seconds();
+  const double err = out.pixel_error, bound = out.pixel_error_bound;
   log("viewcells: bake: " + std::to_string(out.cells) + " view cells, mean PVS " + fmt(out.mean_pvs, 1) +
       " objects, estimated pixel error " +
-      (std::isnan(out.pixel_error) ? std::string("not known") : fmt(out.pixel_error, 2)) + "; " + c.output + ": " +
+      (!std::isnan(err)     ? fmt(err, 2)
+       : !std::isnan(bound) ? "below " + fmt(bound, 2) + " (90% bound)"
+                            : std::string("not known")) +
+      " after " + std::to_string(out.agvs.samples) + " samples (" + out.agvs.stop_reason + "); " + c.output + ": " +
       std::to_string(out.file_bytes) + " bytes in " + fmt(out.seconds, 1) + " s");
   return out;
 }

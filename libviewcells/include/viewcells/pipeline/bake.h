@@ -10,6 +10,7 @@
 #include <string>
 
 #include "viewcells/agvs/agvs.h"
+#include "viewcells/merge/merge.h"
 #include "viewcells/pipeline/build.h"
 
 namespace viewcells::pipeline {
@@ -49,5 +50,12 @@ struct BakeResult {
 };
 
 BakeResult bake(const BakeConfig& config, const Log& log);
+
+/// The PVSs of the view cells `coarse` (MHT nodes of a cut at or above the cut `fine`): each
+/// the union of the PVSs `fine_lists` of the fine cells below it. A viewpoint in a coarse cell
+/// lies in one of its fine cells, so what any of them sees the coarse cell sees.
+std::vector<std::vector<uint32_t>> coarsen(const MergeHistory& h, const std::vector<int32_t>& fine,
+                                           const std::vector<std::vector<uint32_t>>& fine_lists,
+                                           const std::vector<int32_t>& coarse);
 
 }  // namespace viewcells::pipeline

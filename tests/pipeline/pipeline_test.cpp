@@ -1,0 +1,152 @@
+// The pipeline driven as a library, as a second driver (an engine plugin, a farm) would: build,
+// bake under budgets, the PVSs of coarser cuts, reports.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+
+#include "support/test_scenes.h"
+#include "viewcells/core/error.h"
+#include "viewcells/io/binary_file.h"
+#include "viewcells/io/scene_io.h"
+#include "viewcells/pipeline/bake.h"
+#include "viewcells/pipeline/cut.h"
+#include "viewcells/pipeline/report.h"
+#include "viewcells/runtime.hpp"
+#include "viewcells/scene/generators.h"
+
+namespace viewcells {
+namespace {
+
+const pipeline::Log quiet = [](const std::string&) {};
+
+const std::string& office() {
+  static const std::string path = [] {
+    const std::string p = test::temp_path("pipeline-office.obj");
+    write_obj(generate_scene({GeneratorKind::kOffice, 1, 1}), p);
+    return p;
+  }();
+  return path;
+}
+
+pipeline::BuildConfig small_build(const std::string& hierarchy) {
+  pipeline::BuildConfig c;
+  c.scene.path = office();
+  c.sampling.samples = 20000;
+  c.sampling.show_progress = false;
+  c.subdivision.max_cells = 120;
+  c.subdivision.show_progress = false;
+  c.hierarchy_path = hierarchy;
+  return c;
+}
+
+TEST(Pipeline, BuildWritesWhatItReturnsAndReportsIt) {
+  const std::string path = test::temp_path("pipeline.vcells");
+  const pipeline::BuildResult r = pipeline::build(small_build(path), quiet);
+  const SubdivisionFile back = read_subdivision(path);
+  EXPECT_EQ(back.subdivision.leaf_count(), r.file.subdivision.leaf_count());
+  ASSERT_TRUE(back.history && r.file.history);
+  EXPECT_EQ(back.history->leaf_count, r.file.history->leaf_count);
+  EXPECT_EQ(back.leaf_pvs, r.file.leaf_pvs);
+  const auto j = nlohmann::json::parse(pipeline::report_json(r));
+  EXPECT_EQ(j["command"], "build");
+  EXPECT_EQ(j["subdivision"]["cells"], r.file.subdivision.leaf_count());
+  EXPECT_TRUE(j.contains("embree_isa"));
+  EXPECT_EQ(j["counts"]["valid_segments"], r.sampling.result.stats.valid_segments);
+}
+
+TEST(Pipeline, CoarserCutsSeeTheUnionOfTheirParts) {
+  const pipeline::BuildResult r = pipeline::build(small_build(""), quiet);
+  const SubdivisionFile& file = r.file;
+  const MergeHistory& h = *file.history;
+  const ViewCellSet fine = extract_by_count(h, 40);
+  const PvsFile fine_file = pipeline::pvs_file_for(file, fine);
+  std::vector<std::vector<uint32_t>> fine_lists(fine.cells.size());
+  for (uint32_t i = 0; i < fine.cells.size(); ++i) fine_lists[i] = fine_file.pvs.cell_pvs(i);
+  // The construction PVS of a merged cell is the union of its leaves': coarsening the fine
+  // cells' PVSs must give exactly the coarse cells' own.
+  for (size_t count : {40ul, 17ul, 3ul, 1ul}) {
+    const ViewCellSet coarse = extract_by_count(h, count);
+    const auto lists = pipeline::coarsen(h, fine.cells, fine_lists, coarse.cells);
+    const PvsFile coarse_file = pipeline::pvs_file_for(file, coarse);
+    ASSERT_EQ(lists.size(), count);
+    for (uint32_t i = 0; i < count; ++i) EXPECT_EQ(lists[i], coarse_file.pvs.cell_pvs(i)) << count << " cells, cell " << i;
+  }
+}
+
+pipeline::BakeConfig small_bake(const std::string& out) {
+  pipeline::BakeConfig c;
+  c.scene.path = office();
+  c.sampling.samples = 3000;  // few: AGVS then finds much the construction samples missed
+  c.sampling.show_progress = false;
+  c.subdivision.max_cells = 200;
+  c.subdivision.show_progress = false;
+  c.agvs.max_samples = 150000;
+  c.agvs.show_progress = false;
+  c.output = out;
+  return c;
+}
+
+TEST(Pipeline, BakeHoldsTheMemoryBudgetForTheFileItWrites) {
+  const std::string out = test::temp_path("budget.pvs");
+  size_t coarsened = 0, fitted = 0;
+  for (uint64_t budget = 2500; budget <= 9000; budget += 500) {
+    pipeline::BakeConfig c = small_bake(out);
+    c.memory = budget;
+    try {
+      const pipeline::BakeResult r = pipeline::bake(c, quiet);
+      ++fitted;
+      EXPECT_LE(std::filesystem::file_size(out), budget);
+      EXPECT_EQ(r.file_bytes, std::filesystem::file_size(out));
+      coarsened += r.cells < r.agvs_cells;
+      const runtime::PvsFile f(out);
+      EXPECT_EQ(f.cell_count(), r.cells);
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("fit in"), std::string::npos) << e.what();
+    }
+  }
+  EXPECT_GT(fitted, 5u);
+  RecordProperty("coarsened", static_cast<int>(coarsened));
+}
+
+TEST(Pipeline, BakeByCellsWritesThatManyAndContinuesFromItsWorkDirectory) {
+  const std::string out = test::temp_path("cells.pvs"), work = test::temp_path("bake-work");
+  pipeline::BakeConfig c = small_bake(out);
+  c.cells = 9;
+  c.work_dir = work;
+  const pipeline::BakeResult first = pipeline::bake(c, quiet);
+  EXPECT_EQ(first.cells, 9u);
+  EXPECT_FALSE(first.hierarchy_reused);
+  c.agvs.max_samples = 300000;
+  const pipeline::BakeResult second = pipeline::bake(c, quiet);
+  EXPECT_TRUE(second.hierarchy_reused);
+  EXPECT_TRUE(second.agvs_resumed);
+  EXPECT_GE(second.agvs.samples, 300000u);
+  EXPECT_GE(second.pvs_entries, first.pvs_entries) << "sampling on only adds to the PVSs";
+  // The same as one uninterrupted run of 300,000 samples.
+  const std::string direct = test::temp_path("direct.pvs");
+  pipeline::BakeConfig d = small_bake(direct);
+  d.cells = 9;
+  d.agvs.max_samples = 300000;
+  pipeline::bake(d, quiet);
+  const runtime::PvsFile a(out), b(direct);
+  ASSERT_EQ(a.cell_count(), b.cell_count());
+  for (int32_t i = 0; i < static_cast<int32_t>(a.cell_count()); ++i) {
+    const auto x = a.objects(i), y = b.objects(i);
+    EXPECT_EQ(std::vector<uint32_t>(x.begin(), x.end()), std::vector<uint32_t>(y.begin(), y.end())) << "cell " << i;
+  }
+  // Settings that change the hierarchy are not served from the work directory.
+  c.sampling.seed = 2;
+  EXPECT_FALSE(pipeline::bake(c, quiet).hierarchy_reused);
+}
+
+TEST(Pipeline, BakeRefusesNoBudgetOrTwo) {
+  pipeline::BakeConfig c = small_bake(test::temp_path("none.pvs"));
+  EXPECT_THROW(pipeline::bake(c, quiet), Error);
+  c.cells = 4;
+  c.memory = 100000;
+  EXPECT_THROW(pipeline::bake(c, quiet), Error);
+}
+
+}  // namespace
+}  // namespace viewcells
