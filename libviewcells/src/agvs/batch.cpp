@@ -1,0 +1,248 @@
+// AGVS paper 4.1: one batch of global visibility sampling: draw the samples, cast them, and
+// apply their segments to the PVSs of every cell they pierce, in sample order. The batch is
+// the unit of determinism: its samples come from its own random stream, parallel work is cut
+// into fixed chunks, and everything that depends on order is applied serially.
+#include "solver_impl.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <span>
+#include <tuple>
+
+namespace viewcells {
+
+namespace {
+
+/// The view space-direction samples last: they also replace the draws that failed (no
+/// mutation candidate left, a degenerate two-point pair), so every batch has n samples.
+constexpr int kOrder[kDists] = {kSil, kTpm, kOd, kTp, kVsd};
+
+struct SilhouetteJob {
+  Candidate candidate;
+  double u[2] = {0, 0};
+  int n = 0;
+  Vec3 points[2], dirs[2];
+  uint64_t rays = 0;
+};
+
+}  // namespace
+
+/// A batch's samples, grouped by distribution so that each distribution's rays are counted
+/// exactly: samples first_of[d] .. end_of[d] - 1 are distribution d's.
+struct AgvsSolver::Impl::BatchSamples {
+  std::vector<Vec3> points, dirs;
+  std::vector<int32_t> ref_cell;  ///< REF: the cell each sample belongs to
+  uint32_t first_of[kDists] = {}, end_of[kDists] = {};
+  uint64_t discovery_rays = 0;  ///< the silhouette searches' rays
+};
+
+/// Segments cast from a fixed run of one distribution's samples.
+struct AgvsSolver::Impl::BatchChunk {
+  uint32_t first = 0, size = 0;
+  int dist = 0;
+  SegmentSet segs;
+  std::vector<uint32_t> sample_of;
+  uint64_t rays = 0;
+  size_t seg_start = 0;  ///< index of its first segment among the batch's
+};
+
+void AgvsSolver::Impl::draw_samples(uint64_t index, uint32_t n, const double share[kDists], BatchSamples& s) {
+  Rng rng(config.seed, 1000 + index);
+  uint32_t want[kDists];
+  uint32_t assigned = 0;
+  for (int d = 0; d < kDists; ++d) assigned += want[d] = static_cast<uint32_t>(std::floor(share[d] * n));
+  want[kVsd] += n - assigned;  // what rounding left over
+  uint32_t failed = 0;
+  std::vector<SilhouetteJob> sil_jobs;
+  for (int d : kOrder) {
+    s.first_of[d] = static_cast<uint32_t>(s.points.size());
+    const uint32_t target = want[d] + (d == kVsd ? failed : 0);
+    for (uint32_t k = 0; k < target; ++k) {
+      Vec3 p, dir;
+      if (config.method == AgvsMethod::kRef) {
+        // A random cell, a uniform point in it (rejection in its bounds), a random direction.
+        const uint32_t c = static_cast<uint32_t>(rng.below(cells.cell_count()));
+        const Box3& b = cells.cell_bounds(c);
+        for (int tries = 0; tries < 1000; ++tries) {
+          p = {rng.uniform(b.lo.x, b.hi.x), rng.uniform(b.lo.y, b.hi.y), rng.uniform(b.lo.z, b.hi.z)};
+          if (cells.cell_at(p) == static_cast<int32_t>(c)) break;
+        }
+        dir = sphere_direction(rng.uniform(), rng.uniform());
+        s.ref_cell.push_back(static_cast<int32_t>(c));
+      } else if (d == kSil) {
+        // Candidates and random numbers drawn here, in order; the searches run below.
+        if (silhouette.empty()) {
+          ++failed;
+          continue;
+        }
+        SilhouetteJob job;
+        job.candidate = silhouette.take();
+        job.u[0] = rng.uniform(), job.u[1] = rng.uniform();
+        sil_jobs.push_back(job);
+        continue;
+      } else if (!draw(d, rng, p, dir)) {
+        ++failed;
+        continue;
+      }
+      s.points.push_back(p);
+      s.dirs.push_back(dir);
+    }
+    if (d == kSil && !sil_jobs.empty()) {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, sil_jobs.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t j = r.begin(); j < r.end(); ++j) {
+          SilhouetteJob& job = sil_jobs[j];
+          job.n = silhouette_samples(job.candidate, job.u, job.points, job.dirs, job.rays);
+        }
+      });
+      for (const SilhouetteJob& job : sil_jobs) {
+        s.discovery_rays += job.rays;
+        if (job.n == 0) ++failed;
+        for (int j = 0; j < job.n; ++j) {
+          s.points.push_back(job.points[j]);
+          s.dirs.push_back(job.dirs[j]);
+        }
+      }
+    }
+    s.end_of[d] = static_cast<uint32_t>(s.points.size());
+  }
+}
+
+std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const BatchSamples& s,
+                                                                          std::vector<std::vector<int32_t>>& seg_cells) {
+  // Cast in fixed chunks within each distribution, in parallel; outputs in sample order.
+  constexpr uint32_t kChunk = 1024;
+  std::vector<BatchChunk> chunks;
+  for (int d : kOrder)
+    for (uint32_t f = s.first_of[d]; f < s.end_of[d]; f += kChunk) {
+      BatchChunk c;
+      c.first = f;
+      c.size = std::min(kChunk, s.end_of[d] - f);
+      c.dist = d;
+      chunks.push_back(std::move(c));
+    }
+  tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
+    BatchChunk& c = chunks[k];
+    c.rays = caster().cast(std::span<const Vec3>(s.points.data() + c.first, c.size),
+                           std::span<const Vec3>(s.dirs.data() + c.first, c.size), c.segs, c.sample_of);
+  });
+  // The cells of every segment, in parallel.
+  size_t total = 0;
+  for (BatchChunk& c : chunks) {
+    c.seg_start = total;
+    total += c.segs.size();
+  }
+  seg_cells.assign(total, {});
+  if (config.method != AgvsMethod::kRef) {
+    tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
+      std::vector<std::tuple<int32_t, double, double>> stack;
+      std::vector<int32_t> leaves;
+      const SegmentSet& segs = chunks[k].segs;
+      for (size_t i = 0; i < segs.size(); ++i)
+        cells.cells_of_segment(segs.a(i), segs.b(i), seg_cells[chunks[k].seg_start + i], stack, leaves);
+    });
+  }
+  return chunks;
+}
+
+/// What applying a batch counted: per distribution, and the estimator's camera rays per sample
+/// (0 when the sample's point is inside a solid: no camera stands there) and those that were
+/// wrong pixels (an entry new to the point's cell).
+struct AgvsSolver::Impl::BatchCounts {
+  uint64_t contribution[kDists] = {}, rays[kDists] = {};
+  std::vector<uint8_t> camera_rays, wrong_rays, has_segment;
+};
+
+void AgvsSolver::Impl::apply_segment(const BatchSamples& s, const BatchChunk& c, size_t i,
+                                     const std::vector<int32_t>& pierced, std::vector<int32_t>& origin_cell,
+                                     BatchCounts& counts) {
+  const uint32_t sample = c.first + c.sample_of[i];
+  counts.has_segment[sample] = 1;
+  const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
+  bool contributed[2] = {false, false};
+  uint64_t gain = 0;
+  // Whether the sample's point lies on this segment: its own segment (re-casts of points
+  // inside solids start elsewhere; see-through companions are the first one's).
+  auto on_segment = [&] {
+    const Vec3 a = c.segs.a(i), ab = c.segs.b(i) - a;
+    const double t = dot(s.points[sample] - a, ab);
+    return t >= 0 && t <= dot(ab, ab);
+  };
+  if (config.method == AgvsMethod::kRef) {
+    // Per cell: the object hit forward from the sample's point, for its cell only; one
+    // camera ray, counted once per sample.
+    const uint32_t o = objs[1];
+    if (counts.camera_rays[sample] == 0 && on_segment()) {
+      counts.camera_rays[sample] = 1;
+      if (config.filter_statistics) count_hits(s.ref_cell[sample], o, kNoObject);
+      if (o != kNoObject && pvs.insert(static_cast<uint32_t>(s.ref_cell[sample]), o)) {
+        ++gain;
+        counts.wrong_rays[sample] = 1;
+      }
+    }
+  } else {
+    const bool own = c.dist == kVsd && counts.camera_rays[sample] == 0 && on_segment();
+    if (own && origin_cell[sample] == -2) origin_cell[sample] = cells.cell_at(s.points[sample]);
+    bool at_origin[2] = {false, false};
+    gain = contribute(pvs, pierced, objs[0], objs[1], contributed, own ? origin_cell[sample] : -1, at_origin);
+    if (config.filter_statistics)
+      for (int32_t cell : pierced) count_hits(cell, objs[0], objs[1]);
+    // The estimator's rays: a camera at the point sees along both rays of its segment.
+    if (own) {
+      counts.camera_rays[sample] = 2;
+      counts.wrong_rays[sample] = static_cast<uint8_t>(at_origin[0] + at_origin[1]);
+    }
+  }
+  counts.contribution[c.dist] += gain;
+  if (gain > 0 && config.method == AgvsMethod::kAgvs) {
+    // A mutation candidate per end whose object contributed.
+    const Vec3 a = c.segs.a(i), b = c.segs.b(i);
+    for (int e = 0; e < 2; ++e) {
+      if (!contributed[e]) continue;
+      const Vec3& term = e ? b : a;
+      const Vec3& origin = e ? a : b;
+      add_candidate({origin, term, end_radius(objs[1 - e], origin), end_radius(objs[e], term), objs[e]});
+    }
+  }
+}
+
+void AgvsSolver::Impl::batch(uint64_t index, uint32_t n) {
+  double share[kDists];
+  shares(share);
+  BatchSamples s;
+  draw_samples(index, n, share, s);
+  const size_t count = s.points.size();
+  std::vector<std::vector<int32_t>> seg_cells;
+  const std::vector<BatchChunk> chunks = cast_samples(s, seg_cells);
+  // Apply in sample order (serial: contributions depend on what came before).
+  BatchCounts counts;
+  counts.rays[kSil] += s.discovery_rays;
+  counts.camera_rays.assign(count, 0);
+  counts.wrong_rays.assign(count, 0);
+  counts.has_segment.assign(count, 0);
+  std::vector<int32_t> origin_cell(count, -2);
+  for (const BatchChunk& c : chunks) {
+    counts.rays[c.dist] += c.rays;
+    for (size_t i = 0; i < c.segs.size(); ++i) apply_segment(s, c, i, seg_cells[c.seg_start + i], origin_cell, counts);
+  }
+  // The estimator counts view space-direction samples (all of them for SGVS and REF).
+  uint64_t vsd_rays = 0, vsd_contributing = 0;
+  for (uint32_t k = s.first_of[kVsd]; k < s.end_of[kVsd]; ++k) {
+    // No segment at all: both rays left the scene without a hit (the caster emits nothing
+    // then), so the point is free and its camera sees nothing there: right pixels.
+    if (!counts.has_segment[k]) counts.camera_rays[k] = config.method == AgvsMethod::kRef ? 1 : 2;
+    vsd_rays += counts.camera_rays[k];
+    vsd_contributing += counts.wrong_rays[k];
+  }
+  uint64_t samples_of[kDists];
+  for (int d = 0; d < kDists; ++d) samples_of[d] = s.end_of[d] - s.first_of[d];
+  update_weights(share, samples_of, counts.contribution, counts.rays);
+  stats.samples += count;
+  stats.batches += 1;
+  stats.mutation_candidates = two_point.size();
+  stats.camera_rays += vsd_rays;
+  stats.wrong_camera_rays += vsd_contributing;
+  update_estimate(vsd_rays, vsd_contributing);
+}
+
+}  // namespace viewcells

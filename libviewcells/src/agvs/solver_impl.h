@@ -1,0 +1,169 @@
+#pragma once
+// AGVS paper 4.6 (putting it all together): the solver's state, shared by the files that
+// implement its parts: distributions.cpp (4.3, 4.4), mixture.cpp (4.2), batch.cpp (4.1, one
+// batch of the sampling loop), estimator.cpp (4.5), filter.cpp (5), edit.cpp (6),
+// state_io.cpp (saving and resuming) and solver.cpp (the loop and the public API).
+#include <algorithm>
+#include <deque>
+#include <limits>
+#include <memory>
+#include <vector>
+
+#include "box_tree.h"
+#include "candidates.h"
+#include "halton.h"
+#include "viewcells/agvs/agvs.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/rng.h"
+#include "viewcells/sampling/sampler.h"
+
+namespace viewcells {
+
+namespace agvs_detail {
+constexpr int kDists = static_cast<int>(AgvsDistribution::kCount);
+constexpr int kVsd = 0, kOd = 1, kTp = 2, kTpm = 3, kSil = 4;
+}  // namespace agvs_detail
+
+using namespace agvs_detail;
+
+struct AgvsSolver::Impl {
+  const Scene* scene_;  ///< rebound by scene edits
+  const CellLocator& cells;
+  AgvsConfig config;
+  const RayCaster* caster_ref_;
+  std::unique_ptr<SegmentCaster> caster_;
+  GlobalPvs pvs;
+  AgvsStats stats;
+  // Surface sampling: rendered objects, and each one's triangles by cumulative area.
+  std::vector<uint32_t> objects;
+  std::vector<std::vector<std::pair<double, uint32_t>>> triangles_of;
+  std::vector<double> object_radius;
+  Halton halton[kDists];
+  uint64_t halton_index[kDists] = {};
+  // Mutation candidates of the two mutation strategies.
+  CandidateBuffer two_point, silhouette;
+  // The mixture: contribution and rays of each distribution in the last batch.
+  double weight[kDists] = {};
+  double recent_contribution[kDists] = {}, recent_rays[kDists] = {};
+  uint64_t last_calibration = 0;
+  bool calibrated = false;
+  // The pixel error estimator's window: per batch, view space-direction rays and those that
+  // added an entry to the cell containing their origin.
+  std::deque<std::pair<uint64_t, uint64_t>> window;
+  uint64_t window_total = 0;  ///< camera rays since the start (or the last edit), trimmed ones too
+  double error = std::numeric_limits<double>::quiet_NaN();
+  /// With too few wrong camera rays for a window: the error's 90% upper bound, in pixels.
+  double error_bound = std::numeric_limits<double>::quiet_NaN();
+  double eps;  ///< offset of ray origins from surfaces
+  // The visibility filter's sampling densities (config.filter_statistics): segments through
+  // each cell, and per cell and object the segments through the cell that hit the object
+  // (saturating).
+  std::vector<uint64_t> cell_samples;
+  std::vector<uint16_t> hit_counts;
+  std::vector<GlobalPvs> references;  ///< for the curve's coverage only
+
+  const Scene& scene() const { return *scene_; }
+  const RayCaster& caster_ref() const { return *caster_ref_; }
+  const SegmentCaster& caster() const { return *caster_; }
+
+  Impl(const Scene& s, const RayCaster& rc, const CellLocator& c, const AgvsConfig& cfg)
+      : cells(c),
+        config(cfg),
+        pvs(c.cell_count(), static_cast<uint32_t>(s.object_count())),
+        halton{Halton(cfg.seed, 11), Halton(cfg.seed, 12), Halton(cfg.seed, 13), Halton(cfg.seed, 14),
+               Halton(cfg.seed, 15)} {
+    bind(s, rc);
+    if (config.filter_statistics) {
+      cell_samples.assign(c.cell_count(), 0);
+      hit_counts.assign(size_t(c.cell_count()) * s.object_count(), 0);
+    }
+  }
+
+  /// Takes the scene and its caster: what sampling derives from them.
+  void bind(const Scene& s, const RayCaster& rc);
+
+  /// A point on a random rendered object from Halton coordinates (u0 object, u1 triangle,
+  /// u2, u3 barycentric) and the triangle's unit normal.
+  Vec3 object_point(double u0, double u1, double u2, double u3, Vec3& normal) const;
+
+  Vec3 view_point(double u0, double u1, double u2) const {
+    const Box3& b = cells.view_box();
+    const Vec3 e = b.extent();
+    return {b.lo.x + e.x * u0, b.lo.y + e.y * u1, b.lo.z + e.z * u2};
+  }
+
+  /// Draws one sample of distribution d into (point, dir); false when it cannot (no candidate).
+  bool draw(int d, Rng& rng, Vec3& point, Vec3& dir);
+
+  void add_candidate(const Candidate& c) {
+    two_point.add(c, config.mutation_buffer);
+    silhouette.add(c, config.mutation_buffer);
+  }
+
+  /// Silhouette mutation (paper 4.4, after Wonka et al.'s adaptive border sampling): from the
+  /// candidate's other end, discovery rays towards points moved off the seen object along a
+  /// random direction of the plane through its end, perpendicular to the segment; the nearest
+  /// one that misses the object (binary search) passes its silhouette. If that ray then hits
+  /// something more than k r(o) beyond the moved point (a depth discontinuity), a second
+  /// search runs along the jump. Returns the samples' points and directions (one or two).
+  /// `angle_u`: the two uniform numbers that choose the directions of the two searches (drawn
+  /// beforehand, so that searches run in parallel and stay reproducible); `rays` counts the
+  /// discovery rays. Thread-safe.
+  int silhouette_samples(const Candidate& c, const double angle_u[2], Vec3 points_out[2], Vec3 dirs_out[2],
+                         uint64_t& rays) const;
+
+  /// The filter's densities: one more segment through `cell`, hitting objects a and b.
+  void count_hits(int32_t cell, uint32_t a, uint32_t b) {
+    ++cell_samples[cell];
+    const size_t row = size_t(cell) * pvs.object_count();
+    auto bump = [&](uint32_t o) {
+      if (o == kNoObject) return;
+      uint16_t& h = hit_counts[row + o];
+      if (h < std::numeric_limits<uint16_t>::max()) ++h;
+    };
+    bump(a);
+    if (b != a) bump(b);
+  }
+
+  /// Radius of what lies at a segment end: its object, or else the view cell there.
+  double end_radius(uint32_t object, const Vec3& p) const {
+    if (object != kNoObject) return object_radius[object];
+    const int32_t c = cells.cell_at(p);
+    return c >= 0 ? 0.5 * cells.cell_bounds(c).diagonal() : 0.0;
+  }
+
+  /// The shares of the next batch's samples.
+  void shares(double share[kDists]);
+
+  void batch(uint64_t index, uint32_t n);
+  // The stages of a batch (batch.cpp).
+  struct BatchSamples;
+  struct BatchChunk;
+  struct BatchCounts;
+  void draw_samples(uint64_t index, uint32_t n, const double share[kDists], BatchSamples& s);
+  std::vector<BatchChunk> cast_samples(const BatchSamples& s, std::vector<std::vector<int32_t>>& seg_cells);
+  void apply_segment(const BatchSamples& s, const BatchChunk& c, size_t i, const std::vector<int32_t>& pierced,
+                     std::vector<int32_t>& origin_cell, BatchCounts& counts);
+  /// The mixture's weights after a batch (mixture.cpp), and the per-distribution statistics.
+  void update_weights(const double share[kDists], const uint64_t samples[kDists], const uint64_t contribution[kDists],
+                      const uint64_t rays[kDists]);
+
+  /// Equation 5: the window holds the most recent batches whose camera rays (view
+  /// space-direction rays from free space) number at least (1 - e) / (k^2 e (1 - P)), e the
+  /// wrong share over them.
+  void update_estimate(uint64_t rays, uint64_t wrong);
+
+  /// The window reaches back at most over the newer half of all camera rays so far: an
+  /// estimate must describe the current solution, and the error keeps falling. If even that
+  /// half holds too few wrong rays for equation 5 (the error is below what it resolves), there
+  /// is no estimate, and error_bound gives the one-sided 90% Poisson upper bound over it.
+  void evaluate_window();
+
+  double mean_pvs() const { return static_cast<double>(pvs.entries()) / cells.cell_count(); }
+
+  AgvsEditStats edit(const Scene& edited, const RayCaster& rc, const std::vector<uint32_t>& new_of_old);
+
+  std::vector<std::vector<uint32_t>> filtered(const VisibilityFilter& f) const;
+};
+
+}  // namespace viewcells
