@@ -20,6 +20,52 @@ ConvexPolyhedron ConvexPolyhedron::box(const Box3& b, int32_t first_plane_id) {
   return p;
 }
 
+namespace {
+
+/// Welds the plane's section: points closer than `weld` (a small multiple of the rounding) are
+/// one vertex (two cut edges leaving a vertex just beyond the plane end up that close). Only
+/// the section can hold such pairs; the parent's vertices were welded when they were made.
+/// Returns the representatives; `welded` maps every id to its own.
+template <class Point>
+std::vector<uint32_t> weld_section(std::vector<uint32_t> ids, const Point& point, double weld,
+                                   std::map<uint32_t, uint32_t>& welded) {
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  std::vector<uint32_t> section;
+  for (uint32_t id : ids) {
+    uint32_t rep = id;
+    for (uint32_t r : section)
+      if (length(point(r) - point(id)) <= weld) {
+        rep = r;
+        break;
+      }
+    if (rep == id) section.push_back(id);
+    welded[id] = rep;
+  }
+  return section;
+}
+
+/// The section's points ordered by angle around their centre, counter-clockwise about n.
+template <class Point>
+std::vector<uint32_t> ordered_cap(const std::vector<uint32_t>& section, const Point& point, const Vec3& n) {
+  Vec3 centre{};
+  for (uint32_t id : section) centre += point(id);
+  centre = centre / static_cast<double>(section.size());
+  const Vec3 u_axis = normalize(std::abs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
+  const Vec3 v_axis = cross(n, u_axis);
+  std::vector<std::pair<double, uint32_t>> ordered;
+  for (uint32_t id : section) {
+    const Vec3 d = point(id) - centre;
+    ordered.push_back({std::atan2(dot(d, v_axis), dot(d, u_axis)), id});
+  }
+  std::sort(ordered.begin(), ordered.end());
+  std::vector<uint32_t> cap;
+  for (const auto& [angle, id] : ordered) cap.push_back(id);
+  return cap;
+}
+
+}  // namespace
+
 std::optional<std::pair<ConvexPolyhedron, ConvexPolyhedron>> ConvexPolyhedron::split(const Plane& plane,
                                                                                       int32_t plane_id) const {
   const size_t nv = vertices_.size();
@@ -95,24 +141,8 @@ std::optional<std::pair<ConvexPolyhedron, ConvexPolyhedron>> ConvexPolyhedron::s
   }
 
   auto point = [&](uint32_t id) { return id < nv ? vertices_[id] : cut_points[id - nv]; };
-  // Weld the plane's section: points closer than a small multiple of the rounding are one
-  // vertex (two cut edges leaving a vertex just beyond the plane end up that close). Only the
-  // section can hold such pairs; the parent's vertices were welded when they were made.
-  std::sort(cap_vertices.begin(), cap_vertices.end());
-  cap_vertices.erase(std::unique(cap_vertices.begin(), cap_vertices.end()), cap_vertices.end());
-  const double weld = 16 * eps;
   std::map<uint32_t, uint32_t> welded;  // id -> representative
-  std::vector<uint32_t> section;
-  for (uint32_t id : cap_vertices) {
-    uint32_t rep = id;
-    for (uint32_t r : section)
-      if (length(point(r) - point(id)) <= weld) {
-        rep = r;
-        break;
-      }
-    if (rep == id) section.push_back(id);
-    welded[id] = rep;
-  }
+  const std::vector<uint32_t> section = weld_section(std::move(cap_vertices), point, 16 * eps, welded);
   auto rep = [&](uint32_t id) {
     const auto it = welded.find(id);
     return it == welded.end() ? id : it->second;
@@ -132,20 +162,7 @@ std::optional<std::pair<ConvexPolyhedron, ConvexPolyhedron>> ConvexPolyhedron::s
 
   // Cap: the plane's section, ordered by angle around its centre in a frame of the plane.
   if (section.size() < 3) return std::nullopt;  // touches the plane in an edge only
-  Vec3 centre{};
-  for (uint32_t id : section) centre += point(id);
-  centre = centre / static_cast<double>(section.size());
-  const Vec3 n = plane.normal;
-  const Vec3 u_axis = normalize(std::abs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
-  const Vec3 v_axis = cross(n, u_axis);
-  std::vector<std::pair<double, uint32_t>> ordered;
-  for (uint32_t id : section) {
-    const Vec3 d = point(id) - centre;
-    ordered.push_back({std::atan2(dot(d, v_axis), dot(d, u_axis)), id});
-  }
-  std::sort(ordered.begin(), ordered.end());
-  std::vector<uint32_t> cap;
-  for (const auto& [angle, id] : ordered) cap.push_back(id);  // counter-clockwise about +n
+  std::vector<uint32_t> cap = ordered_cap(section, point, plane.normal);  // counter-clockwise about +n
   // Negative child: outward normal +n (counter-clockwise about +n); positive child: reversed.
   child[0].faces_.push_back({cap, plane_id, true});
   std::reverse(cap.begin(), cap.end());

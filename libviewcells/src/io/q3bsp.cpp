@@ -116,16 +116,10 @@ bool in_range(int32_t first, int32_t count, size_t n) {
 
 }  // namespace
 
-Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
-  Reader r(bytes, name);
-  if (bytes.size() < 8 || bytes.compare(0, 4, "IBSP") != 0) r.fail("not a Quake 3 BSP file (no IBSP header)");
-  Q3Map m;
-  m.path = name;
-  m.version = r.i32(4);
-  if (m.version != 46 && m.version != 47)
-    r.fail("version " + std::to_string(m.version) + " is not supported (46 and 47 are)");
-  if (bytes.size() < 8 + 8 * 17) r.fail("header ends early");
+namespace {
 
+/// Entities, shaders, planes, leaves and the BSP nodes.
+void read_tree(Reader& r, Q3Map& m) {
   auto [eo, elen] = r.lump(0, 1);
   m.entities = r.str(eo, elen);
   while (!m.entities.empty() && m.entities.back() == '\0') m.entities.pop_back();
@@ -171,6 +165,10 @@ Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
     m.nodes.push_back(n);
   }
   if (m.nodes.empty()) r.fail("the map has no BSP nodes");
+}
+
+/// Drawn surfaces, their vertices and indices, the world model, and the leaves' surfaces.
+void read_surfaces(Reader& r, Q3Map& m) {
   auto [lso, lsn] = r.lump(5, 4);
   for (size_t i = 0; i < lsn; ++i) m.leaf_surfaces.push_back(r.i32(lso + 4 * i));
   auto [vo, vn] = r.lump(10, 44);
@@ -222,7 +220,10 @@ Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
   for (int32_t s : m.leaf_surfaces)
     if (!is_index(s, fn)) r.fail("a leaf names a missing surface");
 
-  // Brushes: what made a leaf solid (for explaining rays that cross solid space).
+}
+
+/// Brushes: what made a leaf solid (for explaining rays that cross solid space).
+void read_brushes(Reader& r, Q3Map& m) {
   auto [bso, bsn] = r.lump(9, 8);
   for (size_t i = 0; i < bsn; ++i) {
     Q3BrushSide side{r.i32(bso + 8 * i), r.i32(bso + 8 * i + 4)};
@@ -248,6 +249,10 @@ Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
     if (!in_range(l.first_brush, l.brush_count, lbn))
       r.fail("a leaf's brushes lie outside the leafbrushes lump");
 
+}
+
+/// q3map2's cluster rows (the map's PVS), when the map was vis-compiled.
+void read_visibility(Reader& r, Q3Map& m) {
   auto [viso, vislen] = r.lump(16, 1);
   if (vislen > 0) {
     if (vislen < 8) r.fail("the visibility lump ends early");
@@ -261,6 +266,24 @@ Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
     for (const Q3Leaf& l : m.leaves)
       if (l.cluster >= m.cluster_count) r.fail("a leaf names cluster " + std::to_string(l.cluster) + " of " + std::to_string(m.cluster_count));
   }
+}
+
+}  // namespace
+
+Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
+  Reader r(bytes, name);
+  if (bytes.size() < 8 || bytes.compare(0, 4, "IBSP") != 0) r.fail("not a Quake 3 BSP file (no IBSP header)");
+  Q3Map m;
+  m.path = name;
+  m.version = r.i32(4);
+  if (m.version != 46 && m.version != 47)
+    r.fail("version " + std::to_string(m.version) + " is not supported (46 and 47 are)");
+  if (bytes.size() < 8 + 8 * 17) r.fail("header ends early");
+
+  read_tree(r, m);
+  read_surfaces(r, m);
+  read_brushes(r, m);
+  read_visibility(r, m);
   return m;
 }
 
