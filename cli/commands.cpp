@@ -9,7 +9,7 @@
 #include "options.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/isa.h"
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 
 namespace viewcells::cli {
 

@@ -8,7 +8,7 @@
 #include <sstream>
 
 #include "viewcells/core/error.h"
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 
 namespace viewcells::cli {
 

@@ -14,7 +14,7 @@
 #include "viewcells/agvs/penumbra.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 #include "viewcells/scene/generators.h"
 
 namespace viewcells {

@@ -12,7 +12,8 @@
 #include "viewcells/core/rng.h"
 #include "viewcells/bsp/adjacency.h"
 #include "viewcells/bsp/subdivision.h"
-#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/cells/hierarchy_file.h"
+#include "viewcells/vis/cell_views.h"
 #include "viewcells/sampling/sampler.h"
 #include "viewcells/scene/generators.h"
 

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/core/error.h"
 #include "viewcells/eval/compare.h"
 #include "viewcells/eval/evaluate.h"

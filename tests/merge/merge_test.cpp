@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/merge/merge.h"

@@ -7,7 +7,7 @@
 
 #include "support/test_scenes.h"
 #include "viewcells/core/error.h"
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pipeline/bake.h"
 #include "viewcells/pipeline/cut.h"

@@ -8,7 +8,8 @@
 #include <fstream>
 
 #include "support/test_scenes.h"
-#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/cells/hierarchy_file.h"
+#include "viewcells/core/error.h"
 #include "viewcells/core/rng.h"
 #include "viewcells/merge/merge.h"
 #include "viewcells/pvs/pvs.h"

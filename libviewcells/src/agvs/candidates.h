@@ -7,7 +7,7 @@
 #include <set>
 
 #include "viewcells/core/vec3.h"
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 #include "viewcells/sampling/segments.h"
 
 namespace viewcells::agvs_detail {

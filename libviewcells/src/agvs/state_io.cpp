@@ -9,32 +9,6 @@ constexpr char kStateMagic[5] = "VAGS";
 constexpr uint32_t kStateVersion = 3;
 }  // namespace
 
-void GlobalPvs::save(ByteWriter& w) const {
-  w.put(cells_);
-  w.put(objects_);
-  w.put_array(bits_);
-}
-
-GlobalPvs GlobalPvs::load(ByteReader& r, uint32_t cells, uint32_t objects) {
-  const uint32_t file_cells = r.get<uint32_t>();
-  const uint32_t file_objects = r.get<uint32_t>();
-  if (file_cells != cells || file_objects != objects) r.fail("the PVS table does not match the cells and objects");
-  GlobalPvs p(cells, objects);
-  std::vector<uint64_t> bits;
-  r.get_array(bits, p.bits_.size());
-  if (bits.size() != p.bits_.size()) r.fail("PVS rows of the wrong size");
-  p.bits_ = std::move(bits);
-  for (uint32_t c = 0; c < p.cells_; ++c) {
-    uint32_t n = 0;
-    for (size_t w = 0; w < p.words_; ++w) n += static_cast<uint32_t>(__builtin_popcountll(p.bits_[c * p.words_ + w]));
-    if (p.words_ && p.objects_ % 64 && (p.bits_[c * p.words_ + p.words_ - 1] >> (p.objects_ % 64)))
-      r.fail("PVS names objects that do not exist");
-    p.sizes_[c] = n;
-    p.entries_ += n;
-  }
-  return p;
-}
-
 void AgvsSolver::save(const std::string& path, uint64_t identity) const {
   const Impl& m = *impl_;
   ByteWriter w;

@@ -759,4 +759,30 @@ Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const Cost
   return out;
 }
 
+std::vector<std::vector<uint32_t>> leaf_pvs(const Subdivision& s, const SegmentSet& segments) {
+  std::vector<std::vector<uint32_t>> pvs(s.nodes.size());
+  for (int32_t leaf : s.leaves()) {
+    auto& ids = pvs[leaf];
+    for (uint32_t i : s.segments[leaf])
+      for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
+        if (o != kNoObject) ids.push_back(o);
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  }
+  return pvs;
+}
+
+void rebuild_cells(Subdivision& s) {
+  s.cells.assign(s.nodes.size(), ConvexPolyhedron());
+  s.cells[0] = ConvexPolyhedron::box(s.view_box, 0);
+  for (const SplitRecord& r : s.splits) {
+    const BspNode& n = s.nodes[r.node];
+    auto halves = s.cells[r.node].split(s.planes[n.plane], n.plane);
+    if (!halves) throw Error("replaying split of node " + std::to_string(r.node) + " failed (corrupt file?)");
+    s.cells[n.child[0]] = std::move(halves->first);
+    s.cells[n.child[1]] = std::move(halves->second);
+    s.cells[r.node] = ConvexPolyhedron();
+  }
+}
+
 }  // namespace viewcells

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <set>
 
-#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/core/error.h"
 #include "viewcells/merge/merge.h"
 

@@ -8,7 +8,7 @@
 #include <unordered_map>
 
 #include "viewcells/core/error.h"
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 #include "viewcells/io/scene_io.h"
 
 namespace viewcells {

@@ -12,7 +12,7 @@
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 #include "viewcells/pipeline/cut.h"
 #include "viewcells/pipeline/pvs.h"
 

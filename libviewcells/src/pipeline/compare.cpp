@@ -8,7 +8,7 @@
 #include "text.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 #include "viewcells/pipeline/report.h"
 #include "viewcells/q3/view_space.h"
 

@@ -6,7 +6,7 @@
 #include "text.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/progress.h"
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 #include "viewcells/io/scene_io.h"
 
 namespace viewcells::pipeline {

@@ -7,7 +7,7 @@
 
 #include "text.h"
 #include "viewcells/core/isa.h"
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 
 namespace viewcells::pipeline {
 

@@ -4,9 +4,10 @@
 #include <iterator>
 #include <map>
 
-#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/cells/view_cells.h"
+#include "viewcells/bsp/bsp_io.h"
 #include "viewcells/core/error.h"
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 
 namespace viewcells {
 
@@ -174,10 +175,7 @@ std::vector<uint32_t> unrle_row(const std::string& row, uint32_t object_count) {
   return out;
 }
 
-int32_t PvsFile::locate(const Vec3& p) const {
-  const int32_t leaf = bsp.locate(p);
-  return leaf < 0 ? -1 : leaf_cell[leaf];
-}
+int32_t PvsFile::locate(const Vec3& p) const { return locate_cell(bsp, leaf_cell, p); }
 
 PvsFile make_pvs_file(const Subdivision& s, const std::vector<std::vector<uint32_t>>& leaf_pvs,
                       const MergeHistory& h, const std::vector<int32_t>& cells) {

@@ -9,7 +9,7 @@
 #include <limits>
 #include <unordered_map>
 
-#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/core/error.h"
 #include "viewcells/pvs/pvs.h"
 

@@ -7,7 +7,7 @@
 #include <sys/mman.h>
 #endif
 
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 
 namespace viewcells {
 

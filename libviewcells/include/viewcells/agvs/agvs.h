@@ -22,76 +22,13 @@
 #include <vector>
 
 #include "viewcells/bsp/subdivision.h"
+#include "viewcells/cells/view_cells.h"
+#include "viewcells/pvs/global_pvs.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
 #include "viewcells/scene/scene.h"
 
 namespace viewcells {
-
-class ByteWriter;
-class ByteReader;
-
-/// View cells for global visibility: a BSP whose leaves map to cells (a PvsFile's, or any
-/// subdivision's leaves with a leaf -> cell map). Point location, the cells a segment
-/// pierces, and each cell's bounds and volume (from the BSP's convex cells).
-class CellLocator {
- public:
-  /// `leaf_cell` per node of `bsp` (-1 for inner nodes); every leaf in a cell < cell_count.
-  CellLocator(Subdivision bsp, std::vector<int32_t> leaf_cell, uint32_t cell_count);
-  uint32_t cell_count() const { return cell_count_; }
-  const Box3& view_box() const { return bsp_.view_box; }
-  /// The cell containing p, or -1 outside the view box.
-  int32_t cell_at(const Vec3& p) const;
-  /// The cells the segment a-b (inside the view box) has length in, sorted, into `out`.
-  void cells_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
-                        std::vector<std::tuple<int32_t, double, double>>& stack,
-                        std::vector<int32_t>& leaves) const;
-  const Box3& cell_bounds(uint32_t c) const { return bounds_[c]; }
-  /// Per cell, the cells sharing a part of its boundary of positive area, sorted.
-  std::vector<std::vector<uint32_t>> neighbours() const;
-  double cell_volume(uint32_t c) const { return volume_[c]; }
-
- private:
-  Subdivision bsp_;
-  std::vector<int32_t> leaf_cell_;
-  uint32_t cell_count_ = 0;
-  std::vector<Box3> bounds_;
-  std::vector<double> volume_;
-};
-
-/// The PVS of every cell as a bit row over the objects; entries are only ever added.
-class GlobalPvs {
- public:
-  GlobalPvs() = default;
-  GlobalPvs(uint32_t cells, uint32_t objects);
-  /// The table of per-cell object lists (ids < objects).
-  static GlobalPvs from_lists(uint32_t objects, const std::vector<std::vector<uint32_t>>& lists);
-  uint32_t cell_count() const { return cells_; }
-  uint32_t object_count() const { return objects_; }
-  bool contains(uint32_t cell, uint32_t object) const {
-    return (bits_[size_t(cell) * words_ + object / 64] >> (object % 64)) & 1;
-  }
-  /// Adds the entry; true when it is new.
-  bool insert(uint32_t cell, uint32_t object);
-  /// Removes the entry (dynamic edits only); true when it was there.
-  bool erase(uint32_t cell, uint32_t object);
-  uint32_t size(uint32_t cell) const { return sizes_[cell]; }
-  uint64_t entries() const { return entries_; }
-  /// Entries that `other` (of the same shape) has too.
-  uint64_t common_entries(const GlobalPvs& other) const;
-  std::vector<uint32_t> list(uint32_t cell) const;  ///< sorted object ids
-  bool operator==(const GlobalPvs& o) const { return cells_ == o.cells_ && objects_ == o.objects_ && bits_ == o.bits_; }
-  void save(ByteWriter& w) const;
-  /// Reads what save() wrote; Error unless it has `cells` rows over `objects` objects.
-  static GlobalPvs load(ByteReader& r, uint32_t cells, uint32_t objects);
-
- private:
-  uint32_t cells_ = 0, objects_ = 0;
-  size_t words_ = 0;
-  std::vector<uint64_t> bits_;
-  std::vector<uint32_t> sizes_;
-  uint64_t entries_ = 0;
-};
 
 /// Adds a visibility sample's objects (kNoObject: none) to the PVS of every cell in `cells`
 /// (those its segment pierces) and returns its contribution there, equation 2: the number of

@@ -151,4 +151,11 @@ bool use_geometry_aligned(const Scene& scene, const SubdivisionConfig& config, s
 Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const CostModel& model,
                       const SubdivisionConfig& config);
 
+/// Sorted object ids seen by the segments of each leaf of `s` (per node; empty for inner nodes).
+std::vector<std::vector<uint32_t>> leaf_pvs(const Subdivision& s, const SegmentSet& segments);
+
+/// Recomputes the leaf polyhedra (s.cells) by replaying the splits from the view box (a
+/// subdivision read from disk keeps only its tree).
+void rebuild_cells(Subdivision& s);
+
 }  // namespace viewcells

@@ -7,7 +7,8 @@
 
 #include "viewcells/bsp/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
-#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/cells/hierarchy_file.h"
+#include "viewcells/vis/cell_views.h"
 #include "viewcells/pipeline/sampling.h"
 
 namespace viewcells::pipeline {

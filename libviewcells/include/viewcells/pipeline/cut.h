@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "viewcells/bsp/subdivision_io.h"
+#include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/merge/merge.h"
 #include "viewcells/pipeline/build.h"
 #include "viewcells/pvs/pvs.h"

@@ -1,4 +1,4 @@
-#include "viewcells/io/binary_file.h"
+#include "viewcells/core/binary_file.h"
 
 #include <unistd.h>
 #include <zstd.h>

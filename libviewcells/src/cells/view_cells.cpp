@@ -1,0 +1,68 @@
+#include "viewcells/cells/view_cells.h"
+
+#include <algorithm>
+
+#include "viewcells/bsp/adjacency.h"
+#include "viewcells/core/error.h"
+
+namespace viewcells {
+
+int32_t locate_cell(const Subdivision& bsp, const std::vector<int32_t>& leaf_cell, const Vec3& p) {
+  const int32_t leaf = bsp.locate(p);
+  return leaf < 0 ? -1 : leaf_cell[leaf];
+}
+
+CellLocator::CellLocator(Subdivision bsp, std::vector<int32_t> leaf_cell, uint32_t cell_count)
+    : bsp_(std::move(bsp)), leaf_cell_(std::move(leaf_cell)), cell_count_(cell_count) {
+  if (bsp_.nodes.empty() || leaf_cell_.size() != bsp_.nodes.size()) throw Error("the view cells need a BSP");
+  if (cell_count_ == 0) throw Error("there are no view cells");
+  for (size_t n = 0; n < bsp_.nodes.size(); ++n)
+    if (bsp_.nodes[n].plane < 0 && (leaf_cell_[n] < 0 || leaf_cell_[n] >= static_cast<int32_t>(cell_count_)))
+      throw Error("BSP leaf " + std::to_string(n) + " has no view cell");
+  bounds_.assign(cell_count_, Box3{});
+  volume_.assign(cell_count_, 0.0);
+  clip_to_leaves(bsp_, ConvexPolyhedron::box(bsp_.view_box, 0), [&](int32_t n, const ConvexPolyhedron& part) {
+    bounds_[leaf_cell_[n]].extend(part.bounds());
+    volume_[leaf_cell_[n]] += part.volume();
+  });
+  for (uint32_t c = 0; c < cell_count_; ++c)
+    if (!(volume_[c] > 0)) throw Error("view cell " + std::to_string(c) + " has no volume");
+}
+
+int32_t CellLocator::cell_at(const Vec3& p) const { return locate_cell(bsp_, leaf_cell_, p); }
+
+void CellLocator::cells_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
+                                   std::vector<std::tuple<int32_t, double, double>>& stack,
+                                   std::vector<int32_t>& leaves) const {
+  leaves.clear();
+  bsp_.leaves_of_segment(a, b, leaves, stack);
+  out.clear();
+  for (int32_t l : leaves) out.push_back(leaf_cell_[l]);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+std::vector<std::vector<uint32_t>> CellLocator::neighbours() const {
+  std::vector<std::vector<uint32_t>> out(cell_count_);
+  // The leaves' convex cells (a BSP read from a file has none), replayed from the view box.
+  Subdivision with_cells = bsp_;
+  with_cells.cells.assign(bsp_.nodes.size(), ConvexPolyhedron());
+  clip_to_leaves(bsp_, ConvexPolyhedron::box(bsp_.view_box, 0),
+                 [&](int32_t n, const ConvexPolyhedron& part) { with_cells.cells[n] = part; });
+  std::vector<int32_t> leaves;
+  for (size_t n = 0; n < bsp_.nodes.size(); ++n)
+    if (bsp_.nodes[n].plane < 0) leaves.push_back(static_cast<int32_t>(n));
+  for (const LeafAdjacency& a : leaf_adjacency(with_cells, leaves)) {
+    const int32_t ca = leaf_cell_[a.a], cb = leaf_cell_[a.b];
+    if (ca == cb) continue;
+    out[ca].push_back(static_cast<uint32_t>(cb));
+    out[cb].push_back(static_cast<uint32_t>(ca));
+  }
+  for (auto& list : out) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return out;
+}
+
+}  // namespace viewcells
