@@ -28,22 +28,7 @@ for r in $(seq "$runs"); do
     "${bin[$side]}" -q sample "$city" --segments 1000000 --measure-raw -o "$dir/ab.vseg" --report "$dir/ab-s.json"
     "${bin[$side]}" -q build "$city" --segments 300000 --max-cells 20000 --min-reduction 0 -o "$dir/ab.vcells" \
       --report "$dir/ab-b.json"
-    python3 -c "
-import json
-s = json.load(open('$dir/ab-s.json'))['timings']
-b = json.load(open('$dir/ab-b.json'))['timings']
-print('$side', s['segments_per_second'] / 1e6, s['raw_rays_per_second'] / 1e6, b['subdivision_seconds'], b['merge_seconds'], sep='\t')
-" >>"$results"
+    python3 scripts/vctables.py ab-row "$side" "$dir/ab-s.json" "$dir/ab-b.json" >>"$results"
   done
 done
-python3 - "$results" "$sha" "$runs" "$size" <<'EOF'
-import statistics, sys
-rows = [l.split('\t') for l in open(sys.argv[1]).read().split('\n') if l]
-med = {side: [statistics.median(float(r[k]) for r in rows if r[0] == side) for k in range(1, 5)] for side in ('old', 'new')}
-names = ['sampling Msegments/s', 'raw Embree Mrays/s', 'subdivision s (20k cells)', 'merge s (20k cells)']
-print(f"Command: `scripts/bench-ab.sh {sys.argv[2]} {sys.argv[3]} {sys.argv[4]}`; city size {sys.argv[4]}, medians of {sys.argv[3]} alternating runs\n")
-print('| quantity | old (' + sys.argv[2] + ') | new | new / old |')
-print('| --- | ---: | ---: | ---: |')
-for n, o, w in zip(names, med['old'], med['new']):
-    print(f'| {n} | {o:.2f} | {w:.2f} | {w / o:.3f} |')
-EOF
+python3 scripts/vctables.py ab "$results" "$sha" "$runs" "$size"

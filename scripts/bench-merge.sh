@@ -22,30 +22,6 @@ for n in 2000 200 20; do
   "$vc" compress "$dir/office-merge.vcells" --count "$n" -o "$dir/office-$n.pvs" --flat "$dir/office-$n.vflt" \
     --report "$dir/compress-office-$n.json" -q
 done
-python3 - "$dir" "$size" "$cells" <<'PY' > "$dir/merge-table.md"
-import json, sys
-d, size, cells = sys.argv[1], sys.argv[2], int(sys.argv[3])
-print(f"Merging: the city of size {size} (seed 1), 1.5M segments, {cells:,} AV-S cells merged down to one; "
-      "the office of size 4, 1M samples, 2,000 cells. Threads = 2.\n")
-print("| scene | cells merged | subdivision s | merge s | pair costs evaluated | stale entries skipped | cost at all cells | at 1/10 | at 1/100 |")
-print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
-for name in ["city", "office"]:
-    r = json.load(open(f"{d}/merge-{name}.json")); m = r["merge"]; t = r["timings"]
-    curve = {p["cells"]: p["cost"] for p in m["cost_at_power_of_two_cells"]}
-    n = m["cells_from"]
-    def near(k):
-        c = min(curve, key=lambda x: abs(x - k)); return f"{curve[c]:,.0f} ({c:,})"
-    print(f"| {name} | {n:,} | {t['subdivision_seconds']:.1f} | {t['merge_seconds']:.2f} | {m['pair_costs_evaluated']:,} | "
-          f"{m['stale_entries_skipped']:,} | {r['final_cost']:,.0f} | {near(n / 10)} | {near(n / 100)} |")
-print("\nCompression of the sampled PVSs through the merge history (`viewcells compress`):\n")
-print("| scene | view cells | objects | PVS entries | kept after | ratio | varint bytes before | after | .pvs file bytes | bit rows bytes | Quake RLE bytes |")
-print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
-for name, counts in [("city", [cells, 5000, 500, 50]), ("office", [2000, 200, 20])]:
-    for n in counts:
-        r = json.load(open(f"{d}/compress-{name}-{n}.json"))
-        print(f"| {name} | {r['cells']:,} | {r['objects']:,} | {r['entries_before']:,} | {r['entries_after']:,} | "
-              f"{r['entry_ratio']:.3f} | {r['varint_bytes_before']:,} | {r['varint_bytes_after']:,} | {r['file_bytes']:,} | "
-              f"{r['flat']['bit_row_bytes']:,} | {r['flat']['run_length_bytes']:,} |")
-PY
-python3 scripts/replace-section.py BENCHMARKS.md merging "scripts/bench-merge.sh $size $cells" "$dir/merge-table.md"
+python3 scripts/vctables.py merging "$dir" "$size" "$cells" > "$dir/merge-table.md"
+python3 scripts/vctables.py replace-section BENCHMARKS.md merging "scripts/bench-merge.sh $size $cells" "$dir/merge-table.md"
 cat "$dir/merge-table.md"

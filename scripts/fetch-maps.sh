@@ -37,20 +37,7 @@ for deb in "$cache"/debs/*.deb; do
   dpkg-deb -x "$deb" "$tmp"
   # Later archives (pak2 over pak1, 0.8.8 over 0.8.5) replace earlier versions of a map.
   find "$tmp" -name '*.pk3' | sort | while read -r pk3; do
-    python3 - "$pk3" "$cache/bsp" <<'PY'
-import os, sys, zipfile
-pk3, out = sys.argv[1], sys.argv[2]
-with zipfile.ZipFile(pk3) as z:
-    for info in z.infolist():
-        name = info.filename
-        if name.lower().startswith("maps/") and name.lower().endswith(".bsp"):
-            target = os.path.join(out, os.path.basename(name))
-            data = z.read(info)
-            tmp = target + ".tmp"
-            with open(tmp, "wb") as f:
-                f.write(data)
-            os.replace(tmp, target)
-PY
+    python3 scripts/vctables.py unpack-maps "$pk3" "$cache/bsp"
   done
   rm -rf "$tmp"
   touch "$stamp"

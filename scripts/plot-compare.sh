@@ -9,35 +9,9 @@ dir="$1"
 title="${2:-$(basename "$dir")}"
 [ -f "$dir/curves.csv" ] || { echo "plot-compare: $dir/curves.csv not found (run viewcells compare first)" >&2; exit 1; }
 command -v gnuplot >/dev/null || { echo "plot-compare: gnuplot is missing (bash scripts/install-deps.sh)" >&2; exit 1; }
-methods=$(python3 -c "
-import csv; seen=[]
-for r in csv.DictReader(open('$dir/curves.csv')):
-    if r['method'] not in seen: seen.append(r['method'])
-print(' '.join(seen))")
+methods=$(python3 "$(dirname "$0")/vctables.py" compare-methods "$dir/curves.csv")
 # Volume-weighted histograms of the cells' render cost, 24 common bins.
-python3 - "$dir" <<'PY'
-import csv, sys
-d = sys.argv[1]
-rows = list(csv.DictReader(open(f"{d}/histogram.csv")))
-if not rows:
-    open(f"{d}/histogram.dat", "w").write("")
-    sys.exit()
-top = max(float(r["cost"]) for r in rows) or 1.0
-bins = 24
-methods = []
-for r in rows:
-    if r["method"] not in methods: methods.append(r["method"])
-share = {m: [0.0] * bins for m in methods}
-total = {m: 0.0 for m in methods}
-for r in rows:
-    b = min(bins - 1, int(float(r["cost"]) / top * bins))
-    share[r["method"]][b] += float(r["volume"])
-    total[r["method"]] += float(r["volume"])
-with open(f"{d}/histogram.dat", "w") as f:
-    f.write("cost " + " ".join(methods) + "\n")
-    for b in range(bins):
-        f.write(f"{(b + 0.5) * top / bins:.6g} " + " ".join(f"{share[m][b] / total[m]:.6g}" for m in methods) + "\n")
-PY
+python3 "$(dirname "$0")/vctables.py" compare-histogram "$dir"
 gnuplot <<GP
 set datafile separator ","
 set terminal pngcairo size 900,600 font ",11"

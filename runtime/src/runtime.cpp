@@ -224,6 +224,11 @@ struct vc_pvs {
   std::vector<GeneralPlane> planes;
   std::vector<uint64_t> offsets;  // per cell + 1, into ids
   std::vector<uint32_t> ids;      // every cell's visible objects, sorted per cell
+  // A uniform grid over the view box: per grid cell, the deepest BSP node whose subtree holds
+  // the whole grid cell (slightly enlarged), where location starts instead of at the root.
+  int grid_n[3] = {1, 1, 1};
+  double grid_scale[3] = {0, 0, 0};
+  std::vector<uint32_t> grid_start;
 };
 
 namespace {
@@ -366,6 +371,64 @@ void read_lists(Reader& r, vc_pvs& f, uint64_t max_items) {
   }
 }
 
+/// The deepest node whose subtree holds the whole box [lo, hi]: below it, every point of the
+/// box takes the same branch at every node (a plane's side is linear in the point, so the
+/// corners decide: all on the negative side or on the plane, or all strictly positive).
+uint32_t deepest_node(const vc_pvs& f, const double lo[3], const double hi[3]) {
+  uint32_t n = 0;
+  while (f.nodes[n].right) {
+    const Node& node = f.nodes[n];
+    const uint32_t axis = node.meta >> 30;
+    bool all_neg = true, all_pos = true;
+    if (axis < 3) {
+      all_neg = hi[axis] <= node.offset;
+      all_pos = lo[axis] > node.offset;
+    } else {
+      for (int c = 0; c < 8 && (all_neg || all_pos); ++c) {
+        const Vec corner{{(c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]}};
+        const int side = orientation(f.planes[node.meta & kIndex], corner);
+        all_neg &= side <= 0;
+        all_pos &= side > 0;
+      }
+    }
+    if (!all_neg && !all_pos) break;
+    n = all_pos ? node.right : n + 1;
+  }
+  return n;
+}
+
+/// About two grid cells per BSP node, cubes as near as the box allows, at most 2^21 in all.
+void build_grid(vc_pvs& f) {
+  double extent[3], volume = 1;
+  for (int k = 0; k < 3; ++k) volume *= extent[k] = f.hi[k] - f.lo[k];
+  const double target = std::min<double>(2.0 * f.nodes.size(), 1 << 21);
+  const double side = std::cbrt(volume / target);
+  size_t total = 1;
+  for (int k = 0; k < 3; ++k) {
+    const double n = std::ceil(extent[k] / side);
+    f.grid_n[k] = static_cast<int>(std::clamp(std::isfinite(n) ? n : 1.0, 1.0, 256.0));
+    f.grid_scale[k] = f.grid_n[k] / extent[k];
+    total *= static_cast<size_t>(f.grid_n[k]);
+  }
+  f.grid_start.resize(total);
+  // Each grid cell enlarged by far more than the rounding of a point's grid index, so that a
+  // point given to a cell lies in its enlarged box.
+  double margin[3];
+  for (int k = 0; k < 3; ++k) margin[k] = 1e-9 * (std::fabs(f.lo[k]) + std::fabs(f.hi[k]) + extent[k]);
+  size_t at = 0;
+  for (int z = 0; z < f.grid_n[2]; ++z)
+    for (int y = 0; y < f.grid_n[1]; ++y)
+      for (int x = 0; x < f.grid_n[0]; ++x) {
+        const int i[3] = {x, y, z};
+        double lo[3], hi[3];
+        for (int k = 0; k < 3; ++k) {
+          lo[k] = f.lo[k] + extent[k] * i[k] / f.grid_n[k] - margin[k];
+          hi[k] = f.lo[k] + extent[k] * (i[k] + 1) / f.grid_n[k] + margin[k];
+        }
+        f.grid_start[at++] = deepest_node(f, lo, hi);
+      }
+}
+
 void read_file(const std::string& path, vc_pvs& f) {
   const std::string payload = read_container(path);
   Reader r(payload);
@@ -389,6 +452,7 @@ void read_file(const std::string& path, vc_pvs& f) {
     n.list[0] = static_cast<uint32_t>(f.offsets[n.meta]);
     n.list[1] = static_cast<uint32_t>(f.offsets[n.meta + 1] - f.offsets[n.meta]);
   }
+  build_grid(f);
 }
 
 void put_error(char* error, size_t size, const std::string& text) {
@@ -450,6 +514,7 @@ size_t vc_pvs_memory_bytes(const vc_pvs* pvs) {
   size_t n = sizeof(vc_pvs) + pvs->rule.capacity();
   for (const std::string& s : pvs->names) n += sizeof(s) + s.capacity();
   return n + pvs->nodes.capacity() * sizeof(Node) + pvs->planes.capacity() * sizeof(GeneralPlane) +
+         pvs->grid_start.capacity() * sizeof(uint32_t) +
          pvs->offsets.capacity() * sizeof(uint64_t) + pvs->ids.capacity() * sizeof(uint32_t);
 }
 
@@ -458,10 +523,15 @@ namespace {
 /// The leaf holding p, or null outside the view box (NaN coordinates included).
 inline const Node* leaf_at(const vc_pvs* pvs, double x, double y, double z) {
   const Vec p{{x, y, z}};
-  for (int k = 0; k < 3; ++k)
-    if (!(p.v[k] >= pvs->lo[k] && p.v[k] <= pvs->hi[k])) return nullptr;
+  size_t cell = 0, stride = 1;
+  for (int k = 0; k < 3; ++k) {
+    if (!(p.v[k] >= pvs->lo[k] && p.v[k] <= pvs->hi[k])) return nullptr;  // NaN fails too
+    const int i = std::min(static_cast<int>((p.v[k] - pvs->lo[k]) * pvs->grid_scale[k]), pvs->grid_n[k] - 1);
+    cell += stride * static_cast<size_t>(i);
+    stride *= static_cast<size_t>(pvs->grid_n[k]);
+  }
   const Node* nodes = pvs->nodes.data();
-  const Node* n = nodes;
+  const Node* n = nodes + pvs->grid_start[cell];
   while (n->right) {
     const uint32_t axis = n->meta >> 30;
     const bool positive = axis < 3 ? p.v[axis] > n->offset : orientation(pvs->planes[n->meta & kIndex], p) > 0;

@@ -1,0 +1,690 @@
+#!/usr/bin/env python3
+"""vctables: every table, plot data file and document section that the benchmark and result
+scripts make from viewcells' JSON reports and CSV files, in one tested module
+(tests/scripts/vctables_test.py). The scripts run the commands; this turns what they wrote
+into the numbers of BENCHMARKS.md and docs/.
+
+Usage: vctables.py COMMAND ARGS...   (vctables.py --help lists the commands)
+"""
+import csv
+import glob
+import json
+import math
+import os
+import re
+import statistics
+import sys
+import zipfile
+
+COMMANDS = {}
+
+
+def command(args):
+    """Registers a command taking the positional arguments `args` (for --help)."""
+    def register(f):
+        COMMANDS[f.__name__.replace("_", "-")] = (f, args, (f.__doc__ or "").strip())
+        return f
+    return register
+
+
+@command("DIR RUNS SIZE")
+def sampling(*args):
+    """BENCHMARKS.md, sampling: medians of the sample reports of both view spaces."""
+    argv = ["vctables"] + list(args)
+    d, runs, size = argv[1], int(argv[2]), argv[3]
+    rows = []
+    for name in ["scene-bounds", "street-band"]:
+        reps = [json.load(open(f"{d}/sample-{name}-{r}.json")) for r in range(1, runs + 1)]
+        med = lambda f: statistics.median(f(x) for x in reps)
+        t = lambda x: x["timings"]
+        c = lambda x: x["counts"]
+        half_raw = lambda x: t(x)["raw_rays_per_second"] / 2
+        rows.append((name,
+                     reps[0]["scene"]["triangles"],
+                     med(lambda x: c(x)["valid_segments"]),
+                     med(lambda x: c(x)["samples"]),
+                     med(lambda x: c(x)["valid_segments"] / c(x)["samples"]),
+                     med(lambda x: t(x)["raw_rays_per_second"]) / 1e6,
+                     med(lambda x: t(x)["samples_per_second"]) / 1e6,
+                     med(lambda x: t(x)["segments_per_second"]) / 1e6,
+                     med(lambda x: t(x)["samples_per_second"] / half_raw(x)),
+                     med(lambda x: t(x)["segments_per_second"] / half_raw(x)),
+                     reps[0]["settings"]["threads"]))
+    print(f"City size {size}, seed 1; {runs} runs per row (seeds 1..{runs}), medians; threads = {rows[0][10]}.\n")
+    print("| view space | triangles | segments | samples | valid share | raw Embree Mrays/s | Msamples/s | Msegments/s | samples/s ÷ ½ raw | segments/s ÷ ½ raw |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for r in rows:
+        print(f"| {r[0]} | {r[1]:,} | {r[2]:,.0f} | {r[3]:,.0f} | {r[4]:.3f} | {r[5]:.2f} | {r[6]:.2f} | {r[7]:.2f} | {r[8]:.3f} | {r[9]:.3f} |")
+
+
+@command("DIR SIZE CELLS")
+def subdivision(*args):
+    """BENCHMARKS.md, subdivision: time per phase at 0.5M-2M segments, and the growth per doubling."""
+    argv = ["vctables"] + list(args)
+    d, size, cells = argv[1], argv[2], argv[3]
+    print(f"City size {size} (seed 1), {int(cells):,} cells, default view box, no stagnation stop, threads = 2.\n")
+    print("| segments | load s | BVH s | sampling s | subdivision s | write s | cells | initial cost | final cost | axis candidates | GA candidates |")
+    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    base = None
+    for n in [500000, 1000000, 1500000, 2000000]:
+        r = json.load(open(f"{d}/build-{n}.json")); t = r["timings"]; s = r["subdivision"]
+        print(f"| {n:,} | {t['load_seconds']:.2f} | {t['bvh_build_seconds']:.2f} | {t['sampling_seconds']:.2f} | "
+              f"{t['subdivision_seconds']:.1f} | {t['write_seconds']:.2f} | {s['cells']:,} | {s['initial_cost']:,.0f} | "
+              f"{s['final_cost']:,.0f} | {s['axis_candidates_evaluated']:,} | {s['geometry_candidates_evaluated']:,} |")
+    ts = {n: json.load(open(f"{d}/build-{n}.json"))["timings"]["subdivision_seconds"] for n in [500000, 1000000, 2000000]}
+    print(f"\nSubdivision time ratios: 1M / 0.5M = {ts[1000000] / ts[500000]:.2f}, 2M / 1M = {ts[2000000] / ts[1000000]:.2f} "
+          "(2.0 would be linear in the number of segments).")
+
+
+@command("DIR SIZE CELLS")
+def merging(*args):
+    """BENCHMARKS.md, merging: merge and compression reports of the city and the office."""
+    argv = ["vctables"] + list(args)
+    d, size, cells = argv[1], argv[2], int(argv[3])
+    print(f"Merging: the city of size {size} (seed 1), 1.5M segments, {cells:,} AV-S cells merged down to one; "
+          "the office of size 4, 1M samples, 2,000 cells. Threads = 2.\n")
+    print("| scene | cells merged | subdivision s | merge s | pair costs evaluated | stale entries skipped | cost at all cells | at 1/10 | at 1/100 |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for name in ["city", "office"]:
+        r = json.load(open(f"{d}/merge-{name}.json")); m = r["merge"]; t = r["timings"]
+        curve = {p["cells"]: p["cost"] for p in m["cost_at_power_of_two_cells"]}
+        n = m["cells_from"]
+        def near(k):
+            c = min(curve, key=lambda x: abs(x - k)); return f"{curve[c]:,.0f} ({c:,})"
+        print(f"| {name} | {n:,} | {t['subdivision_seconds']:.1f} | {t['merge_seconds']:.2f} | {m['pair_costs_evaluated']:,} | "
+              f"{m['stale_entries_skipped']:,} | {r['final_cost']:,.0f} | {near(n / 10)} | {near(n / 100)} |")
+    print("\nCompression of the sampled PVSs through the merge history (`viewcells compress`):\n")
+    print("| scene | view cells | objects | PVS entries | kept after | ratio | varint bytes before | after | .pvs file bytes | bit rows bytes | Quake RLE bytes |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for name, counts in [("city", [cells, 5000, 500, 50]), ("office", [2000, 200, 20])]:
+        for n in counts:
+            r = json.load(open(f"{d}/compress-{name}-{n}.json"))
+            print(f"| {name} | {r['cells']:,} | {r['objects']:,} | {r['entries_before']:,} | {r['entries_after']:,} | "
+                  f"{r['entry_ratio']:.3f} | {r['varint_bytes_before']:,} | {r['varint_bytes_after']:,} | {r['file_bytes']:,} | "
+                  f"{r['flat']['bit_row_bytes']:,} | {r['flat']['run_length_bytes']:,} |")
+
+
+@command("RESULTS_TSV SHA RUNS SIZE")
+def ab(*args):
+    """BENCHMARKS.md, ab: medians of alternating old/new runs (rows from ab-row) and their ratios."""
+    argv = ["vctables"] + list(args)
+    rows = [l.split('\t') for l in open(argv[1]).read().split('\n') if l]
+    med = {side: [statistics.median(float(r[k]) for r in rows if r[0] == side) for k in range(1, 5)] for side in ('old', 'new')}
+    names = ['sampling Msegments/s', 'raw Embree Mrays/s', 'subdivision s (20k cells)', 'merge s (20k cells)']
+    print(f"Command: `scripts/bench-ab.sh {argv[2]} {argv[3]} {argv[4]}`; city size {argv[4]}, medians of {argv[3]} alternating runs\n")
+    print('| quantity | old (' + argv[2] + ') | new | new / old |')
+    print('| --- | ---: | ---: | ---: |')
+    for n, o, w in zip(names, med['old'], med['new']):
+        print(f'| {n} | {o:.2f} | {w:.2f} | {w / o:.3f} |')
+
+
+@command("OUT KIND SIZE CELLS SECONDS")
+def agvs(*args):
+    """BENCHMARKS.md, agvs-KINDSIZE: AGVS, SGVS and REF reports; writes OUT/METHOD.dat for the plots."""
+    argv = ["vctables"] + list(args)
+    out, kind, size, cells, seconds = argv[1:6]
+    r = {m: json.load(open(f"{out}/{m}.json")) for m in ("agvs", "sgvs", "ref")}
+    for m in r:
+        with open(f"{out}/{m}.dat", "w") as f:
+            for p in r[m]["curve"]:
+                err = p["pixel_error"] if p["pixel_error"] is not None else float("nan")
+                bound = p["pixel_error_bound"] if p.get("pixel_error_bound") is not None else float("nan")
+                f.write(f"{p['seconds']} {p['mean_pvs_size']} {err} {bound}\n")
+    def first_time(m, ok):
+        for p in r[m]["curve"]:
+            if ok(p):
+                return p["seconds"]
+        return None
+    def fmt_t(t):
+        return "not reached" if t is None else f"{t:.2f} s"
+    print(f"The {kind} of size {size} (seed 1): {cells} view cells cut from a merge history of AV-S cells, each method "
+          f"given {seconds} s; threads = 2.\n")
+    print("By mean PVS size (the acceptance test): the time AGVS needs to reach the mean PVS size each method reaches "
+          "at the end; the speed-up is that method's time over AGVS's.\n")
+    print("| method | samples | rays | mean PVS at the end | estimated pixel error | measured pixel error | "
+          "AGVS reaches this mean PVS after | speed-up of AGVS |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for m in ("agvs", "sgvs", "ref"):
+        final = r[m]["mean_pvs_size"]
+        t = first_time("agvs", lambda p: p["mean_pvs_size"] >= final)
+        est = r[m]["estimated_pixel_error"]
+        bound = r[m].get("pixel_error_bound")
+        meas = r[m]["measured_pixel_error"]["pixels"] if r[m]["measured_pixel_error"] else None
+        speed = r[m]["seconds"] / t if t and m != "agvs" else None
+        print(f"| {m.upper()} | {r[m]['samples']:,} | {r[m]['rays']:,} | {final:.2f} | "
+              f"{(f'< {bound:.2f}' if bound is not None else 'n/a') if est is None else f'{est:.2f}'} | "
+              f"{'n/a' if meas is None else f'{meas:.2f}'} | {fmt_t(t)} | {'' if speed is None else f'{speed:.1f} x'} |")
+    print("\nBy the entries themselves (robust to entries only AGVS finds): the time each method needs to find 95% of its "
+          "own final PVS entries, and the time AGVS needs to find 95% of that method's final entries.\n")
+    print("| method | final entries | AGVS has of them at the end | method finds 95% of them after | "
+          "AGVS finds 95% of them after | speed-up of AGVS |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: |")
+    for k, m in enumerate(("sgvs", "ref")):
+        entries = r[m]["pvs_entries"]
+        own = first_time(m, lambda p: p["mean_pvs_size"] * int(cells) >= 0.95 * entries - 1e-9)
+        agvs = first_time("agvs", lambda p: p["covered"][k] >= 0.95 * entries)
+        have = r["agvs"]["curve"][-1]["covered"][k] / entries
+        speed = own / agvs if own and agvs else None
+        print(f"| {m.upper()} | {entries:,} | {100 * have:.1f}% | {fmt_t(own)} | {fmt_t(agvs)} | "
+              f"{'' if speed is None else f'{speed:.1f} x'} |")
+    print(f"\nMeasured pixel error: 20,000 random cameras of 32x32 (90 degrees; wrong pixels come in clusters, so many "
+          f"small cameras measure better than few large ones), wrong pixels scaled to 1024x1024. '< x': too few wrong "
+          f"camera rays in the newer half of the run for equation 5's window; the error is below x with probability "
+          f"0.9. Dashed in the plot.\n")
+    print(f"\n![mean PVS](docs/agvs/{kind}{size}-pvs.png) ![pixel error](docs/agvs/{kind}{size}-error.png)\n")
+
+
+@command("OUT KIND SIZE CELLS MAX_SAMPLES CAMERAS CAMERA_SIZE")
+def estimator(*args):
+    """BENCHMARKS.md, estimator-KINDSIZE: estimated against measured pixel error; writes OUT/METHOD.dat."""
+    argv = ["vctables"] + list(args)
+    out, kind, size, cells, max_samples, cameras, camera_size = argv[1:8]
+    rows = {}
+    for m in ("sgvs", "agvs"):
+        runs = sorted((json.load(open(f)) for f in glob.glob(f"{out}/{m}-*.json")), key=lambda r: r["samples"])
+        rows[m] = runs
+        with open(f"{out}/{m}.dat", "w") as f:
+            for r in runs:
+                est = r["estimated_pixel_error"]; bound = r.get("pixel_error_bound")
+                meas = r["measured_pixel_error"]["pixels"]
+                f.write(f"{r['samples']} {est if est is not None else 'nan'} {bound if bound is not None else 'nan'} {meas}\n")
+    print(f"The {kind} of size {size} (seed 1), {cells} view cells; each method stopped at doubling sample counts "
+          f"(saved and resumed). Estimated: equation 5's window (P = 0.9, k = 0.5) of the camera rays (view "
+          f"space-direction rays from free space); measured: {cameras} random cameras of {camera_size}x{camera_size} "
+          f"(90 degrees) against the PVSs at that point. Both in pixels of a 1024x1024 image. Ratio: estimated over "
+          f"measured ('<': too few wrong camera rays in the newer half of the run for a window, the 90% upper bound "
+          f"instead).\n")
+    print("| method | samples | mean PVS | estimated | window (camera rays) | measured | ratio |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+    within = {}
+    for m, runs in rows.items():
+        for r in runs:
+            est = r["estimated_pixel_error"]; bound = r.get("pixel_error_bound")
+            meas = r["measured_pixel_error"]["pixels"]
+            shown = f"{est:.2f}" if est is not None else (f"< {bound:.2f}" if bound is not None else "n/a")
+            ratio = est / meas if est is not None and meas > 0 else None
+            if ratio is not None:
+                within.setdefault(m, []).append(0.5 <= ratio <= 2)
+            print(f"| {m.upper()} | {r['samples']:,} | {r['mean_pvs_size']:.2f} | {shown} | "
+                  f"{r['estimator_window_rays']:,} | {meas:.2f} | {'' if ratio is None else f'{ratio:.2f}'} |")
+    print()
+    for m, w in within.items():
+        print(f"- {m.upper()}: the estimate is within a factor of 2 of the measurement at {sum(w)} of {len(w)} stops "
+              f"with both known.")
+    print(f"\n![estimated and measured pixel error](docs/agvs/estimator-{kind}{size}.png)\n")
+
+
+@command("OUT KIND SIZE CELLS")
+def filter(*args):
+    """BENCHMARKS.md, filter-KINDSIZE: mean PVS and measured error with and without the filter."""
+    argv = ["vctables"] + list(args)
+    out, kind, size, cells = argv[1:5]
+    print(f"AGVS on the {kind} of size {size} (seed 1), {cells} view cells. Measured pixel error: 20,000 random cameras "
+          f"of 32x32, in pixels of a 1024x1024 image. Object space filter with k = 1; 'and view space': also merged "
+          f"with the most similar neighbouring cell.\n")
+    print("| samples | filter | mean PVS unfiltered | filtered | growth | measured error unfiltered | filtered |")
+    print("| ---: | --- | ---: | ---: | ---: | ---: | ---: |")
+    for n in (100000, 1000000, 10000000):
+        for f, name in (("object", "object space"), ("both", "and view space")):
+            r = json.load(open(f"{out}/{f}-{n}.json"))
+            fl = r["filter"]
+            print(f"| {r['samples']:,} | {name} | {fl['mean_pvs_size_unfiltered']:.2f} | {fl['mean_pvs_size_filtered']:.2f} | "
+                  f"{fl['mean_pvs_size_filtered'] / fl['mean_pvs_size_unfiltered']:.2f} x | "
+                  f"{fl['measured_pixel_error_unfiltered']['pixels']:.2f} | {r['measured_pixel_error']['pixels']:.2f} |")
+    print()
+
+
+@command("DIR CELLS SIZE")
+def accuracy(*args):
+    """docs/accuracy-vs-time.md from the comparisons and the leak study."""
+    argv = ["vctables"] + list(args)
+    d, cells, size = argv[1], int(argv[2]), argv[3]
+    def curve(run, method):
+        return {int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/{run}/curves.csv")) if r["method"] == method}
+    def constructed(run, method):
+        return {int(r["cells"]): float(r["constructed_cost"]) for r in csv.DictReader(open(f"{d}/{run}/curves.csv")) if r["method"] == method}
+    def summary(run):
+        return json.load(open(f"{d}/{run}/summary.json"))
+    def near(curve, want):
+        """The reported cell count nearest to `want`."""
+        return min(curve, key=lambda c: abs(c - want))
+    def method(run, name):
+        return next(m for m in summary(run)["methods"] if m["method"] == name)
+    print("# Accuracy versus time\n")
+    print(f"Generated by `scripts/accuracy-vs-time.sh {cells} {size}` (tables here, plots in `docs/accuracy/`); "
+          "rerun it to regenerate. Costs are evaluated c(S) on independent evaluation samples (seed 99), "
+          "r(o) = max(100, triangles); times are wall-clock seconds on the project's machine (2 cores).\n")
+    print("## 1. How many construction samples (paper, figure 6)\n")
+    print("The subdivision (AV-S) is built from N samples; the evaluator scores every result on the same "
+          "8M (office) or 4M (city) evaluation samples. \"Estimated\" is the builder's own cost from its N "
+          "samples: low N under-estimates because it misses visibility.\n")
+    print(f"| scene | construction samples | sampling s | subdivision s | estimated cost at {cells:,} | evaluated cost at {cells:,} | evaluated at about 100 |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for scene in ["office", "city"]:
+        for n in [50000, 200000, 1000000, 2000000]:
+            run = f"samples-{scene}-{n}"
+            s = summary(run); m = method(run, "av-s"); c = curve(run, "av-s"); e = constructed(run, "av-s")
+            last = max(c)
+            print(f"| {scene} | {n:,} | {s['timings']['construction_sampling_seconds']:.2f} | {m['build_seconds']:.1f} | "
+                  f"{e[last]:,.0f} | {c[last]:,.0f} | {c[near(c, 100)]:,.0f} ({near(c, 100)}) |")
+    print("\n![office](accuracy/samples-office.png) ![city](accuracy/samples-city.png)\n")
+    print("## 2. Geometry-aligned candidates (paper, table 1 and figure 11)\n")
+    print("The rotated office (30 degrees about the vertical), 1M construction samples, 4M evaluation samples.\n")
+    off, on = curve("ga-off", "av-s"), curve("ga-150", "av-s")
+    moff, mon = method("ga-off", "av-s"), method("ga-150", "av-s")
+    counts = sorted({near(off, w) for w in [10, 30, 100, 300, 1000, cells]} & set(on))
+    print("| candidates | subdivision s | merge s (AV-M) | " + " | ".join(f"cost at {c:,}" for c in counts) + " |")
+    print("| --- | ---: | ---: | " + " | ".join("---:" for _ in counts) + " |")
+    avm_off, avm_on = method("ga-off", "av-m"), method("ga-150-avm", "av-m")
+    print(f"| axis-aligned only | {moff['build_seconds']:.1f} | {avm_off['build_seconds'] - moff['build_seconds']:.1f} | " +
+          " | ".join(f"{off[c]:,.0f}" for c in counts) + " |")
+    print(f"| + 150 geometry-aligned | {mon['build_seconds']:.1f} | {avm_on['build_seconds'] - mon['build_seconds']:.1f} | " +
+          " | ".join(f"{on[c]:,.0f}" for c in counts) + " |")
+    print("| ratio AA / AA+GA | | | " + " | ".join(f"{off[c] / on[c]:.3f}" for c in counts) + " |")
+    print(f"\nThe paper measured a 4-15% benefit on its rotated soda building, and called it marginal for "
+          f"the time it costs. ![ratio](accuracy/ga-ratio.png)\n")
+    print("## 3. Candidate limits\n")
+    print("| axis positions per axis | GA planes per cell | subdivision s | axis candidates evaluated | GA candidates evaluated | cost at about 100 | cost at " + f"{cells:,}" + " |")
+    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for run, ax, ga in [("axis-50", 50, 150), ("ga-150", 200, 150), ("axis-800", 800, 150), ("ga-50", 200, 50), ("ga-400", 200, 400)]:
+        m = method(run, "av-s"); c = curve(run, "av-s"); last = max(c)
+        print(f"| {ax} | {ga} | {m['build_seconds']:.1f} | {m['axis_candidates_evaluated']:,} | {m['geometry_candidates_evaluated']:,} | "
+              f"{c[near(c, 100)]:,.0f} | {c[last]:,.0f} |")
+    print("\n## 4. Embree robust versus fast mode\n")
+    L = json.load(open(f"{d}/leaks.json"))
+    print(f"Leaks are rays the watertight brute-force caster sees hitting a surface that Embree misses or "
+          f"sees behind it, on the {L['leak_scene']['triangles']:,}-triangle city of size 3: random rays; rays aimed "
+          f"at a point of an edge shared by two triangles, from the side both of them face; and rays aimed at a "
+          f"vertex from a side all triangles around it face. Those rays enter the surface at the edge or vertex, "
+          f"so missing it is a leak (grazing a silhouette, which may rightly go either way, is excluded). Fewer "
+          f"rays than asked means no such direction was found often enough. Speed is rays per second "
+          f"of bare Embree on {L['speed']['robust']['rays']:,} random rays in the {L['speed_scene']['triangles']:,}-triangle "
+          "city (best of three).\n")
+    print("| mode | Mrays/s | random: leaks / hits | edge-aimed: leaks / hits | vertex-aimed: leaks / hits |")
+    print("| --- | ---: | ---: | ---: | ---: |")
+    for mode in ["robust", "fast"]:
+        k = L["leaks"][mode]
+        print(f"| {mode} | {L['speed'][mode]['rays_per_second'] / 1e6:.2f} | " +
+              " | ".join(f"{k[x]['leaks']:,} / {k[x]['oracle_hits']:,}" for x in ["random", "edge", "vertex"]) + " |")
+    print(f"\nFast mode is {L['speed']['fast']['rays_per_second'] / L['speed']['robust']['rays_per_second']:.2f} x the "
+          "speed of robust mode here; `viewcells` uses robust mode unless `--fast` is given.")
+    rl = sum(L["leaks"]["robust"][k]["leaks"] for k in ["edge", "vertex"])
+    fl = sum(L["leaks"]["fast"][k]["leaks"] for k in ["edge", "vertex"])
+    if rl:
+        print(f"Robust mode lets {rl:,} of these rays through where fast mode lets {fl:,}: not watertight either, "
+              "on this scene. Why is not yet explained (the rays are converted to float before Embree sees them, "
+              "which moves the aim point by up to a float step; the oracle works in double).")
+
+
+@command("DIR SCENE")
+def accuracy_samples_dat(*args):
+    """Plot data: evaluated cost per cell count for each construction sample count."""
+    argv = ["vctables"] + list(args)
+    d, scene = argv[1], argv[2]
+    runs = [50000, 200000, 1000000, 2000000]
+    cols = [{int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/samples-{scene}-{n}/curves.csv"))} for n in runs]
+    print("cells " + " ".join(f"{n // 1000}k" for n in runs))
+    for c in sorted(set(cols[0]) & set(cols[-1])):
+        print(c, " ".join(str(col.get(c, "NaN")) for col in cols))
+
+
+@command("DIR")
+def ga_ratio_dat(*args):
+    """Plot data: cost ratio axis-aligned only / with geometry-aligned candidates."""
+    argv = ["vctables"] + list(args)
+    d = argv[1]
+    off = {int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/ga-off/curves.csv")) if r["method"] == "av-s"}
+    on = {int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/ga-150/curves.csv")) if r["method"] == "av-s"}
+    for c in sorted(set(off) & set(on)):
+        print(c, off[c] / on[c])
+
+
+@command("DIR")
+def compare_histogram(*args):
+    """DIR/histogram.dat: volume-weighted histograms of the cells' render cost, 24 common bins."""
+    argv = ["vctables"] + list(args)
+    d = argv[1]
+    rows = list(csv.DictReader(open(f"{d}/histogram.csv")))
+    if not rows:
+        open(f"{d}/histogram.dat", "w").write("")
+        return
+    top = max(float(r["cost"]) for r in rows) or 1.0
+    bins = 24
+    methods = []
+    for r in rows:
+        if r["method"] not in methods: methods.append(r["method"])
+    share = {m: [0.0] * bins for m in methods}
+    total = {m: 0.0 for m in methods}
+    for r in rows:
+        b = min(bins - 1, int(float(r["cost"]) / top * bins))
+        share[r["method"]][b] += float(r["volume"])
+        total[r["method"]] += float(r["volume"])
+    with open(f"{d}/histogram.dat", "w") as f:
+        f.write("cost " + " ".join(methods) + "\n")
+        for b in range(bins):
+            f.write(f"{(b + 0.5) * top / bins:.6g} " + " ".join(f"{share[m][b] / total[m]:.6g}" for m in methods) + "\n")
+
+
+@command("DIR CELLS SAMPLES SIZE")
+def results(*args):
+    """docs/results.md from the comparisons of the office, rotated office and city."""
+    argv = ["vctables"] + list(args)
+    d, cells, samples, size = argv[1], int(argv[2]), int(argv[3]), argv[4]
+    names = {"av-m": "AV-M", "av-s": "AV-S", "kd-casm": "KD-CASM", "kd-lasm": "KD-LASM", "kd-vt": "KD-VT",
+             "kd-vt-star": "KD-VT*", "bsp": "BSP"}
+    print("# Results: view cell construction methods compared\n")
+    print(f"Generated by `scripts/results.sh {cells} {samples} {size}` (the tables and the plots in "
+          "`docs/results/`); rerun it to regenerate everything here. Every method builds from the same "
+          f"{samples:,} construction samples (seed 1) and is scored by the evaluator on "
+          f"{4 * samples:,} independent evaluation samples (seed 1000004), as in the paper's section 6.1: "
+          "c(S) = sum of p(i) r(PVS_i) with r(o) = max(100, triangles), p(i) = V_i / V, PVSs from the "
+          "evaluation samples. The curves follow each method's own refinement order (split order; the "
+          "merge history backwards for AV-M).\n")
+    print("Methods (section 6.3): AV-M = AV-S then merging; AV-S = our cost-driven subdivision; KD-CASM / "
+          "KD-LASM = breadth-first kd-tree, spatial median, cycling / longest axis; KD-VT = KD-LASM that leaves "
+          "cells whose sampled r(PVS) is under 5% of the whole view space's alone; KD-VT* = its depth-first "
+          "version (max depth 40); BSP = splits on scene polygon planes only, chosen as cell-and-portal "
+          "builders do.\n")
+    claims = []
+    for name, label in [("office", "office (size 4, two storeys)"), ("rotated-office", "rotated office (size 4, 30 degrees)"),
+                        ("city", f"city (size {size})")]:
+        rows = list(csv.DictReader(open(f"{d}/compare-{name}/curves.csv")))
+        s = json.load(open(f"{d}/compare-{name}/summary.json"))
+        s["_name"] = name
+        curve = {}
+        for r in rows:
+            curve.setdefault(r["method"], {})[int(r["cells"])] = float(r["cost"])
+        sc = s["scene"]
+        print(f"## {label}\n")
+        print(f"{sc['triangles']:,} triangles, {sc['objects']:,} objects. Empty view space detection: "
+              f"{s['effects']['empty_space_detection']['reason']}. Pixel term: off (c = 0).\n")
+        # Columns at the reported cell counts nearest to 10, 100, 1000 and the most.
+        have = sorted(curve["av-m"])
+        counts = sorted({min(have, key=lambda c: abs(c - want)) for want in [10, 100, 1000, cells] if want <= cells})
+        print("| method | cells built | build s | " + " | ".join(f"cost at {c:,}" for c in counts) + " | " +
+              " | ".join(f"/ AV-M at {c:,}" for c in counts) + " |")
+        print("| --- | ---: | ---: | " + " | ".join(["---:"] * (2 * len(counts))) + " |")
+        for m in s["methods"]:
+            meth = m["method"]
+            cost = [curve[meth].get(c) for c in counts]
+            ratio = [(curve[meth].get(c) / curve["av-m"][c]) if curve[meth].get(c) and c in curve.get("av-m", {}) else None
+                     for c in counts]
+            fmtc = lambda v: f"{v:,.0f}" if v is not None else "-"
+            fmtr = lambda v: f"{v:.3f}" if v is not None else "-"
+            print(f"| {names[meth]} | {m['cells']:,} | {m['build_seconds']:.1f} | " + " | ".join(fmtc(v) for v in cost) +
+                  " | " + " | ".join(fmtr(v) for v in ratio) + " |")
+        t = s["timings"]
+        print(f"\nSampling {t['construction_sampling_seconds']:.1f} s (construction) and {t['evaluation_sampling_seconds']:.1f} s "
+              f"(evaluation); evaluating all methods {t['evaluation_seconds']:.1f} s. "
+              f"![cost](results/{name}-cost.png) ![ratio](results/{name}-ratio.png) ![histogram](results/{name}-histogram.png)\n")
+        top = max(c for c in curve["av-m"] if c in curve["kd-casm"])
+        mid = [c for c in curve["av-m"] if c in curve["kd-casm"] and c >= 100]
+        gain = [1 - curve["av-m"][c] / curve["kd-casm"][c] for c in mid]
+        claims.append((label, top, 1 - curve["av-m"][top] / curve["kd-casm"][top], min(gain) if gain else None,
+                       max(gain) if gain else None,
+                       curve["bsp"].get(top), curve["kd-casm"][top], curve["kd-lasm"].get(top),
+                       curve["av-s"].get(top), curve["av-m"][top], max(curve["bsp"]), s))
+    print("## Side by side with the paper's claims\n")
+    print("| claim (paper, section 6.3) | scene | measured here |")
+    print("| --- | --- | --- |")
+    for (label, top, gain_top, gmin, gmax, bsp, kdc, kdl, avs, avm, bsp_cells, s) in claims:
+        rng = f"from {100 * gmin:+.0f}% to {100 * gmax:+.0f}% over 100-{top:,} cells" if gmin is not None else "-"
+        print(f"| AV-M about 20-30% below KD-CASM | {label} | {100 * gain_top:.0f}% below at {top:,} cells (gain {rng}) |")
+    for (label, top, gain_top, gmin, gmax, bsp, kdc, kdl, avs, avm, bsp_cells, s) in claims:
+        worst = max((m for m in s["methods"]), key=lambda m: m["evaluated_cost_at_most_cells"])
+        bsp_curve = {int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/compare-{s['_name']}/curves.csv")) if r["method"] == "bsp"}
+        avm_curve = {int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/compare-{s['_name']}/curves.csv")) if r["method"] == "av-m"}
+        below = max(c for c in avm_curve if c <= bsp_cells)  # AV-M with at most as many cells
+        bsp_text = (f"BSP {bsp / avm:.2f} x AV-M at {top:,} cells" if bsp else
+                    f"BSP stops at {bsp_cells:,} cells (no polygons left to split by) with cost "
+                    f"{bsp_curve[bsp_cells]:,.0f}, {bsp_curve[bsp_cells] / avm_curve[below]:.2f} x AV-M's with {below:,} cells")
+        print(f"| BSP worst: it cannot split empty space | {label} | {bsp_text}; worst at the most cells: "
+              f"{names[worst['method']]} |")
+    for (label, top, gain_top, gmin, gmax, bsp, kdc, kdl, avs, avm, bsp_cells, s) in claims:
+        if kdl:
+            print(f"| KD-CASM better than KD-LASM in cities | {label} | KD-CASM / KD-LASM = {kdc / kdl:.3f} at {top:,} cells |")
+    for (label, top, gain_top, gmin, gmax, bsp, kdc, kdl, avs, avm, bsp_cells, s) in claims:
+        cv = {}
+        for r in csv.DictReader(open(f"{d}/compare-{s['_name']}/curves.csv")):
+            cv.setdefault(r["method"], {})[int(r["cells"])] = float(r["cost"])
+        pts = [c for c in sorted(cv["av-m"]) if c in cv["av-s"] and c >= 10]
+        worst = max(pts, key=lambda c: cv["av-m"][c] / cv["av-s"][c])
+        best = min(pts, key=lambda c: cv["av-m"][c] / cv["av-s"][c])
+        est = {}
+        for r in csv.DictReader(open(f"{d}/compare-{s['_name']}/curves.csv")):
+            est.setdefault(r["method"], {})[int(r["cells"])] = float(r["constructed_cost"])
+        print(f"| merging (AV-M) gains little over AV-S | {label} | AV-M / AV-S from {cv['av-m'][best] / cv['av-s'][best]:.3f} "
+              f"({best:,} cells) to {cv['av-m'][worst] / cv['av-s'][worst]:.3f} ({worst:,} cells); equal at {top:,}. "
+              f"At {worst:,} cells the construction samples estimated AV-M at {est['av-m'][worst]:,.0f} and AV-S at "
+              f"{est['av-s'][worst]:,.0f} |")
+    print("\nReading it. AV-S and AV-M lead in the office and the rotated office by about the paper's "
+          "margin at thousands of cells. In the generated city the kd-trees come close: its street grid is "
+          "axis-aligned and regular, so median splits fall on streets, and its view space is mostly sky "
+          "where every cell sees much of the city. Greedy merging (AV-M) loses to AV-S's own top-down "
+          "order at low cell counts, although by the construction samples it wins there (last rows): "
+          "merging starts from 5,000 leaves of about 200 samples each, whose PVSs are undersampled, and "
+          "the greedy order picks the pairs whose sampled PVSs happen to overlap most, so it overfits the "
+          "construction samples, and independent samples expose it. The paper found merging's gain "
+          "\"very limited\"; here it is a loss below a few hundred cells. Until merging accounts for "
+          "sampling noise, users who want few cells should cut AV-S's order (`build --no-merge`). The polygon BSP stops where no "
+          "polygons are left; on the rotated office its wall-aligned planes do well at the count it stops at.")
+    print("\nKD-VT* is depth-first: its curve shows the order in which it refines, which is why the paper "
+          "calls it not scalable; its final set, where it stops, is what such tools ship.")
+
+
+@command("OUT SAMPLES EVAL_SAMPLES")
+def maps(*args):
+    """docs/results/q3-maps.md and .csv from the comparisons with q3map2 on every map."""
+    argv = ["vctables"] + list(args)
+    out, samples, eval_samples = argv[1], int(argv[2]), int(argv[3])
+    rows, skipped, failed = [], [], []
+    for info_path in sorted(glob.glob(f"{out}/*.info.json")):
+        name = os.path.basename(info_path)[:-len(".info.json")]
+        if os.path.exists(f"{out}/{name}.skipped"):
+            skipped.append(name); continue
+        if os.path.exists(f"{out}/{name}.failed"):
+            failed.append((name, open(f"{out}/{name}.failed").read().strip().splitlines()[-1])); continue
+        s = json.load(open(f"{out}/{name}/summary.json"))
+        info = json.load(open(info_path))
+        q = s["q3map2"]
+        t = s["timings"]
+        rows.append(dict(
+            map=name, triangles=s["scene"]["triangles"], objects=s["scene"]["objects"], clusters=q["clusters"],
+            non_occluding=info["quake3"]["surfaces"]["non_occluding"],
+            q3_cost=q["q3map2_cost"], avm_cost=q["av_m_cost_at_clusters"], ratio=q["av_m_cost_ratio"],
+            cells_to_match=q["av_m_cells_to_match"], pvs_ratio=q["pvs_size_ratio"],
+            excluded=q["excluded_but_seen"], causes=q["excluded_by_cause"],
+            q3_bytes=q["storage_bytes"]["q3map2_rows"], q3_leaf_bytes=q["storage_bytes"]["q3map2_leaf_surface_lists"],
+            ours_bytes=q["storage_bytes"]["ours_compressed"], ours_rle=q["storage_bytes"]["ours_rle_rows"],
+            build_s=q["build_seconds"],
+            sampling_s=t["construction_sampling_seconds"] + t["evaluation_sampling_seconds"],
+            wall_s=float(open(f"{out}/{name}/wall_seconds").read())))
+
+    CAUSES = ("crack", "invisible", "void", "unlisted", "far", "rejected")
+
+    def num(x, d=0):
+        return "n/a" if x is None else f"{x:,.{d}f}"
+
+    with open("docs/results/q3-maps.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        keys = [k for k in rows[0] if k != "causes"] if rows else []
+        w.writerow(keys + list(CAUSES))
+        for r in rows:
+            w.writerow([r[k] for k in keys] + [r["causes"].get(c, 0) for c in CAUSES])
+
+    lines = []
+    lines.append(f"Every OpenArena map with vis data ({len(rows)} maps; {len(skipped)} without vis data skipped"
+                 + (f", {len(failed)} failed" if failed else "") + "). Per map: "
+                 f"{samples:,} construction samples, {eval_samples:,} evaluation samples (another seed), both with origins "
+                 "in the map's non-solid space; AV-S to 3x the map's cluster count, merged (AV-M); cell weights are "
+                 "volumes of non-solid space; r(o) = max(100, triangles); the sky closes the map but costs nothing; "
+                 "solid brushes stop rays as hulls half a unit inside their sides; water, fog, slime, lava and "
+                 "translucent surfaces are rendered and seen through; objects are the map's surfaces.\n")
+    lines.append("| map | triangles | clusters | q3map2 cost | AV-M cost at clusters | AV-M / q3map2 | AV-M cells to match q3map2 "
+                 "| PVS ours / q3map2 | seen but excluded (crack / invisible / void / unlisted / far / rejected) "
+                 "| q3map2 rows (B) | ours compressed (B) "
+                 "| build (s) |")
+    lines.append("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for r in rows:
+        c = r["causes"]
+        lines.append(f"| {r['map']} | {r['triangles']:,} | {r['clusters']:,} | {num(r['q3_cost'])} | {num(r['avm_cost'])} | "
+                     f"{num(r['ratio'], 3)} | {num(r['cells_to_match'])} | {r['pvs_ratio']:.3f} | "
+                     f"{r['excluded']:,} ({' / '.join(f'{c.get(k, 0):,}' for k in CAUSES)}) | "
+                     f"{r['q3_bytes']:,} | {r['ours_bytes']:,} | {r['build_s']:.1f} |")
+    lines.append("")
+    ratios = [r["ratio"] for r in rows if r["ratio"] is not None]
+    lower = [x for x in ratios if x < 1]
+    if ratios:
+        lines.append(f"**AV-M's evaluated render cost at q3map2's cell count is lower than q3map2's on {len(lower)} of "
+                     f"{len(rows)} maps**" + (f" ({len(rows) - len(ratios)} did not reach that count)" if len(ratios) < len(rows) else "")
+                     + f": AV-M / q3map2 median {statistics.median(ratios):.3f}, range {min(ratios):.3f} to {max(ratios):.3f}. "
+                     f"Fewest AV-M cells that match q3map2's cost, as a share of its clusters: median "
+                     f"{statistics.median([r['cells_to_match'] / r['clusters'] for r in rows if r['cells_to_match']]):.3f}.\n")
+    tot = {k: sum(r["causes"].get(k, 0) for r in rows) for k in CAUSES}
+    worst = lambda k: ", ".join(f"{r['map']} {r['causes'][k]:,}" for r in sorted(rows, key=lambda r: -r["causes"].get(k, 0))[:3]
+                                if r["causes"].get(k, 0))
+    lines.append(f"PVS agreement: our samples see a median {statistics.median([r['pvs_ratio'] for r in rows]):.3f} of what "
+                 f"q3map2's cluster PVS admits (q3map2's is conservative: portal flow through structural brushes, whole "
+                 f"clusters, every surface of every leaf; ours is sampled). Objects we see from a cluster that q3map2 "
+                 f"excludes, {sum(r['excluded'] for r in rows):,} (cluster, object) pairs over all maps, each with the "
+                 f"first evaluation segment that saw it and its cause (docs/quake3.md): {tot['crack']:,} crack (through "
+                 f"a drawn brush side: cracks between triangles; {worst('crack')}), {tot['invisible']:,} invisible "
+                 f"(through a brush side that is not drawn; {worst('invisible')}), {tot['void']:,} void (through solid "
+                 f"space no brush fills; {worst('void')}), {tot['unlisted']:,} unlisted (seen inside a cluster q3map2 "
+                 f"admits, but the surface is not listed in that cluster's leaves; {worst('unlisted')}), {tot['far']:,} "
+                 f"far (beyond the map's _farplanedist; {worst('far')}), {tot['rejected']:,} rejected (a line of sight "
+                 f"through non-solid space that q3map2's PVS rejects; {worst('rejected')}). The pairs are in "
+                 f"out/maps/MAP/excluded.csv.\n")
+    qb = sum(r["q3_bytes"] for r in rows)
+    ql = sum(r["q3_leaf_bytes"] for r in rows)
+    ob = sum(r["ours_bytes"] for r in rows)
+    orle = sum(r["ours_rle"] for r in rows)
+    lines.append(f"Storage over all maps at q3map2's cell counts: q3map2's uncompressed cluster rows {qb:,} B (plus "
+                 f"{ql:,} B of leaf surface lists a renderer needs to turn clusters into surfaces); our hierarchy-"
+                 f"compressed object lists {ob:,} B ({ob / qb:.2f} x the rows; as flat Quake-style RLE object rows "
+                 f"{orle:,} B).\n")
+    lines.append(f"Time: building (AV-S and merging) took {sum(r['build_s'] for r in rows):.0f} s over all maps "
+                 f"(median {statistics.median([r['build_s'] for r in rows]):.1f} s), sampling "
+                 f"{sum(r['sampling_s'] for r in rows):.0f} s, whole runs {sum(r['wall_s'] for r in rows):.0f} s.\n")
+    if failed:
+        lines.append("Failed: " + "; ".join(f"{n} ({e})" for n, e in failed) + "\n")
+    lines.append("Per map in docs/results/q3-maps.csv.\n")
+    open("docs/results/q3-maps.md", "w").write("\n".join(lines))
+
+
+@command("PK3 OUT_DIR")
+def unpack_maps(*args):
+    """Extracts maps/*.bsp from a .pk3 (zip) into a directory, each file atomically."""
+    argv = ["vctables"] + list(args)
+    pk3, out = argv[1], argv[2]
+    with zipfile.ZipFile(pk3) as z:
+        for info in z.infolist():
+            name = info.filename
+            if name.lower().startswith("maps/") and name.lower().endswith(".bsp"):
+                target = os.path.join(out, os.path.basename(name))
+                data = z.read(info)
+                tmp = target + ".tmp"
+                with open(tmp, "wb") as f:
+                    f.write(data)
+                os.replace(tmp, target)
+
+
+@command("FILE NAME COMMAND TABLE_FILE")
+def replace_section(path, name, cmd, table_file):
+    """Replaces the text between <!-- NAME:begin --> and <!-- NAME:end --> in a Markdown file by
+    "Command: `COMMAND`", a blank line, and the contents of TABLE_FILE."""
+    table = open(table_file).read()
+    text = open(path).read()
+    begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
+    if begin not in text or end not in text:
+        raise SystemExit(f"vctables: {path} has no {begin} ... {end} section")
+    block = f"{begin}\nCommand: `{cmd}`\n\n{table}{end}"
+    text = re.sub(re.escape(begin) + ".*?" + re.escape(end), lambda m: block, text, flags=re.S)
+    open(path, "w").write(text)
+
+
+@command("SIDE SAMPLE_JSON BUILD_JSON")
+def ab_row(side, sample_json, build_json):
+    """One row of bench-ab.sh's TSV: side, Msegments/s, raw Mrays/s, subdivision s, merge s."""
+    s = json.load(open(sample_json))["timings"]
+    b = json.load(open(build_json))["timings"]
+    print(side, s["segments_per_second"] / 1e6, s["raw_rays_per_second"] / 1e6, b["subdivision_seconds"],
+          b["merge_seconds"], sep="\t")
+
+
+@command("INFO_JSON")
+def street_band(info_json):
+    """The view box of the street band: the scene's footprint, from the ground to 30 m."""
+    b = json.load(open(info_json))["bounds"]
+    print(",".join(str(v) for v in b["min"][:2] + [0.0] + b["max"][:2] + [30.0]))
+
+
+@command("JSON KEY...")
+def get(path, *keys):
+    """Prints one value of a JSON file, e.g. `get info.json quake3 clusters`."""
+    v = json.load(open(path))
+    for k in keys:
+        v = v[int(k)] if isinstance(v, list) else v[k]
+    print(v)
+
+
+@command("START_EPOCH_SECONDS")
+def elapsed(start):
+    """Seconds since START (as `date +%s.%N` printed it), one decimal."""
+    import time
+    print("%.1f" % (time.time() - float(start)))
+
+
+@command("CURVES_CSV")
+def compare_methods(path):
+    """The methods of a compare run's curves.csv, in order of appearance."""
+    seen = []
+    for r in csv.DictReader(open(path)):
+        if r["method"] not in seen:
+            seen.append(r["method"])
+    print(" ".join(seen))
+
+
+@command("BENCH_JSON CELLS OBJECTS")
+def runtime(path, cells, objects):
+    """BENCHMARKS.md, runtime: Google Benchmark's JSON of viewcells_runtime_bench."""
+    r = json.load(open(path))
+    ctx = r["context"]
+    rows = {b["name"]: b for b in r["benchmarks"] if b.get("run_type", "iteration") == "iteration"}
+    first = next(iter(rows.values()))
+    print(f"A .pvs of the city: {int(first['cells']):,} view cells over {int(first['objects']):,} objects "
+          f"(`compress --count {int(cells):,}` of the merging benchmark's hierarchy); the reader holds "
+          f"{first['memory_MB']:.1f} MB once the file is open. One core (taskset) of {ctx.get('num_cpus', '?')} at "
+          f"{ctx.get('mhz_per_cpu', 0) / 1000:.1f} GHz, Google Benchmark; viewpoints uniform in the view box "
+          f"(1M drawn once, seed 1) unless said: the worst case for caches, since every query lands somewhere new.\n")
+    print("| query | ns per query | M queries/s per core |")
+    print("| --- | ---: | ---: |")
+    names = {"BM_Locate": "point location only",
+             "BM_LocateAndList": "point location + the cell's visible objects (sorted ids)",
+             "BM_WalkAndList": "the same along a walk (steps of 0.2% of the box diagonal: frames of a moving camera)",
+             "BM_LocateAndBitRow": f"point location + the cell's bit row ({(int(first['objects']) + 7) // 8:,} bytes, filled)"}
+    for key, label in names.items():
+        if key in rows:
+            b = rows[key]
+            ns = b["cpu_time"] * {"ns": 1, "us": 1e3, "ms": 1e6}[b.get("time_unit", "ns")]
+            print(f"| {label} | {ns:.0f} | {b['items_per_second'] / 1e6:.2f} |")
+    print()
+
+
+def main(argv):
+    if len(argv) < 2 or argv[1] in ("-h", "--help"):
+        print(__doc__)
+        for name, (f, args, doc) in sorted(COMMANDS.items()):
+            print(f"  {name} {args}\n      {doc.splitlines()[0]}")
+        return 0 if len(argv) >= 2 else 2
+    name = argv[1]
+    if name not in COMMANDS:
+        print(f"vctables: no command '{name}' (--help lists them)", file=sys.stderr)
+        return 2
+    f, args, _ = COMMANDS[name]
+    f(*argv[2:])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

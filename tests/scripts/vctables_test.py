@@ -1,0 +1,278 @@
+"""Tests of scripts/vctables.py: every table of BENCHMARKS.md and docs/ is computed from small
+reports made here, and the numbers it prints (medians, ratios, speed-ups, shares) are checked
+against the same arithmetic done by hand."""
+import contextlib
+import csv
+import io
+import json
+import os
+import sys
+import tempfile
+import unittest
+import warnings
+import zipfile
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "..", "scripts"))
+import vctables  # noqa: E402
+
+
+def run(name, *args):
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        vctables.COMMANDS[name][0](*[str(a) for a in args])
+    return out.getvalue()
+
+
+def dump(path, obj):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w") as f:
+        json.dump(obj, f)
+
+
+def row(table, first_cell):
+    """The cells of the Markdown table row starting with `first_cell`."""
+    for line in table.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if cells and cells[0] == first_cell:
+            return cells
+    raise AssertionError(f"no row {first_cell!r} in:\n{table}")
+
+
+def write_curves(path, rows):
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["method", "cells", "cost", "ratio_to_av_m", "constructed_cost"])
+        for r in rows:
+            w.writerow(r)
+
+
+class Tables(unittest.TestCase):
+    def setUp(self):
+        warnings.simplefilter("ignore", ResourceWarning)  # the tables open report files briefly
+        self.tmp = tempfile.TemporaryDirectory()
+        self.d = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_replace_section_keeps_the_rest(self):
+        md, table = f"{self.d}/b.md", f"{self.d}/t.md"
+        open(md, "w").write("head\n<!-- x:begin -->\nold\n<!-- x:end -->\ntail\n")
+        open(table, "w").write("| new |\n")
+        run("replace-section", md, "x", "cmd 1", table)
+        self.assertEqual(open(md).read(), "head\n<!-- x:begin -->\nCommand: `cmd 1`\n\n| new |\n<!-- x:end -->\ntail\n")
+        with self.assertRaises(SystemExit):
+            run("replace-section", md, "missing", "c", table)
+
+    def test_sampling_medians_and_ratios_to_half_raw(self):
+        for name in ["scene-bounds", "street-band"]:
+            for r, (seg_rate, raw) in enumerate([(1.0e6, 4e6), (3.0e6, 4e6), (2.0e6, 8e6)], 1):
+                dump(f"{self.d}/sample-{name}-{r}.json", {
+                    "scene": {"triangles": 1000}, "settings": {"threads": 2},
+                    "counts": {"valid_segments": 100 * r, "samples": 200},
+                    "timings": {"raw_rays_per_second": raw, "samples_per_second": 1e6, "segments_per_second": seg_rate}})
+        t = run("sampling", self.d, 3, 23)
+        r = row(t, "scene-bounds")
+        self.assertEqual(r[2], "200")           # median segments
+        self.assertEqual(r[4], "1.000")         # median valid share 200/200
+        self.assertEqual(r[5], "4.00")          # median raw Mrays/s
+        self.assertEqual(r[7], "2.00")          # median Msegments/s
+        self.assertEqual(r[9], "0.500")         # median of 0.5, 1.5, 0.5
+
+    def test_subdivision_growth_per_doubling(self):
+        for n, s in [(500000, 10.0), (1000000, 21.0), (1500000, 33.0), (2000000, 44.1)]:
+            dump(f"{self.d}/build-{n}.json", {
+                "timings": {"load_seconds": 1, "bvh_build_seconds": 1, "sampling_seconds": 1, "subdivision_seconds": s,
+                            "write_seconds": 0.1},
+                "subdivision": {"cells": 50000, "initial_cost": 10, "final_cost": 5, "axis_candidates_evaluated": 7,
+                                "geometry_candidates_evaluated": 0}})
+        t = run("subdivision", self.d, 23, 50000)
+        self.assertIn("1M / 0.5M = 2.10, 2M / 1M = 2.10", t)
+        self.assertEqual(row(t, "1,500,000")[4], "33.0")
+
+    def test_ab_medians_and_ratio(self):
+        tsv = f"{self.d}/ab.tsv"
+        with open(tsv, "w") as f:
+            for side, v in [("old", 1.0), ("new", 1.1), ("old", 3.0), ("new", 3.3), ("old", 2.0), ("new", 2.2)]:
+                f.write(f"{side}\t{v}\t{v}\t{v}\t{v}\n")
+        t = run("ab", tsv, "abc123", 3, 23)
+        r = row(t, "sampling Msegments/s")
+        self.assertEqual(r[1:], ["2.00", "2.20", "1.100"])
+
+    def test_ab_row_reads_both_reports(self):
+        dump(f"{self.d}/s.json", {"timings": {"segments_per_second": 2e6, "raw_rays_per_second": 5e6}})
+        dump(f"{self.d}/b.json", {"timings": {"subdivision_seconds": 3.5, "merge_seconds": 0.25}})
+        self.assertEqual(run("ab-row", "new", f"{self.d}/s.json", f"{self.d}/b.json"), "new\t2.0\t5.0\t3.5\t0.25\n")
+
+    def agvs_report(self, seconds, mean, entries, curve, est=1.0):
+        return {"samples": 1000, "rays": 2000, "seconds": seconds, "mean_pvs_size": mean, "pvs_entries": entries,
+                "estimated_pixel_error": est, "pixel_error_bound": None,
+                "measured_pixel_error": {"pixels": 2.0}, "curve": curve}
+
+    def test_agvs_speed_up_is_the_time_to_the_same_mean_pvs(self):
+        pt = lambda s, m, cov=(0, 0): {"seconds": s, "mean_pvs_size": m, "pixel_error": 1.0, "pixel_error_bound": None,
+                                       "covered": list(cov)}
+        # AGVS reaches mean 8 at 2 s; SGVS ends at 8 after 10 s: 5 x. 10 cells.
+        dump(f"{self.d}/agvs.json", self.agvs_report(10, 9, 90, [pt(1, 5, (30, 30)), pt(2, 8, (76, 70)), pt(10, 9, (80, 80))]))
+        dump(f"{self.d}/sgvs.json", self.agvs_report(10, 8, 80, [pt(4, 7), pt(10, 8)]))
+        dump(f"{self.d}/ref.json", self.agvs_report(10, 6, 60, [pt(5, 6), pt(10, 6)]))
+        t = run("agvs", self.d, "office", 4, 10, 10)
+        self.assertEqual(row(t, "SGVS")[6:8], ["2.00 s", "5.0 x"])
+        self.assertEqual(row(t, "REF")[6:8], ["2.00 s", "5.0 x"])  # AGVS passes 6 at 2 s too
+        # Entries: SGVS finds 95% of its 80 entries (76) at 10 s; AGVS covers 76 at 2 s.
+        sg = [r for r in t.splitlines() if r.startswith("| SGVS | 80")][0]
+        self.assertIn("| 10.00 s | 2.00 s | 5.0 x |", sg)
+        self.assertTrue(os.path.exists(f"{self.d}/agvs.dat"))
+
+    def test_estimator_counts_stops_within_a_factor_of_two(self):
+        for m in ("sgvs", "agvs"):
+            for n, est, meas in [(1000, 4.0, 2.5), (2000, 1.0, 3.0), (4000, None, 1.0)]:
+                dump(f"{self.d}/{m}-{n}.json", {"samples": n, "mean_pvs_size": 5, "estimated_pixel_error": est,
+                                               "pixel_error_bound": 0.5 if est is None else None,
+                                               "measured_pixel_error": {"pixels": meas}, "estimator_window_rays": 9})
+        t = run("estimator", self.d, "office", 4, 500, 4000, 100, 32)
+        self.assertIn("AGVS: the estimate is within a factor of 2 of the measurement at 1 of 2 stops", t)
+        self.assertIn("| < 0.50 |", t)
+
+    def test_filter_growth(self):
+        for n in (100000, 1000000, 10000000):
+            for f in ("object", "both"):
+                dump(f"{self.d}/{f}-{n}.json", {"samples": n, "measured_pixel_error": {"pixels": 1.0},
+                                               "filter": {"mean_pvs_size_unfiltered": 10.0, "mean_pvs_size_filtered": 12.5,
+                                                          "measured_pixel_error_unfiltered": {"pixels": 3.0}}})
+        t = run("filter", self.d, "office", 4, 500)
+        self.assertIn("| 1,000,000 | object space | 10.00 | 12.50 | 1.25 x | 3.00 | 1.00 |", t)
+
+    def test_merging_table(self):
+        for name, n in [("city", 8), ("office", 4)]:
+            dump(f"{self.d}/merge-{name}.json", {
+                "final_cost": 100.0,
+                "merge": {"cells_from": n, "pair_costs_evaluated": 5, "stale_entries_skipped": 2,
+                          "cost_at_power_of_two_cells": [{"cells": 1, "cost": 400.0}, {"cells": 2, "cost": 300.0},
+                                                         {"cells": 4, "cost": 200.0}, {"cells": 8, "cost": 100.0}]},
+                "timings": {"subdivision_seconds": 2.0, "merge_seconds": 0.5}})
+        for name, counts in [("city", [8, 5000, 500, 50]), ("office", [2000, 200, 20])]:
+            for c in counts:
+                dump(f"{self.d}/compress-{name}-{c}.json", {
+                    "cells": c, "objects": 10, "entries_before": 100, "entries_after": 40, "entry_ratio": 0.4,
+                    "varint_bytes_before": 150, "varint_bytes_after": 60, "file_bytes": 500,
+                    "flat": {"bit_row_bytes": 20, "run_length_bytes": 15}})
+        t = run("merging", self.d, 23, 8)
+        self.assertIn("| city | 8 | 2.0 | 0.50 | 5 | 2 | 100 | 400 (1) | 400 (1) |", t)  # 8 / 10 is nearest 1
+        self.assertIn("| office | 200 | 10 | 100 | 40 | 0.400 |", t)
+
+    def test_compare_histogram_shares_sum_to_one(self):
+        os.makedirs(f"{self.d}/c")
+        with open(f"{self.d}/c/histogram.csv", "w") as f:
+            f.write("method,cell,cost,volume\nav-m,0,10,1\nav-m,1,240,3\nkd,0,120,2\n")
+        run("compare-histogram", f"{self.d}/c")
+        lines = open(f"{self.d}/c/histogram.dat").read().split("\n")
+        self.assertEqual(lines[0], "cost av-m kd")
+        cols = [[float(x) for x in l.split()[1:]] for l in lines[1:] if l]
+        self.assertAlmostEqual(sum(c[0] for c in cols), 1.0)
+        self.assertAlmostEqual(sum(c[1] for c in cols), 1.0)
+        self.assertAlmostEqual(cols[-1][0], 0.75)  # the top bin holds av-m's cell of cost 240
+
+    def test_compare_methods_get_street_band_and_unpack(self):
+        write_curves(f"{self.d}/curves.csv", [["av-m", 1, 5, 1, 5], ["kd", 1, 6, 1.2, 6], ["av-m", 2, 4, 1, 4]])
+        self.assertEqual(run("compare-methods", f"{self.d}/curves.csv"), "av-m kd\n")
+        dump(f"{self.d}/info.json", {"bounds": {"min": [1, 2, 3], "max": [4, 5, 6]}, "quake3": {"clusters": 7}})
+        self.assertEqual(run("get", f"{self.d}/info.json", "quake3", "clusters"), "7\n")
+        self.assertEqual(run("street-band", f"{self.d}/info.json"), "1,2,0.0,4,5,30.0\n")
+        with zipfile.ZipFile(f"{self.d}/a.pk3", "w") as z:
+            z.writestr("maps/m1.bsp", b"IBSP1")
+            z.writestr("textures/x.jpg", b"no")
+        os.makedirs(f"{self.d}/out")
+        run("unpack-maps", f"{self.d}/a.pk3", f"{self.d}/out")
+        self.assertEqual(os.listdir(f"{self.d}/out"), ["m1.bsp"])
+
+    def compare_run(self, name, methods, curves, q3=None):
+        rows = []
+        for m, pts in curves.items():
+            for c, cost in pts.items():
+                rows.append([m, c, cost, "", cost * 0.9])
+        write_curves(f"{self.d}/{name}/curves.csv", rows)
+        s = {"scene": {"triangles": 100, "objects": 10},
+             "effects": {"empty_space_detection": {"reason": "enabled"}},
+             "timings": {"construction_sampling_seconds": 1, "evaluation_sampling_seconds": 2, "evaluation_seconds": 3},
+             "methods": [{"method": m, "cells": max(curves[m]), "build_seconds": 1.5, "axis_candidates_evaluated": 10,
+                          "geometry_candidates_evaluated": 0, "evaluated_cost_at_most_cells": curves[m][max(curves[m])]}
+                         for m in methods]}
+        if q3:
+            s["q3map2"] = q3
+        dump(f"{self.d}/{name}/summary.json", s)
+
+    def test_results_ratios_to_av_m(self):
+        methods = ["av-m", "av-s", "kd-casm", "kd-lasm", "kd-vt", "kd-vt-star", "bsp"]
+        for name in ["office", "rotated-office", "city"]:
+            curves = {m: {10: 100.0 * (1 + k / 10), 100: 80.0 * (1 + k / 10), 1000: 50.0 * (1 + k / 10)}
+                      for k, m in enumerate(methods)}
+            self.compare_run(f"compare-{name}", methods, curves)
+        t = run("results", self.d, 1000, 1000, 23)
+        self.assertEqual(row(t, "KD-CASM")[-1], "1.200")  # kd-casm / av-m at 1,000 cells
+        self.assertIn("17% below at 1,000 cells", t)        # 1 - 50 / 60
+
+    def test_accuracy_plot_data(self):
+        for n in [50000, 200000, 1000000, 2000000]:
+            write_curves(f"{self.d}/samples-office-{n}/curves.csv", [["av-s", 10, n / 1000, "", 1], ["av-s", 20, 1, "", 1]])
+        dat = run("accuracy-samples-dat", self.d, "office").splitlines()
+        self.assertEqual(dat[0], "cells 50k 200k 1000k 2000k")
+        self.assertEqual(dat[1], "10 50.0 200.0 1000.0 2000.0")
+        write_curves(f"{self.d}/ga-off/curves.csv", [["av-s", 10, 6.0, "", 1]])
+        write_curves(f"{self.d}/ga-150/curves.csv", [["av-s", 10, 4.0, "", 1]])
+        self.assertEqual(run("ga-ratio-dat", self.d), "10 1.5\n")
+
+    def test_maps_table(self):
+        q3 = {"clusters": 10, "q3map2_cost": 200.0, "av_m_cost_at_clusters": 150.0, "av_m_cost_ratio": 0.75,
+              "av_m_cells_to_match": 5, "pvs_size_ratio": 0.8, "excluded_but_seen": 3,
+              "excluded_by_cause": {"crack": 2, "void": 1},
+              "storage_bytes": {"q3map2_rows": 1000, "q3map2_leaf_surface_lists": 50, "ours_compressed": 250,
+                                "ours_rle_rows": 400}, "build_seconds": 2.0}
+        out = f"{self.d}/maps"
+        for name in ["m1", "m2"]:
+            self.compare_run(f"maps/{name}", ["av-m"], {"av-m": {10: 150.0}}, q3)
+            dump(f"{out}/{name}.info.json", {"quake3": {"surfaces": {"non_occluding": 1}}})
+            open(f"{out}/{name}/wall_seconds", "w").write("4.0")
+        dump(f"{out}/m3.info.json", {"quake3": {"surfaces": {"non_occluding": 0}}})
+        open(f"{out}/m3.skipped", "w").write("no visibility data")
+        cwd = os.getcwd()
+        os.makedirs(f"{self.d}/docs/results")
+        os.chdir(self.d)
+        try:
+            run("maps", out, 1000, 4000)
+            md = open("docs/results/q3-maps.md").read()
+        finally:
+            os.chdir(cwd)
+        self.assertIn("(2 maps; 1 without vis data skipped)", md)
+        self.assertIn("lower than q3map2's on 2 of 2 maps**: AV-M / q3map2 median 0.750", md)
+        self.assertIn("500 B (0.25 x the rows", md)  # 500 / 2000 B over both maps
+
+    def test_runtime_table(self):
+        bench = {"context": {"num_cpus": 2, "mhz_per_cpu": 2450, "library_version": "v1.7.1"},
+                 "benchmarks": [{"name": "BM_Locate", "run_type": "iteration", "cpu_time": 125.0, "time_unit": "ns",
+                                 "items_per_second": 8e6, "cells": 50000, "objects": 8100, "memory_MB": 80.0},
+                                {"name": "BM_LocateAndList", "run_type": "iteration", "cpu_time": 0.2, "time_unit": "us",
+                                 "items_per_second": 5e6, "cells": 50000, "objects": 8100, "memory_MB": 80.0}]}
+        dump(f"{self.d}/r.json", bench)
+        t = run("runtime", f"{self.d}/r.json", 50000, 8100)
+        self.assertIn("| point location only | 125 | 8.00 |", t)
+        self.assertIn("| 200 | 5.00 |", t)
+        self.assertIn("50,000 view cells over 8,100 objects (`compress --count 50,000`", t)
+
+
+class Cli(unittest.TestCase):
+    def test_unknown_command_and_help(self):
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            self.assertEqual(vctables.main(["vctables", "nope"]), 2)
+        self.assertIn("no command 'nope'", err.getvalue())
+        out = io.StringIO()
+        with contextlib.redirect_stdout(out):
+            self.assertEqual(vctables.main(["vctables", "--help"]), 0)
+        for name in ["sampling", "results", "maps", "runtime", "replace-section"]:
+            self.assertIn(name, out.getvalue())
+
+
+if __name__ == "__main__":
+    unittest.main()
