@@ -32,10 +32,7 @@ int run_build(const BuildArgs& a, const Common& c) {
   config.hierarchy_path = a.output;
   config.views = a.views;
   const pipeline::BuildResult result = pipeline::build(config, c.logger());
-  if (!a.report.empty()) {
-    pipeline::write_report(a.report, result);
-    c.log("viewcells: report -> " + a.report);
-  }
+  write_report_to(a.report, result, c);
   return 0;
 }
 

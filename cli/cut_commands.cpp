@@ -25,10 +25,7 @@ int run_extract(const ExtractArgs& e, const Common& c) {
   config.scene_path = e.scene;
   config.views = e.views;
   const pipeline::ExtractResult result = pipeline::extract(config, c.logger());
-  if (!e.output.empty()) {
-    pipeline::write_report(e.output, result);
-    c.log("viewcells: view cells -> " + e.output);
-  }
+  write_report_to(e.output, result, c, "view cells");
   if (e.output.empty() && !e.views.any()) std::cout << pipeline::report_json(result);
   return 0;
 }
@@ -46,10 +43,7 @@ int run_compress(const CompressArgs& a, const Common& c) {
   config.output = a.output;
   config.flat = a.flat;
   const pipeline::CompressResult result = pipeline::compress(config, c.logger());
-  if (!a.report.empty()) {
-    pipeline::write_report(a.report, result);
-    c.log("viewcells: report -> " + a.report);
-  }
+  write_report_to(a.report, result, c);
   return 0;
 }
 

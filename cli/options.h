@@ -11,6 +11,7 @@
 
 #include "viewcells/core/vec3.h"
 #include "viewcells/pipeline/cut.h"
+#include "viewcells/pipeline/report.h"
 #include "viewcells/pipeline/sampling.h"
 
 namespace viewcells::cli {
@@ -26,6 +27,14 @@ struct Common {
   /// The pipeline's log: lines on stderr unless --quiet.
   pipeline::Log logger() const;
 };
+
+/// Writes the result's JSON report to `path` when one was asked for, and says so (`what`).
+template <class Result>
+void write_report_to(const std::string& path, const Result& result, const Common& c, const std::string& what = "report") {
+  if (path.empty()) return;
+  pipeline::write_report(path, result);
+  c.log("viewcells: " + what + " -> " + path);
+}
 
 /// A subcommand and what runs it once its options are parsed.
 struct Command {

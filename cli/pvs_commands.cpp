@@ -97,10 +97,7 @@ int run_pvs(const PvsArgs& a, const Common& c) {
   config.references = a.references;
   config.output = a.output;
   const pipeline::PvsResult result = pipeline::compute_pvs(config, c.logger());
-  if (!a.report.empty()) {
-    pipeline::write_report(a.report, result);
-    c.log("viewcells: report -> " + a.report);
-  }
+  write_report_to(a.report, result, c);
   return 0;
 }
 
@@ -176,10 +173,7 @@ int run_bake(BakeArgs a, const Common& c) {
   config.output = a.output;
   config.work_dir = a.work;
   const pipeline::BakeResult result = pipeline::bake(config, c.logger());
-  if (!a.report.empty()) {
-    pipeline::write_report(a.report, result);
-    c.log("viewcells: report -> " + a.report);
-  }
+  write_report_to(a.report, result, c);
   return 0;
 }
 

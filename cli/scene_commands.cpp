@@ -110,10 +110,7 @@ int run_sample(const SampleArgs& a, const Common& c) {
   config.segments_path = a.output;
   config.measure_raw = a.measure_raw;
   const pipeline::SampleResult result = pipeline::sample(config, c.logger());
-  if (!a.report.empty()) {
-    pipeline::write_report(a.report, result);
-    c.log("viewcells: report -> " + a.report);
-  }
+  write_report_to(a.report, result, c);
   return 0;
 }
 
