@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # A/B of the hot paths against an earlier commit, measured in one run: sampling 1M segments
-# on the city (with bare Embree's rate beside it) and a build of 20k cells from 300k segments
-# (subdivision, then merging with the neighbour graph), alternating the two binaries RUNS
+# on the city (with bare Embree's rate beside it), a build of 20k cells from 300k segments
+# (subdivision, then merging with the neighbour graph), and AGVS on 500 view cells of the
+# office (2M samples; the office's hierarchy is built once), alternating the two binaries RUNS
 # times; prints the medians and the ratio new / old. The old commit is built (Release) in a
 # git worktree under out/ab/. Usage: scripts/bench-ab.sh OLD_COMMIT [RUNS] [CITY_SIZE]
 set -euo pipefail
@@ -23,12 +24,16 @@ fi
 declare -A bin=([old]="$tree/b/cli/viewcells" [new]="$vc")
 results="$dir/ab.tsv"
 : >"$results"
+office=$(bench_scene office 4)
+"$vc" -q build "$office" --samples 500000 --max-cells 2000 --seed 1 -o "$dir/ab-office.vcells"
 for r in $(seq "$runs"); do
   for side in old new; do
     "${bin[$side]}" -q sample "$city" --segments 1000000 --measure-raw -o "$dir/ab.vseg" --report "$dir/ab-s.json"
     "${bin[$side]}" -q build "$city" --segments 300000 --max-cells 20000 --min-reduction 0 -o "$dir/ab.vcells" \
       --report "$dir/ab-b.json"
-    python3 scripts/vctables.py ab-row "$side" "$dir/ab-s.json" "$dir/ab-b.json" >>"$results"
+    "${bin[$side]}" -q pvs "$dir/ab-office.vcells" --scene "$office" --cells 500 --samples 2000000 --seed 1 \
+      -o "$dir/ab.pvs" --report "$dir/ab-p.json"
+    python3 scripts/vctables.py ab-row "$side" "$dir/ab-s.json" "$dir/ab-b.json" "$dir/ab-p.json" >>"$results"
   done
 done
 python3 scripts/vctables.py ab "$results" "$sha" "$runs" "$size"

@@ -109,8 +109,11 @@ def ab(*args):
     """BENCHMARKS.md, ab: medians of alternating old/new runs (rows from ab-row) and their ratios."""
     argv = ["vctables"] + list(args)
     rows = [l.split('\t') for l in open(argv[1]).read().split('\n') if l]
-    med = {side: [statistics.median(float(r[k]) for r in rows if r[0] == side) for k in range(1, 5)] for side in ('old', 'new')}
-    names = ['sampling Msegments/s', 'raw Embree Mrays/s', 'subdivision s (20k cells)', 'merge s (20k cells)']
+    width = min(len(r) for r in rows)
+    med = {side: [statistics.median(float(r[k]) for r in rows if r[0] == side) for k in range(1, width)]
+           for side in ('old', 'new')}
+    names = ['sampling Msegments/s', 'raw Embree Mrays/s', 'subdivision s (20k cells)', 'merge s (20k cells)',
+             'AGVS Msamples/s (office 4, 500 cells)'][:width - 1]
     print(f"Command: `scripts/bench-ab.sh {argv[2]} {argv[3]} {argv[4]}`; city size {argv[4]}, medians of {argv[3]} alternating runs\n")
     print('| quantity | old (' + argv[2] + ') | new | new / old |')
     print('| --- | ---: | ---: | ---: |')
@@ -603,13 +606,17 @@ def replace_section(path, name, cmd, table_file):
     open(path, "w").write(text)
 
 
-@command("SIDE SAMPLE_JSON BUILD_JSON")
-def ab_row(side, sample_json, build_json):
-    """One row of bench-ab.sh's TSV: side, Msegments/s, raw Mrays/s, subdivision s, merge s."""
+@command("SIDE SAMPLE_JSON BUILD_JSON [PVS_JSON]")
+def ab_row(side, sample_json, build_json, pvs_json=None):
+    """One row of bench-ab.sh's TSV: side, Msegments/s, raw Mrays/s, subdivision s, merge s (and AGVS Msamples/s)."""
     s = json.load(open(sample_json))["timings"]
     b = json.load(open(build_json))["timings"]
-    print(side, s["segments_per_second"] / 1e6, s["raw_rays_per_second"] / 1e6, b["subdivision_seconds"],
-          b["merge_seconds"], sep="\t")
+    row = [side, s["segments_per_second"] / 1e6, s["raw_rays_per_second"] / 1e6, b["subdivision_seconds"],
+           b["merge_seconds"]]
+    if pvs_json:
+        p = json.load(open(pvs_json))
+        row.append(p["samples_per_second"] / 1e6)
+    print(*row, sep="\t")
 
 
 @command("INFO_JSON")

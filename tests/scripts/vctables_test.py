@@ -95,15 +95,19 @@ class Tables(unittest.TestCase):
         tsv = f"{self.d}/ab.tsv"
         with open(tsv, "w") as f:
             for side, v in [("old", 1.0), ("new", 1.1), ("old", 3.0), ("new", 3.3), ("old", 2.0), ("new", 2.2)]:
-                f.write(f"{side}\t{v}\t{v}\t{v}\t{v}\n")
+                f.write(f"{side}\t{v}\t{v}\t{v}\t{v}\t{2 * v}\n")
         t = run("ab", tsv, "abc123", 3, 23)
         r = row(t, "sampling Msegments/s")
         self.assertEqual(r[1:], ["2.00", "2.20", "1.100"])
+        self.assertEqual(row(t, "AGVS Msamples/s (office 4, 500 cells)")[1:], ["4.00", "4.40", "1.100"])
 
     def test_ab_row_reads_both_reports(self):
         dump(f"{self.d}/s.json", {"timings": {"segments_per_second": 2e6, "raw_rays_per_second": 5e6}})
         dump(f"{self.d}/b.json", {"timings": {"subdivision_seconds": 3.5, "merge_seconds": 0.25}})
         self.assertEqual(run("ab-row", "new", f"{self.d}/s.json", f"{self.d}/b.json"), "new\t2.0\t5.0\t3.5\t0.25\n")
+        dump(f"{self.d}/p.json", {"samples_per_second": 3e6})
+        self.assertEqual(run("ab-row", "old", f"{self.d}/s.json", f"{self.d}/b.json", f"{self.d}/p.json"),
+                         "old\t2.0\t5.0\t3.5\t0.25\t3.0\n")
 
     def agvs_report(self, seconds, mean, entries, curve, est=1.0):
         return {"samples": 1000, "rays": 2000, "seconds": seconds, "mean_pvs_size": mean, "pvs_entries": entries,
