@@ -155,6 +155,7 @@ struct BakeArgs {
   AgvsOptions agvs;
   uint64_t agvs_seed = 1;
   std::string output, report, work;
+  double checkpoint = 60;
 };
 
 int run_bake(BakeArgs a, const Common& c) {
@@ -172,6 +173,7 @@ int run_bake(BakeArgs a, const Common& c) {
   config.agvs.seed = a.sampling.seed;
   config.output = a.output;
   config.work_dir = a.work;
+  config.checkpoint_seconds = a.checkpoint;
   const pipeline::BakeResult result = pipeline::bake(config, c.logger());
   write_report_to(a.report, result, c);
   return 0;
@@ -199,6 +201,11 @@ void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
   bk->add_option("--work", a->work,
                  "Work directory: keeps the hierarchy and the AGVS state, so that a rerun with the same scene and "
                  "settings skips the hierarchy and continues sampling (e.g. with a smaller --pixel-error)");
+  bk->add_option("--checkpoint", a->checkpoint,
+                 "With --work: save the AGVS state this often, in seconds, so that a bake cut off continues from "
+                 "there when run again (0: only at the end)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   bk->add_option("-o,--output", a->output, "The .pvs file to write")->required();
   bk->add_option("--report", a->report, "JSON report: budget, cells, file bytes, pixel error, samples, timings");
   bk->footer("Without --pixel-error, --time or --agvs-samples, AGVS runs to an estimated pixel error of 10 (of 1024x1024).");

@@ -96,10 +96,21 @@ std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, const LoadedS
     }
   }
   log("viewcells: bake: PVSs of " + std::to_string(cells.cell_count()) + " view cells by AGVS");
-  solver.run();
-  if (!state.empty()) {
-    const UnbatchedWrites now;
-    solver.save(state, identity);
+  // With a work directory, the state is saved every checkpoint_seconds: the run stops between
+  // batches, saves, and goes on, which changes nothing of its samples (a resumed state
+  // continues exactly), so a bake cut off mid-way continues from the last checkpoint.
+  const AgvsConfig& a = c.agvs;
+  while (true) {
+    const double until = solver.stats().seconds + c.checkpoint_seconds;
+    const bool sliced = !state.empty() && c.checkpoint_seconds > 0 && (!(a.max_seconds > 0) || until < a.max_seconds);
+    solver.set_limits(a.max_samples, sliced ? until : a.max_seconds, a.pixel_error);
+    solver.run();
+    if (!state.empty()) {
+      const UnbatchedWrites now;
+      solver.save(state, identity);
+    }
+    if (!sliced || solver.stats().stop_reason != "reached the time limit") break;
+    log("viewcells: bake: checkpoint after " + std::to_string(solver.stats().samples) + " samples -> " + state);
   }
   out.agvs = solver.stats();
   out.pixel_error = solver.pixel_error();

@@ -25,6 +25,7 @@ struct BakeConfig {
   AgvsConfig agvs;                 ///< stopping rule (pixel error, time, samples), seed, batch
   std::string output;              ///< .pvs
   std::string work_dir;            ///< empty: nothing kept between runs
+  double checkpoint_seconds = 60;  ///< with a work directory: AGVS state saved this often (0: at the end)
 };
 
 struct BakeResult {
