@@ -3,7 +3,7 @@
 # on the city (with bare Embree's rate beside it), a build of 20k cells from 300k segments
 # (subdivision, then merging with the neighbour graph), and AGVS on 500 view cells of the
 # office (2M samples; the office's hierarchy is built once), alternating the two binaries RUNS
-# times; prints the medians and the ratio new / old. The old commit is built (Release) in a
+# times; the medians and the ratio new / old go into the ab section of BENCHMARKS.md. The old commit is built (Release) in a
 # git worktree under out/ab/. Usage: scripts/bench-ab.sh OLD_COMMIT [RUNS] [CITY_SIZE]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -36,4 +36,6 @@ for r in $(seq "$runs"); do
     python3 scripts/vctables.py ab-row "$side" "$dir/ab-s.json" "$dir/ab-b.json" "$dir/ab-p.json" >>"$results"
   done
 done
-python3 scripts/vctables.py ab "$results" "$sha" "$runs" "$size"
+python3 scripts/vctables.py ab "$results" "$sha" "$runs" "$size" > "$dir/ab-table.md"
+python3 scripts/vctables.py replace-section BENCHMARKS.md ab "scripts/bench-ab.sh $sha $runs $size" "$dir/ab-table.md"
+cat "$dir/ab-table.md"

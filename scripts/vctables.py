@@ -114,7 +114,8 @@ def ab(*args):
            for side in ('old', 'new')}
     names = ['sampling Msegments/s', 'raw Embree Mrays/s', 'subdivision s (20k cells)', 'merge s (20k cells)',
              'AGVS Msamples/s (office 4, 500 cells)'][:width - 1]
-    print(f"Command: `scripts/bench-ab.sh {argv[2]} {argv[3]} {argv[4]}`; city size {argv[4]}, medians of {argv[3]} alternating runs\n")
+    print(f"City size {argv[4]}, office size 4; medians of {argv[3]} alternating runs of the old ({argv[2]}) and the "
+          f"new build; threads = 2.\n")
     print('| quantity | old (' + argv[2] + ') | new | new / old |')
     print('| --- | ---: | ---: | ---: |')
     for n, o, w in zip(names, med['old'], med['new']):

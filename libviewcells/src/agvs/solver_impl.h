@@ -2,7 +2,7 @@
 // AGVS paper 4.6 (putting it all together): the solver's state, shared by the files that
 // implement its parts: distributions.cpp (4.3, 4.4), mixture.cpp (4.2), batch.cpp (4.1, one
 // batch of the sampling loop), estimator.cpp (4.5), filter.cpp (5), edit.cpp (6),
-// state_io.cpp (saving and resuming) and solver.cpp (the loop and the public API).
+// state_io.cpp (saving and resuming) and agvs.cpp (the loop and the public API).
 #include <algorithm>
 #include <deque>
 #include <limits>

@@ -201,7 +201,7 @@ ViewCellSet first_cut(const BakeConfig& c, const SubdivisionFile& file, const Lo
 BakeResult bake(const BakeConfig& c, const Log& log) {
   if ((c.cells > 0) == (c.memory > 0)) throw Error("bake needs one budget: --cells N or --memory BYTES");
   if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0))
-    throw Error("give when the PVSs are good enough: --pixel-error, --time or --samples");
+    throw Error("give when the PVSs are good enough: a pixel error, a time or a number of AGVS samples");
   Stopwatch total;
   BakeResult out;
   out.config = c;

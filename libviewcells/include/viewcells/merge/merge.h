@@ -32,7 +32,7 @@ struct CellPartition {
 };
 
 /// The leaves of `s` as a partition, in the order of s.leaves(); `leaf_pvs` is per node
-/// (subdivision_io.h: leaf_pvs). Needs the leaf cells (s.cells) for the neighbours.
+/// (bsp/subdivision.h: leaf_pvs). Needs the leaf cells (s.cells) for the neighbours.
 CellPartition partition_from_subdivision(const Subdivision& s, const std::vector<std::vector<uint32_t>>& leaf_pvs);
 
 /// A uniform nx x ny x nz grid over segments.view_box as a partition (the simplest kD
