@@ -12,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <new>
 #include <stdexcept>
 #include <string>
@@ -136,49 +137,123 @@ std::string read_container(const std::string& path) {
 
 // ------------------------------------------------------------ exact orientation predicate
 
-/// a + b = x + y exactly.
-inline void two_sum(double a, double b, double& x, double& y) {
-  x = a + b;
-  const double bv = x - a, av = x - bv;
-  y = (a - av) + (b - bv);
-}
+/// Signed integers of any size (32-bit limbs, least significant first), for the exact
+/// fallback: a double is an integer times a power of two, so with every coordinate of a
+/// predicate on the grid of the smallest power among them, the determinant is an exact
+/// integer sum whatever the magnitudes (no overflow, no underflow, denormals included).
+struct BigInt {
+  bool negative = false;
+  std::vector<uint32_t> limbs;  // magnitude; empty for zero
 
-/// Adds b to the expansion e (components non-overlapping, increasing in magnitude, no
-/// zeros); Shewchuk's Grow-Expansion with zero elimination.
-void grow(std::vector<double>& e, double b) {
-  std::vector<double> h;
-  h.reserve(e.size() + 1);
-  double q = b;
-  for (double ei : e) {
-    double sum, err;
-    two_sum(q, ei, sum, err);
-    if (err != 0) h.push_back(err);
-    q = sum;
+  void trim() {
+    while (!limbs.empty() && limbs.back() == 0) limbs.pop_back();
+    if (limbs.empty()) negative = false;
   }
-  if (q != 0) h.push_back(q);
-  e.swap(h);
+  /// |m| * 2^shift, with the sign of `negative`.
+  static BigInt from(uint64_t m, int shift, bool negative) {
+    BigInt b;
+    b.negative = negative;
+    b.limbs.assign(static_cast<size_t>(shift / 32) + 3, 0);
+    const int bit = shift % 32;  // m < 2^53, so m 2^bit < 2^85: three limbs
+    const uint64_t low = m << bit, high = bit ? m >> (64 - bit) : 0;
+    b.limbs[shift / 32] = static_cast<uint32_t>(low);
+    b.limbs[shift / 32 + 1] = static_cast<uint32_t>(low >> 32);
+    b.limbs[shift / 32 + 2] = static_cast<uint32_t>(high);
+    b.trim();
+    return b;
+  }
+};
+
+int compare_magnitude(const BigInt& a, const BigInt& b) {
+  if (a.limbs.size() != b.limbs.size()) return a.limbs.size() < b.limbs.size() ? -1 : 1;
+  for (size_t k = a.limbs.size(); k-- > 0;)
+    if (a.limbs[k] != b.limbs[k]) return a.limbs[k] < b.limbs[k] ? -1 : 1;
+  return 0;
 }
 
-/// Adds s * x * y * z to e exactly (two products through fma).
-void add_triple(std::vector<double>& e, double s, double x, double y, double z) {
-  const double p = s * x * y;  // s is +-1: s * x is exact
-  const double pe = std::fma(s * x, y, -p);
-  const double p1 = p * z, e1 = std::fma(p, z, -p1);
-  const double p2 = pe * z, e2 = std::fma(pe, z, -p2);
-  for (double t : {e2, p2, e1, p1}) grow(e, t);
+BigInt multiply(const BigInt& a, const BigInt& b) {
+  BigInt r;
+  if (a.limbs.empty() || b.limbs.empty()) return r;
+  r.negative = a.negative != b.negative;
+  r.limbs.assign(a.limbs.size() + b.limbs.size(), 0);
+  for (size_t i = 0; i < a.limbs.size(); ++i) {
+    uint64_t carry = 0;
+    for (size_t j = 0; j < b.limbs.size(); ++j) {
+      const uint64_t t = static_cast<uint64_t>(a.limbs[i]) * b.limbs[j] + r.limbs[i + j] + carry;
+      r.limbs[i + j] = static_cast<uint32_t>(t);
+      carry = t >> 32;
+    }
+    r.limbs[i + b.limbs.size()] = static_cast<uint32_t>(carry);
+  }
+  r.trim();
+  return r;
 }
 
-/// det [x; y; z] of three rows added to e with sign s, exactly.
-void add_det3(std::vector<double>& e, double s, const Vec& x, const Vec& y, const Vec& z) {
-  const double* X = x.v;
-  const double* Y = y.v;
-  const double* Z = z.v;
-  add_triple(e, s, X[0], Y[1], Z[2]);
-  add_triple(e, -s, X[0], Y[2], Z[1]);
-  add_triple(e, -s, X[1], Y[0], Z[2]);
-  add_triple(e, s, X[1], Y[2], Z[0]);
-  add_triple(e, s, X[2], Y[0], Z[1]);
-  add_triple(e, -s, X[2], Y[1], Z[0]);
+BigInt add(const BigInt& a, const BigInt& b) {
+  BigInt r;
+  if (a.negative == b.negative) {
+    r.negative = a.negative;
+    r.limbs.assign(std::max(a.limbs.size(), b.limbs.size()) + 1, 0);
+    uint64_t carry = 0;
+    for (size_t k = 0; k + 1 < r.limbs.size(); ++k) {
+      const uint64_t t = carry + (k < a.limbs.size() ? a.limbs[k] : 0) + (k < b.limbs.size() ? b.limbs[k] : 0);
+      r.limbs[k] = static_cast<uint32_t>(t);
+      carry = t >> 32;
+    }
+    r.limbs.back() = static_cast<uint32_t>(carry);
+  } else {
+    const bool a_larger = compare_magnitude(a, b) >= 0;
+    const BigInt& big = a_larger ? a : b;
+    const BigInt& small = a_larger ? b : a;
+    r.negative = big.negative;
+    r.limbs.assign(big.limbs.size(), 0);
+    int64_t borrow = 0;
+    for (size_t k = 0; k < big.limbs.size(); ++k) {
+      int64_t t = static_cast<int64_t>(big.limbs[k]) - (k < small.limbs.size() ? small.limbs[k] : 0) - borrow;
+      borrow = t < 0;
+      if (t < 0) t += int64_t{1} << 32;
+      r.limbs[k] = static_cast<uint32_t>(t);
+    }
+  }
+  r.trim();
+  return r;
+}
+
+/// The sign of det [a 1; b 1; c 1; d 1], exactly: the 24 signed triple products of the
+/// coordinates, each coordinate an integer on the grid 2^emin of the smallest among them.
+int exact_det4_sign(const Vec* points[4]) {
+  int emin = std::numeric_limits<int>::max();
+  for (int i = 0; i < 4; ++i)
+    for (double x : points[i]->v)
+      if (x != 0) {
+        int e = 0;
+        std::frexp(x, &e);
+        emin = std::min(emin, e - 53);
+      }
+  if (emin == std::numeric_limits<int>::max()) return 0;  // every point at the origin
+  BigInt q[4][3];
+  for (int i = 0; i < 4; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const double x = points[i]->v[k];
+      if (x == 0) continue;
+      int e = 0;
+      const double f = std::frexp(x, &e);  // x = f 2^e, 0.5 <= |f| < 1
+      const uint64_t m = static_cast<uint64_t>(std::ldexp(std::fabs(f), 53));  // exact: 53 bits
+      q[i][k] = BigInt::from(m, e - 53 - emin, x < 0);
+    }
+  // Cofactors along the column of ones: det4 = -det[b;c;d] + det[a;c;d] - det[a;b;d] + det[a;b;c].
+  static constexpr int kRows[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
+  static constexpr int kPerm[6][3] = {{0, 1, 2}, {1, 2, 0}, {2, 0, 1}, {0, 2, 1}, {1, 0, 2}, {2, 1, 0}};
+  BigInt sum;
+  for (int minor = 0; minor < 4; ++minor)
+    for (int p = 0; p < 6; ++p) {
+      BigInt t = multiply(multiply(q[kRows[minor][0]][kPerm[p][0]], q[kRows[minor][1]][kPerm[p][1]]),
+                          q[kRows[minor][2]][kPerm[p][2]]);
+      // The minor's sign (- for 0 and 2) times the permutation's (the first three are even).
+      if (((minor % 2 == 0) == (p < 3)) && !t.limbs.empty()) t.negative = !t.negative;
+      sum = add(sum, t);
+    }
+  return sum.limbs.empty() ? 0 : (sum.negative ? -1 : 1);
 }
 
 /// Sign of det [b - a; c - a; d - a] (CGAL's orientation(a, b, c, d)): a floating-point
@@ -199,16 +274,15 @@ int orientation(const GeneralPlane& pl, const Vec& d) {
                            (std::fabs(adxbdy) + std::fabs(bdxady)) * std::fabs(cdz);
   constexpr double eps = 1.1102230246251565e-16;  // 2^-53
   const double bound = 2 * (7.0 + 56.0 * eps) * eps * permanent;  // twice Shewchuk's A bound
-  if (det > bound) return -1;
-  if (-det > bound) return 1;
-  // det [a 1; b 1; c 1; d 1] = -det [b - a; c - a; d - a], as a sum of 24 exact triple products.
-  std::vector<double> e;
-  add_det3(e, -1, pl.b, pl.c, d);
-  add_det3(e, 1, pl.a, pl.c, d);
-  add_det3(e, -1, pl.a, pl.b, d);
-  add_det3(e, 1, pl.a, pl.b, pl.c);
-  if (e.empty()) return 0;
-  return e.back() > 0 ? -1 : 1;
+  // The bound holds without underflow or overflow: far from both, the filter decides.
+  if (permanent > 1e-250 && permanent < 1e250) {
+    if (det > bound) return -1;
+    if (-det > bound) return 1;
+  }
+  // Undecided, or out of double's range (NaN or infinite products): exactly, where
+  // det [a 1; b 1; c 1; d 1] = -det [b - a; c - a; d - a].
+  const Vec* points[4] = {&pl.a, &pl.b, &pl.c, &d};
+  return -exact_det4_sign(points);
 }
 
 }  // namespace
@@ -441,9 +515,14 @@ void read_file(const std::string& path, vc_pvs& f) {
   f.rule = r.get_string();
   for (double& x : f.lo) x = r.get<double>();
   for (double& x : f.hi) x = r.get<double>();
-  for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(f.lo[k]) || !std::isfinite(f.hi[k]) || !(f.lo[k] < f.hi[k]))
-      throw FileError("corrupt file: invalid view box");
+  // As the toolkit checks it (Box3::volume): finite corners and a positive volume in double.
+  bool box_ok = true;
+  double volume = 1;
+  for (int k = 0; k < 3; ++k) {
+    box_ok &= std::isfinite(f.lo[k]) && std::isfinite(f.hi[k]) && f.lo[k] <= f.hi[k];
+    volume *= f.hi[k] - f.lo[k];
+  }
+  if (!box_ok || !(volume > 0)) throw FileError("corrupt file: invalid view box");
   read_bsp(r, f, max_items);
   read_lists(r, f, max_items);
   for (Node& n : f.nodes) {

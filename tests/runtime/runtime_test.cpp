@@ -138,6 +138,63 @@ TEST(Runtime, LocatesLikeTheToolkitOnAndNearEveryPlane) {
   EXPECT_EQ(r.locate(box.hi.x, box.hi.y, box.hi.z), l.file.locate(box.hi));
 }
 
+/// A .pvs of two cells split by the plane through a, b, c, in the view box [lo, hi].
+std::string two_cell_file(const Vec3& a, const Vec3& b, const Vec3& c, const Box3& box, const std::string& name) {
+  PvsFile f;
+  f.bsp.view_box = box;
+  for (int axis = 0; axis < 3; ++axis) {
+    f.bsp.planes.push_back(Plane::axis_aligned(axis, box.lo[axis]));
+    f.bsp.planes.push_back(Plane::axis_aligned(axis, box.hi[axis]));
+  }
+  Plane p;
+  p.normal = {0, 0, 1};  // not used to decide sides: the points are
+  p.points = {a, b, c};
+  f.bsp.planes.push_back(p);
+  f.bsp.nodes.resize(3);
+  f.bsp.nodes[0].plane = 6;
+  f.bsp.nodes[0].child[0] = 1;
+  f.bsp.nodes[0].child[1] = 2;
+  f.bsp.nodes[1].parent = f.bsp.nodes[2].parent = 0;
+  f.leaf_cell = {-1, 0, 1};
+  f.cell_mht_node = {0, 1};
+  f.object_count = 2;
+  f.pvs.cell_count = 2;
+  f.pvs.parent = {-1, -1};
+  f.pvs.stored = {{0}, {1}};
+  const std::string path = test::temp_path(name);
+  write_pvs(path, f);
+  return path;
+}
+
+TEST(Runtime, LocatesLikeTheToolkitAtAnyMagnitude) {
+  // Points whose products overflow or underflow double (1e136 cubed, 1e-104 cubed): the
+  // filter cannot decide, and the exact fallback must still agree with CGAL. A fuzzed file
+  // with a view box at 1e136 found the first.
+  Rng rng(11);
+  size_t checked = 0;
+  for (double s : {1e-104, 1e-100, 1e-10, 1.0, 1e10, 1e100, 1e136, 1e150}) {
+    const Vec3 a{0.1 * s, -0.3 * s, 0.2 * s}, b{0.9 * s, 0.2 * s, -0.1 * s}, c{-0.2 * s, 0.8 * s, 0.3 * s};
+    const Box3 box{{-s, -s, -s}, {s, s, s}};
+    const std::string path = two_cell_file(a, b, c, box, "magnitude.pvs");
+    ASSERT_GT(box.volume(), 0) << s;  // both readers refuse a box whose volume underflows
+    const PvsFile f = read_pvs(path);
+    const runtime::PvsFile r(path);
+    for (int k = 0; k < 300; ++k) {
+      const double u = rng.uniform(-1, 1), v = rng.uniform(-1, 1);
+      Vec3 p = a + u * (b - a) + v * (c - a);  // on the plane, up to rounding
+      for (int ulps = -2; ulps <= 2; ++ulps) {
+        Vec3 q = p;
+        for (int i = 0; i < std::abs(ulps); ++i) q.z = std::nextafter(q.z, ulps > 0 ? 1e308 : -1e308);
+        if (!box.contains(q)) continue;
+        ++checked;
+        ASSERT_EQ(r.locate(q.x, q.y, q.z), f.locate(q)) << "scale " << s << " point " << q.x << " " << q.y << " " << q.z;
+      }
+    }
+    for (const Vec3& q : {a, b, c, Vec3{0, 0, 0}}) ASSERT_EQ(r.locate(q.x, q.y, q.z), f.locate(q)) << "scale " << s;
+  }
+  EXPECT_GT(checked, 1000u);
+}
+
 /// vc_pvs_open's answer for a file: 0, or the code with the message checked to name the file.
 int open_code(const std::string& path) {
   vc_pvs* p = nullptr;
