@@ -256,9 +256,9 @@ int exact_det4_sign(const Vec* points[4]) {
   return sum.limbs.empty() ? 0 : (sum.negative ? -1 : 1);
 }
 
-/// Sign of det [b - a; c - a; d - a] (CGAL's orientation(a, b, c, d)): a floating-point
-/// filter with Shewchuk's error bound, and exact expansion arithmetic when it cannot decide.
-int orientation(const GeneralPlane& pl, const Vec& d) {
+/// The floating-point filter of orientation(): the sign of det [b - a; c - a; d - a] when
+/// Shewchuk's error bound decides it, else 0 (undecided, or out of double's range).
+int filtered_orientation(const GeneralPlane& pl, const Vec& d) {
   const double* a = pl.a.v;
   const double* b = pl.b.v;
   const double* c = pl.c.v;
@@ -279,7 +279,13 @@ int orientation(const GeneralPlane& pl, const Vec& d) {
     if (det > bound) return -1;
     if (-det > bound) return 1;
   }
-  // Undecided, or out of double's range (NaN or infinite products): exactly, where
+  return 0;
+}
+
+/// Sign of det [b - a; c - a; d - a] (CGAL's orientation(a, b, c, d)), exactly: the filter,
+/// and the exact integer determinant when it cannot decide.
+int orientation(const GeneralPlane& pl, const Vec& d) {
+  if (const int sign = filtered_orientation(pl, d)) return sign;
   // det [a 1; b 1; c 1; d 1] = -det [b - a; c - a; d - a].
   const Vec* points[4] = {&pl.a, &pl.b, &pl.c, &d};
   return -exact_det4_sign(points);
@@ -458,10 +464,12 @@ uint32_t deepest_node(const vc_pvs& f, const double lo[3], const double hi[3]) {
       all_neg = hi[axis] <= node.offset;
       all_pos = lo[axis] > node.offset;
     } else {
+      // The filter alone: a corner it cannot decide stops the descent (the grid only needs to
+      // be right where it descends, and exact signs of a grid of corners could be slow).
       for (int c = 0; c < 8 && (all_neg || all_pos); ++c) {
         const Vec corner{{(c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]}};
-        const int side = orientation(f.planes[node.meta & kIndex], corner);
-        all_neg &= side <= 0;
+        const int side = filtered_orientation(f.planes[node.meta & kIndex], corner);
+        all_neg &= side < 0;
         all_pos &= side > 0;
       }
     }
