@@ -17,7 +17,8 @@ fi
 "$vc" compress "$dir/city-merge.vcells" --count "$cells" -o "$dir/city-$cells.pvs" -q
 objects=$(python3 scripts/vctables.py get "$dir/merge-city.json" scene objects)
 VIEWCELLS_BENCH_PVS="$dir/city-$cells.pvs" taskset -c 0 build-release/bench/viewcells_runtime_bench \
-  --benchmark_min_time=2 --benchmark_format=json --benchmark_out="$dir/runtime.json" >/dev/null
+  --benchmark_min_time=1 --benchmark_repetitions=7 --benchmark_report_aggregates_only=true \
+  --benchmark_format=json --benchmark_out="$dir/runtime.json" >/dev/null
 python3 scripts/vctables.py runtime "$dir/runtime.json" "$cells" "$objects" > "$dir/runtime-table.md"
 python3 scripts/vctables.py replace-section BENCHMARKS.md runtime "scripts/bench-runtime.sh $size $cells" \
   "$dir/runtime-table.md"

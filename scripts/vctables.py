@@ -658,13 +658,17 @@ def runtime(path, cells, objects):
     """BENCHMARKS.md, runtime: Google Benchmark's JSON of viewcells_runtime_bench."""
     r = json.load(open(path))
     ctx = r["context"]
-    rows = {b["name"]: b for b in r["benchmarks"] if b.get("run_type", "iteration") == "iteration"}
+    # Medians of the repetitions when there are some, else the single runs.
+    medians = {b["run_name"]: b for b in r["benchmarks"] if b.get("aggregate_name") == "median"}
+    rows = medians or {b["name"]: b for b in r["benchmarks"] if b.get("run_type", "iteration") == "iteration"}
+    reps = max((b.get("repetitions", 1) for b in r["benchmarks"]), default=1)
     first = next(iter(rows.values()))
     print(f"A .pvs of the city: {int(first['cells']):,} view cells over {int(first['objects']):,} objects "
           f"(`compress --count {int(cells):,}` of the merging benchmark's hierarchy); the reader holds "
           f"{first['memory_MB']:.1f} MB once the file is open. One core (taskset) of {ctx.get('num_cpus', '?')} at "
           f"{ctx.get('mhz_per_cpu', 0) / 1000:.1f} GHz, Google Benchmark; viewpoints uniform in the view box "
-          f"(1M drawn once, seed 1) unless said: the worst case for caches, since every query lands somewhere new.\n")
+          f"(1M drawn once, seed 1) unless said: the worst case for caches, since every query lands somewhere new"
+          + (f"; medians of {reps} repetitions" if medians else "") + ".\n")
     print("| query | ns per query | M queries/s per core |")
     print("| --- | ---: | ---: |")
     names = {"BM_Locate": "point location only",

@@ -260,6 +260,14 @@ class Tables(unittest.TestCase):
                                  "items_per_second": 5e6, "cells": 50000, "objects": 8100, "memory_MB": 80.0}]}
         dump(f"{self.d}/r.json", bench)
         t = run("runtime", f"{self.d}/r.json", 50000, 8100)
+        # With repetitions, the medians are reported.
+        med = dict(bench["benchmarks"][0], name="BM_Locate_median", run_name="BM_Locate", run_type="aggregate",
+                   aggregate_name="median", repetitions=7, cpu_time=100.0, items_per_second=1e7)
+        mean = dict(med, name="BM_Locate_mean", aggregate_name="mean", cpu_time=300.0, items_per_second=3e6)
+        dump(f"{self.d}/m.json", dict(bench, benchmarks=[mean, med]))
+        tm = run("runtime", f"{self.d}/m.json", 50000, 8100)
+        self.assertIn("| point location only | 100 | 10.00 |", tm)
+        self.assertIn("medians of 7 repetitions", tm)
         self.assertIn("| point location only | 125 | 8.00 |", t)
         self.assertIn("| 200 | 5.00 |", t)
         self.assertIn("50,000 view cells over 8,100 objects (`compress --count 50,000`", t)
