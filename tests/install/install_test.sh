@@ -1,15 +1,18 @@
 #!/usr/bin/env bash
 # Installs the build into a temporary prefix, configures examples/consumer against it with
 # find_package(viewcells), builds it and checks that its answers are the CLI's:
-#   install_test.sh BUILD_DIR VIEWCELLS WORK
+#   install_test.sh BUILD_DIR VIEWCELLS WORK [FLAGS]
+# FLAGS: what the consumer compiles and links with too (a sanitized build's installed
+# libraries need the sanitizers' runtimes).
 set -euo pipefail
-build="$1"; vc="$2"; work="$3"
+build="$1"; vc="$2"; work="$3"; flags="${4:-}"
 src="$(cd "$(dirname "$0")/../.." && pwd)"
 rm -rf "$work"; mkdir -p "$work"
 cmake --install "$build" --prefix "$work/prefix" >/dev/null
 test -f "$work/prefix/lib/cmake/viewcells/viewcellsConfig.cmake"
 test -f "$work/prefix/include/viewcells/runtime.h"
-cmake -S "$src/examples/consumer" -B "$work/consumer" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
+cmake -S "$src/examples/consumer" -B "$work/consumer" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" \
+  -DCMAKE_C_FLAGS="$flags" -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="$flags" >/dev/null
 cmake --build "$work/consumer" >/dev/null
 
 # A small level, made and queried by the CLI.
