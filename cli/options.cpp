@@ -23,14 +23,6 @@ pipeline::Log Common::logger() const {
   };
 }
 
-std::string fmt(double v, int precision) {
-  std::ostringstream os;
-  os.setf(std::ios::fixed);
-  os.precision(precision);
-  os << v;
-  return os.str();
-}
-
 CLI::Validator whole(uint64_t lo, uint64_t hi) {
   return CLI::Validator(
       [lo, hi](const std::string& text) -> std::string {

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "viewcells/core/format.h"
 #include "viewcells/core/vec3.h"
 #include "viewcells/pipeline/cut.h"
 #include "viewcells/pipeline/report.h"
@@ -42,9 +43,6 @@ struct Command {
   std::function<int()> run;
 };
 using Commands = std::vector<Command>;
-
-/// v with `precision` decimals.
-std::string fmt(double v, int precision = 3);
 
 /// A whole number from lo to hi, written without sign or exponent (CLI11 alone reads "-1" into
 /// an unsigned option as 2^64 - 1).

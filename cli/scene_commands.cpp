@@ -42,11 +42,6 @@ struct InfoArgs {
   std::string json_path;
 };
 
-std::string describe_box(const Box3& b) {
-  return "[" + fmt(b.lo.x, 3) + ", " + fmt(b.lo.y, 3) + ", " + fmt(b.lo.z, 3) + "] - [" + fmt(b.hi.x, 3) + ", " +
-         fmt(b.hi.y, 3) + ", " + fmt(b.hi.z, 3) + "]";
-}
-
 void print_map(const pipeline::MapInfo& m) {
   const Q3Map& map = m.map;
   const Q3MeshStats& st = m.mesh;

@@ -8,7 +8,7 @@
 #include <set>
 #include <sstream>
 
-#include "text.h"
+#include "viewcells/core/format.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
@@ -46,7 +46,7 @@ std::string read_text(const std::string& path) {
 
 /// The hierarchy: from the work directory when it holds one built with these settings for
 /// this scene, else built (and kept there).
-SubdivisionFile hierarchy(const BakeConfig& c, const LoadedScene& loaded, uint32_t max_cells, BakeResult& out,
+SubdivisionFile hierarchy(const BakeConfig& c, LoadedScene& loaded, uint32_t max_cells, BakeResult& out,
                           const Log& log) {
   const std::string key = hierarchy_key(c, max_cells);
   const std::string dir = c.work_dir, vcells = dir + "/hierarchy.vcells", key_path = dir + "/hierarchy.key";
@@ -65,7 +65,9 @@ SubdivisionFile hierarchy(const BakeConfig& c, const LoadedScene& loaded, uint32
   b.model = c.model;
   b.subdivision = c.subdivision;
   b.subdivision.max_cells = max_cells;
-  BuildResult built = build(b, log);
+  // The scene already loaded samples the hierarchy, and comes back for AGVS.
+  BuildResult built = build(b, std::move(loaded), log);
+  loaded = std::move(built.sampling.loaded);
   out.sampling = built.sampling.result.stats;
   if (!dir.empty()) {
     const UnbatchedWrites now;  // a checkpoint: kept even when a later stage fails
@@ -144,20 +146,16 @@ std::vector<std::vector<uint32_t>> coarsen(const MergeHistory& h, const std::vec
 
 namespace {
 
-/// Every cell's PVS of a .pvs file, as sorted lists.
-std::vector<std::vector<uint32_t>> cells_pvs(const PvsFile& pf) {
-  std::vector<std::vector<uint32_t>> lists(pf.pvs.cell_count);
-  for (uint32_t i = 0; i < pf.pvs.cell_count; ++i) lists[i] = pf.pvs.cell_pvs(i);
-  return lists;
-}
-
-/// Writes the .pvs of `set` with `lists`; returns its size in bytes.
+/// Writes the .pvs of the view cells `set`: with the PVSs `lists`, or without them the
+/// construction samples' (what pvs_file_for puts there). Only a file that is kept is read back
+/// and compared (`check`); the sizes a search tries are just measured. Returns its bytes.
 uint64_t write_cut(const std::string& path, const SubdivisionFile& file, const ViewCellSet& set,
-                   const std::vector<std::vector<uint32_t>>& lists) {
+                   const std::vector<std::vector<uint32_t>>* lists, bool check) {
   PvsFile pf = pvs_file_for(file, set);
   pf.rule += "; PVS by agvs";
-  pf.pvs = compress_pvs(*file.history, set.cells, lists);
-  write_pvs_checked(path, pf, lists);
+  if (lists) pf.pvs = compress_pvs(*file.history, set.cells, *lists);
+  if (check) write_pvs_checked(path, pf, *lists);
+  else write_pvs(path, pf);
   return std::filesystem::file_size(staged_path(path));
 }
 
@@ -186,7 +184,7 @@ ViewCellSet first_cut(const BakeConfig& c, const SubdivisionFile& file, const Lo
   if (c.cells) return extract_by_count(h, std::min<size_t>(c.cells, h.leaf_count));
   const size_t n = largest_fitting(h.min_cells(), h.leaf_count, c.memory, [&](size_t count) {
     const ViewCellSet cut = extract_by_count(h, count);
-    return write_cut(c.output, file, cut, cells_pvs(pvs_file_for(file, cut)));
+    return write_cut(c.output, file, cut, nullptr, false);
   });
   if (n == 0)
     throw Error(c.output, 0, "not even " + std::to_string(h.min_cells()) + " view cell(s) fit in " +
@@ -219,7 +217,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   out.agvs_cells = static_cast<uint32_t>(set.cells.size());
   ViewCellSet written = set;
   std::vector<std::vector<uint32_t>> written_lists = lists;
-  out.file_bytes = write_cut(c.output, file, set, lists);
+  out.file_bytes = write_cut(c.output, file, set, &lists, true);
   if (c.memory && out.file_bytes > c.memory) {
     // AGVS found more than the construction samples: the largest coarser cut that fits, with
     // the unions of the sampled PVSs.
@@ -227,14 +225,15 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
         " cells exceed the budget of " + std::to_string(c.memory) + ": coarsening");
     const size_t n = largest_fitting(h.min_cells(), set.cells.size() - 1, c.memory, [&](size_t count) {
       const ViewCellSet cut = extract_by_count(h, count);
-      return write_cut(c.output, file, cut, coarsen(h, set.cells, lists, cut.cells));
+      const auto coarse = coarsen(h, set.cells, lists, cut.cells);
+      return write_cut(c.output, file, cut, &coarse, false);
     });
     if (n == 0)
       throw Error(c.output, 0, "not even " + std::to_string(h.min_cells()) + " view cell(s) fit in " +
                                    std::to_string(c.memory) + " bytes");
     written = extract_by_count(h, n);
     written_lists = coarsen(h, set.cells, lists, written.cells);
-    out.file_bytes = write_cut(c.output, file, written, written_lists);
+    out.file_bytes = write_cut(c.output, file, written, &written_lists, true);
   }
   out.cells = static_cast<uint32_t>(written.cells.size());
   out.rule = written.rule + "; PVS by agvs";

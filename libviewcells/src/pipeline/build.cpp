@@ -1,6 +1,6 @@
 #include "viewcells/pipeline/build.h"
 
-#include "text.h"
+#include "viewcells/core/format.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/merge/merge.h"
@@ -46,11 +46,16 @@ Subdivision subdivide_sampled(const SamplingRun& s, const CostModel& model, Subd
 }  // namespace
 
 BuildResult build(const BuildConfig& config, const Log& log) {
-  config.model.validate();  // before the sampling, not after
+  config.model.validate();  // before loading and sampling, not after
+  return build(config, load_scene_for_rays(config.scene, log), log);
+}
+
+BuildResult build(const BuildConfig& config, LoadedScene loaded, const Log& log) {
+  config.model.validate();
   BuildResult out;
   out.model = config.model;
   out.merge = config.merge;
-  out.sampling = load_and_sample(config.scene, config.sampling, log);
+  out.sampling = sample_loaded(std::move(loaded), config.sampling, log);
   const SamplingRun& s = out.sampling;
   const Box3& box = s.result.segments.view_box;
   if (!std::isnan(config.views.slice_z) && !(config.views.slice_z >= box.lo.z && config.views.slice_z <= box.hi.z))

@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "text.h"
+#include "viewcells/core/format.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/binary_file.h"

@@ -3,7 +3,7 @@
 #include <filesystem>
 #include <memory>
 
-#include "text.h"
+#include "viewcells/core/format.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/core/binary_file.h"

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "text.h"
+#include "viewcells/core/format.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "text.h"
+#include "viewcells/core/format.h"
 #include "viewcells/core/isa.h"
 #include "viewcells/core/binary_file.h"
 

@@ -3,7 +3,7 @@
 #include <cctype>
 #include <filesystem>
 
-#include "text.h"
+#include "viewcells/core/format.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
@@ -49,11 +49,16 @@ void use_map_view_space(LoadedScene& s, SamplerConfig& config) {
 
 SamplingRun load_and_sample(const SceneSource& source, const SamplerConfig& config, const Log& log) {
   if (config.samples == 0 && config.target_segments == 0) throw Error("--samples must be positive");
+  return sample_loaded(load_scene_for_rays(source, log), config, log);
+}
+
+SamplingRun sample_loaded(LoadedScene loaded, const SamplerConfig& config, const Log& log) {
+  if (config.samples == 0 && config.target_segments == 0) throw Error("--samples must be positive");
   SamplingRun out;
   out.config = config;
   out.view_box_given = !config.view_box.empty();
   out.threads = worker_threads();
-  out.loaded = load_scene_for_rays(source, log);
+  out.loaded = std::move(loaded);
   use_map_view_space(out.loaded, out.config);
   const SamplerConfig& c = out.config;
   const EmptySpaceDecision esd = decide_empty_space(*out.loaded.scene, c.empty_space);

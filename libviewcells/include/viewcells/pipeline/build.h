@@ -48,5 +48,8 @@ struct BuildResult {
 };
 
 BuildResult build(const BuildConfig& config, const Log& log);
+/// The same for a scene already loaded (config.scene says only what it is; it moves into the
+/// result's sampling run).
+BuildResult build(const BuildConfig& config, LoadedScene loaded, const Log& log);
 
 }  // namespace viewcells::pipeline

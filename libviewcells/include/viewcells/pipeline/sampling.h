@@ -57,6 +57,8 @@ struct SamplingRun {
 
 /// Loads the scene and samples it (the map's view space on a Quake 3 map).
 SamplingRun load_and_sample(const SceneSource& source, const SamplerConfig& config, const Log& log);
+/// The same for a scene already loaded (it moves into the result).
+SamplingRun sample_loaded(LoadedScene loaded, const SamplerConfig& config, const Log& log);
 
 /// `viewcells sample`: segments, optionally written as .vseg, and optionally Embree's raw
 /// speed on the same rays.

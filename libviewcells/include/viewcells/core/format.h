@@ -1,11 +1,11 @@
 #pragma once
-// Number formatting for the pipeline's log lines and files (internal to src/pipeline).
+/// Numbers and boxes as text for log lines and messages: fixed decimals.
 #include <sstream>
 #include <string>
 
 #include "viewcells/core/vec3.h"
 
-namespace viewcells::pipeline {
+namespace viewcells {
 
 inline std::string fmt(double v, int precision = 3) {
   std::ostringstream os;
@@ -20,4 +20,4 @@ inline std::string describe_box(const Box3& b) {
          fmt(b.hi.y) + ", " + fmt(b.hi.z) + "]";
 }
 
-}  // namespace viewcells::pipeline
+}  // namespace viewcells
