@@ -6,6 +6,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config python3
+  jq                     # the command-line test reads the JSON reports (python3 starts slowly)
   libembree-dev          # ray casting (Embree 3.13)
   libcgal-dev libgmp-dev libmpfr-dev   # exact predicates (header-only CGAL 5.5)
   libboost-graph-dev     # neighbour graph of view cells
