@@ -16,6 +16,7 @@ struct BuildArgs {
   SamplingOptions sampling;
   CellOptions cells;
   bool no_merge = false;
+  MergeOptions merge;
   std::string output, report;
   pipeline::ViewsConfig views;
 };
@@ -29,6 +30,7 @@ int run_build(const BuildArgs& a, const Common& c) {
   config.scene = a.sampling.source();
   config.sampling = a.sampling.sampler(c);
   config.merge = !a.no_merge;
+  if (!a.no_merge) config.merge_agvs = a.merge.agvs(c, a.sampling.seed, config.sampling.samples);
   config.hierarchy_path = a.output;
   config.views = a.views;
   const pipeline::BuildResult result = pipeline::build(config, c.logger());
@@ -66,6 +68,7 @@ void add_build_commands(CLI::App& app, const Common& common, Commands& commands)
   add_sampling_options(bc, b->sampling);
   add_cell_options(bc, b->cells, "Stop at this many cells");
   bc->add_flag("--no-merge", b->no_merge, "Keep the AV-S cells: no merge history (extract and compress need one)");
+  add_merge_options(bc, b->merge);
   bc->add_option("-o,--output", b->output, "Hierarchy file to write (.vcells)");
   bc->add_option("--report", b->report, "JSON report: settings, effects and why, costs, candidates, timings");
   add_view_options(bc, b->views, "Also write the cells as a PLY coloured by render cost",

@@ -11,7 +11,7 @@ namespace {
 
 struct CompareArgs {
   SamplingOptions sampling;
-  std::string methods = "av-m,av-s,kd-casm,kd-lasm,kd-vt,kd-vt-star,bsp";
+  std::string methods = "av-m,av-m-samples,av-s,kd-casm,kd-lasm,kd-vt,kd-vt-star,bsp";
   bool methods_given = false;
   uint32_t max_cells = 1000;
   bool max_cells_given = false;
@@ -22,6 +22,7 @@ struct CompareArgs {
   bool no_ga = false;
   uint32_t axis_candidates = 200;
   uint32_t ga_candidates = 150;
+  MergeOptions merge;
   std::string output;
 };
 
@@ -40,6 +41,7 @@ int run_compare(const CompareArgs& a, const Common& c) {
   config.subdivision.max_axis_candidates = a.axis_candidates;
   config.subdivision.ga_candidates = a.ga_candidates;
   config.geometry_aligned_off = a.no_ga;
+  config.merge_agvs = a.merge.agvs(c, config.construction.seed, config.construction.samples);
   config.output_dir = a.output;
   pipeline::compare(config, c.logger());
   return 0;
@@ -54,7 +56,7 @@ void add_compare_command(CLI::App& app, const Common& common, Commands& commands
                                 "independent evaluation samples (paper, section 6)");
   add_sampling_options(cm, a->sampling);
   cm->add_option("--methods", a->methods,
-                 "Comma-separated: av-m, av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp, and q3-clusters (the clusters "
+                 "Comma-separated: av-m (AV-S's cells merged; see --merge-pvs), av-m-samples (greedy merging on the construction samples' PVSs alone, the paper's AV-M), av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp, and q3-clusters (the clusters "
                  "q3map2 compiled into a Quake 3 map; the default on a .bsp with visibility data, with av-m,av-s,kd-casm)")
       ->capture_default_str()
       ->each([a](const std::string&) { a->methods_given = true; });
@@ -75,6 +77,7 @@ void add_compare_command(CLI::App& app, const Common& common, Commands& commands
   cm->add_option("--ga-candidates", a->ga_candidates, "AV-S/AV-M: geometry-aligned planes per cell")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  add_merge_options(cm, a->merge);
   cm->add_option("-o,--output", a->output, "Directory for curves.csv, histogram.csv, summary.json")->required();
   commands.push_back({cm, [a, &common] { return run_compare(*a, common); }});
 }

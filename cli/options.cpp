@@ -215,6 +215,37 @@ SubdivisionConfig CellOptions::subdivision(const Common& c, uint64_t seed) const
   return config;
 }
 
+std::optional<AgvsConfig> MergeOptions::agvs(const Common& c, uint64_t seed, uint64_t construction_samples) const {
+  if (pvs == "samples") {
+    if (samples || pixel_error > 0) throw Error("--merge-samples and --merge-pixel-error need --merge-pvs agvs");
+    return std::nullopt;
+  }
+  AgvsConfig a;
+  a.seed = seed + 7'000'001;  // not the construction samples' stream
+  a.max_samples = samples;
+  a.pixel_error = pixel_error;
+  if (!samples && !(pixel_error > 0)) a.max_samples = std::max<uint64_t>(construction_samples, 1);
+  a.show_progress = !c.quiet;
+  return a;
+}
+
+void add_merge_options(CLI::App* cmd, MergeOptions& a) {
+  cmd->add_option("--merge-pvs", a.pvs,
+                  "PVSs of the elementary cells that merging decides on: agvs (the construction samples' united with "
+                  "adaptive global visibility sampling of the cells) or samples (the construction samples' alone: "
+                  "a few hundred per cell, whose gaps greedy merging fits)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"agvs", "samples"}));
+  cmd->add_option("--merge-samples", a.samples,
+                  "AGVS samples of each of the two runs over the elementary cells (one to merge on, one held out to "
+                  "choose where greedy merging starts; default, without --merge-pixel-error: --samples)")
+      ->check(whole(1, kMaxSamples));
+  cmd->add_option("--merge-pixel-error", a.pixel_error,
+                  "Run each AGVS run over the elementary cells until its estimated pixel error (of 1024x1024) is at "
+                  "most this")
+      ->check(positive());
+}
+
 void add_cell_options(CLI::App* cmd, CellOptions& a, const std::string& max_cells_help) {
   if (!max_cells_help.empty())
     cmd->add_option("--max-cells", a.max_cells, max_cells_help)->capture_default_str()->check(whole(1, kMaxCells));

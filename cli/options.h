@@ -6,11 +6,13 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "viewcells/core/format.h"
 #include "viewcells/core/vec3.h"
+#include "viewcells/agvs/agvs.h"
 #include "viewcells/pipeline/cut.h"
 #include "viewcells/pipeline/report.h"
 #include "viewcells/pipeline/sampling.h"
@@ -95,6 +97,18 @@ struct CellOptions {
 };
 /// `max_cells_help` empty: no --max-cells option.
 void add_cell_options(CLI::App* cmd, CellOptions& a, const std::string& max_cells_help);
+
+/// What merging decides on: the leaves' PVSs from the construction samples alone, or united
+/// with AGVS's (build, compare, bake).
+struct MergeOptions {
+  std::string pvs = "agvs";
+  uint64_t samples = 0;
+  double pixel_error = 0;
+  /// Unset for --merge-pvs samples; else AGVS with the stopping rule given (default: as many
+  /// samples as the construction had, `construction_samples`), seeded from `seed`.
+  std::optional<AgvsConfig> agvs(const Common& c, uint64_t seed, uint64_t construction_samples) const;
+};
+void add_merge_options(CLI::App* cmd, MergeOptions& a);
 
 /// --count, --memory, --cost-ratio.
 struct CutOptions {

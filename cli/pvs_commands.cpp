@@ -153,6 +153,7 @@ struct BakeArgs {
   uint32_t view_cells = 0;
   std::string memory;
   AgvsOptions agvs;
+  MergeOptions merge;
   uint64_t agvs_seed = 1;
   std::string output, report, work;
   double checkpoint = 60;
@@ -166,6 +167,7 @@ int run_bake(BakeArgs a, const Common& c) {
   config.subdivision = a.cells.subdivision(c, a.sampling.seed);
   config.scene = a.sampling.source();
   config.sampling = a.sampling.sampler(c);
+  config.merge_agvs = a.merge.agvs(c, a.sampling.seed, config.sampling.samples);
   config.cells = a.view_cells;
   config.memory = a.memory.empty() ? 0 : parse_bytes(a.memory);
   if (!a.agvs.samples && !(a.agvs.seconds > 0) && !(a.agvs.pixel_error > 0)) a.agvs.pixel_error = 10;
@@ -197,6 +199,7 @@ void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
                  "Elementary cells to build before merging (default: 4 x --cells, or 4096 with --memory)")
       ->check(whole(1, kMaxCells));
   add_cell_options(bk, a->cells, "");
+  add_merge_options(bk, a->merge);
   add_agvs_options(bk, a->agvs, false, "--agvs-samples");
   bk->add_option("--work", a->work,
                  "Work directory: keeps the hierarchy and the AGVS state, so that a rerun with the same scene and "

@@ -279,8 +279,12 @@ python3 -c "
 import csv, json
 rows = list(csv.DictReader(open('cmp/curves.csv')))
 methods = {r['method'] for r in rows}
-assert methods == {'av-m','av-s','kd-casm','kd-lasm','kd-vt','kd-vt-star','bsp'}, methods
+assert methods == {'av-m','av-m-samples','av-s','kd-casm','kd-lasm','kd-vt','kd-vt-star','bsp'}, methods
 s = json.load(open('cmp/summary.json'))
+assert s['settings']['merge_pvs'] == 'agvs' and s['settings']['merge_agvs_samples_per_run'] == 20000, s['settings']
+m = {x['method']: x for x in s['methods']}
+assert m['av-m']['merge']['leaf_agvs_samples'] >= 40000 and m['av-m-samples']['merge']['leaf_agvs_samples'] == 0
+assert len(m['av-m']['merge']['starts_scored']) >= 2 and m['av-m-samples']['merge']['greedy_from_cells'] == 40
 assert s['settings']['evaluation_samples'] == 80000 and s['settings']['evaluation_seed'] != s['settings']['construction_seed']
 avm = {int(r['cells']): float(r['cost']) for r in rows if r['method'] == 'av-m'}
 kd = {int(r['cells']): float(r['cost']) for r in rows if r['method'] == 'kd-casm'}

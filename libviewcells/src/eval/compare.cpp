@@ -27,12 +27,45 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
+/// AV-M's merge history over the leaves of `s`, with its timings in `r`: validated by AGVS
+/// (config.merge_agvs, method av-m) or greedy on the construction samples' PVSs.
+MergeHistory merge_for_comparison(const Scene& scene, const RayCaster& caster, const Subdivision& s,
+                                  const SegmentSet& built, const CompareConfig& config, const std::string& method,
+                                  MethodResult& r) {
+  MergeConfig mc;
+  mc.show_progress = config.show_progress;
+  auto t = std::chrono::steady_clock::now();
+  std::vector<std::vector<uint32_t>> leaves = leaf_pvs(s, built);
+  r.leaf_pvs_seconds = seconds_since(t);
+  r.greedy_from = static_cast<uint32_t>(s.leaf_count());
+  if (method == "av-m" && config.merge_agvs) {
+    ValidatedMergeConfig vc;
+    vc.agvs = *config.merge_agvs;
+    vc.merge = mc;
+    ValidatedMerge v = merge_validated(scene, caster, s, leaves, config.model, vc);
+    r.leaf_pvs_seconds += v.agvs_seconds;
+    r.neighbour_seconds = v.neighbour_seconds;
+    r.merge_seconds = v.select_seconds + v.merge_seconds;
+    r.leaf_agvs_samples = v.merge_agvs.samples + v.validation_agvs.samples;
+    r.greedy_from = v.greedy_from;
+    r.starts = std::move(v.starts);
+    return std::move(v.history);
+  }
+  t = std::chrono::steady_clock::now();
+  const CellPartition partition = partition_from_subdivision(s, leaves);
+  r.neighbour_seconds = seconds_since(t);
+  t = std::chrono::steady_clock::now();
+  MergeHistory h = merge_cells(scene, partition, config.model, mc);
+  r.merge_seconds = seconds_since(t);
+  return h;
+}
+
 }  // namespace
 
 void check_methods(const std::vector<std::string>& methods) {
   if (methods.empty()) throw Error("no methods to compare");
   for (const std::string& m : methods)
-    if (m != "av-m") parse_split_strategy(m);
+    if (m != "av-m" && m != "av-m-samples") parse_split_strategy(m);
 }
 
 Comparison compare_methods(const Scene& scene, const RayCaster& caster, const CompareConfig& config) {
@@ -61,7 +94,7 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
   for (const std::string& method : config.methods) {
     MethodResult r;
     r.method = method;
-    const bool merged = method == "av-m";
+    const bool merged = method == "av-m" || method == "av-m-samples";
     Subdivision local;
     const Subdivision* s = nullptr;
     if (merged || method == "av-s") {
@@ -85,11 +118,8 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
     const auto t = std::chrono::steady_clock::now();
     const std::vector<std::vector<uint32_t>> pvs = evaluation_pvs(*s, eval.segments);
     if (merged) {
-      MergeConfig mc;
-      mc.show_progress = config.show_progress;
-      const auto tm = std::chrono::steady_clock::now();
-      MergeHistory h = merge_cells(scene, partition_from_subdivision(*s, leaf_pvs(*s, built.segments)), config.model, mc);
-      const double merge_seconds = seconds_since(tm);
+      MergeHistory h = merge_for_comparison(scene, caster, *s, built.segments, config, method, r);
+      const double merge_seconds = r.leaf_pvs_seconds + r.neighbour_seconds + r.merge_seconds;
       r.build_seconds += merge_seconds;
       out.evaluation_seconds -= merge_seconds;  // counted below with the evaluation otherwise
       const std::vector<double> node_cost = evaluated_merge_costs(scene, *s, h, pvs, config.model);
@@ -101,7 +131,7 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
       r.leaves = h.leaf_count;
       if (hist_cells >= h.min_cells() && hist_cells <= h.leaf_count)
         r.cells = merged_cells_at(h, node_cost, hist_cells);
-      if (config.keep_models) out.av_m = std::move(h);
+      if (config.keep_models && method == "av-m") out.av_m = std::move(h);
     } else {
       const std::vector<double> node_cost = evaluated_bsp_costs(scene, *s, pvs, config.model);
       r.evaluated = subdivision_curve(*s, node_cost);

@@ -42,6 +42,21 @@ CellPartition partition_from_subdivision(const Subdivision& s, const std::vector
   return p;
 }
 
+std::vector<std::pair<int32_t, int32_t>> subdivision_prefix(const Subdivision& s, size_t cells) {
+  const std::vector<int32_t> leaves = s.leaves();
+  std::vector<int32_t> mht(s.nodes.size(), -1);  // BSP node -> MHT node, once it is a cell
+  for (size_t i = 0; i < leaves.size(); ++i) mht[leaves[i]] = static_cast<int32_t>(i);
+  std::vector<std::pair<int32_t, int32_t>> prefix;
+  int32_t next = static_cast<int32_t>(leaves.size());
+  for (size_t k = s.splits.size(); k-- > 0 && leaves.size() - prefix.size() > std::max<size_t>(cells, 1);) {
+    const int32_t node = s.splits[k].node, c0 = s.nodes[node].child[0], c1 = s.nodes[node].child[1];
+    VC_CHECK(mht[c0] >= 0 && mht[c1] >= 0);
+    prefix.emplace_back(mht[c0], mht[c1]);
+    mht[node] = next++;
+  }
+  return prefix;
+}
+
 CellPartition grid_partition(const SegmentSet& segs, int nx, int ny, int nz) {
   if (nx < 1 || ny < 1 || nz < 1) throw Error("a grid needs at least one cell along each axis");
   const Box3 box = segs.view_box;
@@ -180,66 +195,35 @@ class Merger {
     for (const auto& [a, b] : p_.neighbours)
       if (a != b) boost::add_edge(a, b, graph);
 
-    // Every neighbouring pair, evaluated in parallel (each is independent).
+    const size_t target = std::max<size_t>(1, config.min_cells);
+    alive_ = L;
+    cost_ = h.initial_cost;
+    Progress progress("merging", L > target ? L - target : 0);
+    std::vector<int32_t> around;
+    for (const auto& [x, y] : config.prefix) {
+      if (alive_ <= target) break;
+      check_prefix_pair(h, x, y);
+      merge(h, graph, x, y, around);
+      if (config.show_progress) progress.advance(1);
+    }
+    // Every neighbouring pair of the current cells, evaluated in parallel (each is independent).
     std::vector<Entry> entries;
-    entries.reserve(p_.neighbours.size());
-    for (const auto& [a, b] : p_.neighbours)
-      if (a != b) entries.push_back({0.0, static_cast<int32_t>(a), static_cast<int32_t>(b)});
-    entries.erase(std::unique(entries.begin(), entries.end(),
-                              [](const Entry& u, const Entry& v) { return u.x == v.x && u.y == v.y; }),
-                  entries.end());
+    for (size_t v = 0; v < h.nodes.size(); ++v)
+      for (auto [it, end] = boost::adjacent_vertices(v, graph); it != end; ++it)
+        if (v < *it) entries.push_back({0.0, static_cast<int32_t>(v), static_cast<int32_t>(*it)});
     evaluate(h, entries);
     std::priority_queue<Entry, std::vector<Entry>, Later> queue(Later{}, std::move(entries));
-
-    const size_t target = std::max<size_t>(1, config.min_cells);
-    size_t alive = L;
-    double cost = h.initial_cost;
-    Progress progress("merging", L > target ? L - target : 0);
     std::vector<Entry> fresh;
-    while (alive > target && !queue.empty()) {
+    while (alive_ > target && !queue.empty()) {
       const Entry e = queue.top();
       queue.pop();
       if (h.nodes[e.x].parent >= 0 || h.nodes[e.y].parent >= 0) {
         ++h.stats.stale;
         continue;
       }
-      const int32_t z = static_cast<int32_t>(h.nodes.size());
-      MergeNode node;
-      node.child[0] = e.x;
-      node.child[1] = e.y;
-      node.weight = h.nodes[e.x].weight + h.nodes[e.y].weight;
-      node.volume = h.nodes[e.x].volume + h.nodes[e.y].volume;
-      node.bounds = h.nodes[e.x].bounds;
-      node.bounds.extend(h.nodes[e.y].bounds);
-      pvs_[z] = unite_sorted(pvs_[e.x], pvs_[e.y]);
-      node.pvs_cost = pvs_cost(pvs_[z], node.bounds);
-      node.pvs_size = static_cast<uint32_t>(pvs_[z].size());
-      // The recorded cost uses the merged cell's actual r(PVS), not the queued estimate.
-      cost += (node.weight * node.pvs_cost - h.nodes[e.x].weight * h.nodes[e.x].pvs_cost -
-               h.nodes[e.y].weight * h.nodes[e.y].pvs_cost) / W_;
-      h.nodes.push_back(node);
-      h.nodes[e.x].parent = z;
-      h.nodes[e.y].parent = z;
-      h.cost_after.push_back(cost);
-      --alive;
-
-      // z inherits the neighbours of x and y.
-      std::vector<int32_t> around;
-      for (int32_t side : {e.x, e.y})
-        for (auto [it, end] = boost::adjacent_vertices(side, graph); it != end; ++it)
-          if (static_cast<int32_t>(*it) != e.x && static_cast<int32_t>(*it) != e.y)
-            around.push_back(static_cast<int32_t>(*it));
-      std::sort(around.begin(), around.end());
-      around.erase(std::unique(around.begin(), around.end()), around.end());
-      boost::clear_vertex(e.x, graph);
-      boost::clear_vertex(e.y, graph);
-      pvs_[e.x] = {};
-      pvs_[e.y] = {};
+      const int32_t z = merge(h, graph, e.x, e.y, around);
       fresh.clear();
-      for (int32_t n : around) {
-        boost::add_edge(n, z, graph);
-        fresh.push_back({0.0, n, z});
-      }
+      for (int32_t n : around) fresh.push_back({0.0, n, z});
       evaluate(h, fresh);
       for (const Entry& f : fresh) queue.push(f);
       if (config.show_progress) progress.advance(1);
@@ -250,6 +234,49 @@ class Merger {
   }
 
  private:
+  void check_prefix_pair(const MergeHistory& h, int32_t x, int32_t y) const {
+    const int32_t n = static_cast<int32_t>(h.nodes.size());
+    if (x < 0 || y < 0 || x >= n || y >= n || x == y || h.nodes[x].parent >= 0 || h.nodes[y].parent >= 0)
+      throw Error("a prefix merge names cells that are not current cells (" + std::to_string(x) + ", " +
+                  std::to_string(y) + ")");
+  }
+
+  /// Merges current cells x and y into a new node z; `around` gets z's neighbours.
+  int32_t merge(MergeHistory& h, Graph& graph, int32_t x, int32_t y, std::vector<int32_t>& around) {
+    const int32_t z = static_cast<int32_t>(h.nodes.size());
+    MergeNode node;
+    node.child[0] = x;
+    node.child[1] = y;
+    node.weight = h.nodes[x].weight + h.nodes[y].weight;
+    node.volume = h.nodes[x].volume + h.nodes[y].volume;
+    node.bounds = h.nodes[x].bounds;
+    node.bounds.extend(h.nodes[y].bounds);
+    pvs_[z] = unite_sorted(pvs_[x], pvs_[y]);
+    node.pvs_cost = pvs_cost(pvs_[z], node.bounds);
+    node.pvs_size = static_cast<uint32_t>(pvs_[z].size());
+    // The recorded cost uses the merged cell's actual r(PVS), not the queued estimate.
+    cost_ += (node.weight * node.pvs_cost - h.nodes[x].weight * h.nodes[x].pvs_cost -
+              h.nodes[y].weight * h.nodes[y].pvs_cost) / W_;
+    h.nodes.push_back(node);
+    h.nodes[x].parent = z;
+    h.nodes[y].parent = z;
+    h.cost_after.push_back(cost_);
+    --alive_;
+    // z inherits the neighbours of x and y.
+    around.clear();
+    for (int32_t side : {x, y})
+      for (auto [it, end] = boost::adjacent_vertices(side, graph); it != end; ++it)
+        if (static_cast<int32_t>(*it) != x && static_cast<int32_t>(*it) != y) around.push_back(static_cast<int32_t>(*it));
+    std::sort(around.begin(), around.end());
+    around.erase(std::unique(around.begin(), around.end()), around.end());
+    boost::clear_vertex(x, graph);
+    boost::clear_vertex(y, graph);
+    pvs_[x] = {};
+    pvs_[y] = {};
+    for (int32_t n : around) boost::add_edge(n, z, graph);
+    return z;
+  }
+
   double pvs_cost(const std::vector<uint32_t>& pvs, const Box3& bounds) const {
     return viewcells::pvs_cost(scene_, r_, model_, pvs, bounds);
   }
@@ -295,6 +322,8 @@ class Merger {
   const CostModel& model_;
   const std::vector<double> r_;
   double W_ = 1;
+  size_t alive_ = 0;
+  double cost_ = 0;
   std::vector<std::vector<uint32_t>> pvs_;  ///< per MHT node, while it is a current cell
 };
 

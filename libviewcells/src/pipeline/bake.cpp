@@ -27,7 +27,7 @@ std::string hierarchy_key(const BakeConfig& c, uint32_t max_cells) {
   const SubdivisionConfig& d = c.subdivision;
   std::ostringstream k;
   k.precision(17);
-  k << "viewcells bake hierarchy v1\nscene " << c.scene.path << " grouping " << to_string(c.scene.grouping)
+  k << "viewcells bake hierarchy v2\nscene " << c.scene.path << " grouping " << to_string(c.scene.grouping)
     << " robust " << c.scene.robust << "\nsamples " << s.samples << " segments " << s.target_segments << " seed "
     << s.seed << " recasts " << s.max_recasts << " empty " << static_cast<int>(s.empty_space) << "\nview box "
     << s.view_box.lo.x << ' ' << s.view_box.lo.y << ' ' << s.view_box.lo.z << ' ' << s.view_box.hi.x << ' '
@@ -36,6 +36,11 @@ std::string hierarchy_key(const BakeConfig& c, uint32_t max_cells) {
     << max_cells << " ga " << static_cast<int>(d.geometry_aligned) << ' ' << d.ga_candidates << ' '
     << d.max_axis_candidates << " min reduction " << d.min_reduction << " density " << d.density.enabled << ' '
     << d.density.lo << ' ' << d.density.hi << ' ' << d.density.outside << '\n';
+  if (c.merge_agvs)
+    k << "merge agvs " << c.merge_agvs->seed << ' ' << c.merge_agvs->max_samples << ' ' << c.merge_agvs->pixel_error << ' '
+      << c.merge_agvs->batch_size << '\n';
+  else
+    k << "merge samples\n";
   return k.str();
 }
 
@@ -65,6 +70,7 @@ SubdivisionFile hierarchy(const BakeConfig& c, LoadedScene& loaded, uint32_t max
   b.model = c.model;
   b.subdivision = c.subdivision;
   b.subdivision.max_cells = max_cells;
+  b.merge_agvs = c.merge_agvs;
   // The scene already loaded samples the hierarchy, and comes back for AGVS.
   BuildResult built = build(b, std::move(loaded), log);
   loaded = std::move(built.sampling.loaded);

@@ -3,6 +3,7 @@
 #include "viewcells/core/format.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/progress.h"
+#include "viewcells/eval/validated_merge.h"
 #include "viewcells/merge/merge.h"
 #include "viewcells/q3/view_space.h"
 
@@ -43,6 +44,54 @@ Subdivision subdivide_sampled(const SamplingRun& s, const CostModel& model, Subd
   return sub;
 }
 
+/// The leaves' PVSs and, unless --no-merge, the merge history, into out.file.
+void merge_leaves(const BuildConfig& config, const SamplingRun& s, const Subdivision& sub, BuildResult& out,
+                  const Log& log) {
+  SubdivisionFile& file = out.file;
+  Stopwatch sw;
+  file.leaf_pvs = leaf_pvs(sub, s.result.segments);
+  out.leaf_pvs_seconds = sw.seconds();
+  if (!config.merge) return;
+  const Scene& scene = *s.loaded.scene;
+  MergeConfig mc;
+  mc.show_progress = config.subdivision.show_progress;
+  if (config.merge_agvs) {
+    const AgvsConfig& a = *config.merge_agvs;
+    log("viewcells: merging " + std::to_string(sub.leaf_count()) + " cells, on PVSs with two AGVS runs over them (" +
+        (a.max_samples ? std::to_string(a.max_samples) + " samples" : "") +
+        (a.max_samples && a.pixel_error > 0 ? " or " : "") +
+        (a.pixel_error > 0 ? "pixel error " + fmt(a.pixel_error) : "") + " each: one to merge on, one to validate)");
+    ValidatedMergeConfig vc;
+    vc.agvs = a;
+    vc.merge = mc;
+    ValidatedMerge v = merge_validated(scene, *s.loaded.caster, sub, file.leaf_pvs, config.model, vc);
+    file.leaf_pvs = std::move(v.leaf_pvs);
+    file.history = std::move(v.history);
+    out.merge_validated = true;
+    out.greedy_from = v.greedy_from;
+    out.merge_starts = std::move(v.starts);
+    out.merge_agvs = std::move(v.merge_agvs);
+    out.validation_agvs = std::move(v.validation_agvs);
+    out.leaf_pvs_seconds += v.agvs_seconds;
+    out.neighbour_seconds = v.neighbour_seconds;
+    out.merge_seconds = v.select_seconds + v.merge_seconds;
+    log("viewcells: greedy merging from the subdivision's own cut at " + std::to_string(v.greedy_from) +
+        " cells (held-out score " + fmt(v.starts.empty() ? 0.0 : std::min_element(v.starts.begin(), v.starts.end(),
+            [](const MergeStart& x, const MergeStart& y) { return x.score < y.score; })->score, 4) + ")");
+  } else {
+    log("viewcells: merging " + std::to_string(sub.leaf_count()) + " cells on the construction samples' PVSs");
+    sw.restart();
+    const CellPartition partition = partition_from_subdivision(sub, file.leaf_pvs);
+    out.neighbour_seconds = sw.seconds();
+    file.history = merge_cells(scene, partition, config.model, mc);
+    out.merge_seconds = file.history->stats.seconds;
+    out.greedy_from = static_cast<uint32_t>(sub.leaf_count());
+  }
+  log("viewcells: leaf PVSs " + fmt(out.leaf_pvs_seconds, 2) + " s, neighbour graph " + fmt(out.neighbour_seconds, 2) +
+      " s, merging " + fmt(out.merge_seconds, 2) + " s (" + std::to_string(file.history->stats.evaluations) +
+      " pair costs, " + std::to_string(file.history->stats.stale) + " stale queue entries skipped)");
+}
+
 }  // namespace
 
 BuildResult build(const BuildConfig& config, const Log& log) {
@@ -64,17 +113,8 @@ BuildResult build(const BuildConfig& config, LoadedScene loaded, const Log& log)
   out.subdivision_config = config.subdivision;
   Subdivision sub = subdivide_sampled(s, config.model, out.subdivision_config, log);
 
+  merge_leaves(config, s, sub, out, log);
   SubdivisionFile& file = out.file;
-  file.leaf_pvs = leaf_pvs(sub, s.result.segments);
-  if (config.merge) {
-    MergeConfig mc;
-    mc.show_progress = config.subdivision.show_progress;
-    log("viewcells: merging " + std::to_string(sub.leaf_count()) + " cells into a merge history");
-    file.history = merge_cells(*s.loaded.scene, partition_from_subdivision(sub, file.leaf_pvs), config.model, mc);
-    log("viewcells: merged in " + fmt(file.history->stats.seconds, 2) + " s (" +
-        std::to_string(file.history->stats.evaluations) + " pair costs, " +
-        std::to_string(file.history->stats.stale) + " stale queue entries skipped)");
-  }
   file.cost_model = config.model;
   file.scene_fingerprint = s.loaded.scene->fingerprint();
   file.object_count = static_cast<uint32_t>(s.loaded.scene->object_count());

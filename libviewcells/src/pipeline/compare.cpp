@@ -51,6 +51,7 @@ CompareConfig compared_config(const CompareRunConfig& c, bool& with_q3) {
   config.subdivision.seed = c.construction.seed;
   config.subdivision.geometry_aligned = c.geometry_aligned_off ? GeometryAlignedMode::kOff : GeometryAlignedMode::kAuto;
   config.histogram_cells = c.histogram_cells;
+  config.merge_agvs = c.merge_agvs;
   config.show_progress = c.construction.show_progress;
   check_methods(config.methods);  // before the output directory is made
   return config;

@@ -161,7 +161,11 @@ json build_effects(const BuildResult& r) {
           ? effect(true, "--density-band: weight 1 for " + fmt(config.density.lo, 2) + " <= z <= " +
                              fmt(config.density.hi, 2) + ", " + fmt(config.density.outside, 3) + " elsewhere")
           : effect(false, "uniform: p(i) = V_i / V (no --density-band)");
-  e["merging"] = r.merge ? effect(true, "default: the merge history is built") : effect(false, "--no-merge");
+  e["merging"] = !r.merge ? effect(false, "--no-merge")
+                 : r.merge_validated
+                     ? effect(true, "default: merged on the leaves' PVSs from the construction samples and an AGVS run, "
+                                    "from the subdivision's cut a second, held-out AGVS run chose")
+                     : effect(true, "--merge-pvs samples: greedy merging on the construction samples' PVSs");
   return e;
 }
 
@@ -226,7 +230,17 @@ std::string report_json(const BuildResult& r) {
   report["final_cost"] = sub.cost();
   if (r.file.history) {
     report["merge"] = merge_summary(*r.file.history);
-    report["timings"]["merge_seconds"] = r.file.history->stats.seconds;
+    report["merge"]["pvs"] = r.merge_validated ? "construction samples and two AGVS runs" : "construction samples";
+    report["merge"]["greedy_from_cells"] = r.greedy_from;
+    if (r.merge_validated) {
+      json starts = json::array();
+      for (const MergeStart& st : r.merge_starts) starts.push_back({{"cells", st.cells}, {"score", st.score}});
+      report["merge"]["starts_scored"] = starts;
+      report["merge"]["agvs_samples"] = {{"merge", r.merge_agvs.samples}, {"validation", r.validation_agvs.samples}};
+    }
+    report["timings"]["leaf_pvs_seconds"] = r.leaf_pvs_seconds;
+    report["timings"]["neighbour_graph_seconds"] = r.neighbour_seconds;
+    report["timings"]["merge_seconds"] = r.merge_seconds;
   }
   report["timings"]["subdivision_seconds"] = sub.stats.seconds;
   report["timings"]["write_seconds"] = r.write_seconds;
@@ -395,6 +409,16 @@ json compare_methods_json(const Comparison& cmp) {
                        {"geometry_candidates_evaluated", m.geometry_candidates},
                        {"evaluated_cost_at_most_cells", m.evaluated.at(last)},
                        {"constructed_cost_at_most_cells", m.constructed.at(last)}});
+    if (m.method == "av-m" || m.method == "av-m-samples") {
+      json starts = json::array();
+      for (const MergeStart& st : m.starts) starts.push_back({{"cells", st.cells}, {"score", st.score}});
+      methods.back()["merge"] = {{"leaf_pvs_seconds", m.leaf_pvs_seconds},
+                                 {"neighbour_graph_seconds", m.neighbour_seconds},
+                                 {"merge_seconds", m.merge_seconds},
+                                 {"leaf_agvs_samples", m.leaf_agvs_samples},
+                                 {"greedy_from_cells", m.greedy_from},
+                                 {"starts_scored", starts}};
+    }
   }
   return methods;
 }
@@ -442,6 +466,9 @@ std::string report_json(const CompareRunResult& r) {
         {"ga_candidates", config.subdivision.ga_candidates},
         {"geometry_aligned", r.config.geometry_aligned_off ? "off" : "auto"},
         {"robust_ray_casting", r.config.scene.robust},
+        {"merge_pvs", config.merge_agvs ? "agvs" : "samples"},
+        {"merge_agvs_samples_per_run", config.merge_agvs ? json(config.merge_agvs->max_samples) : json(nullptr)},
+        {"merge_agvs_pixel_error", config.merge_agvs ? json(config.merge_agvs->pixel_error) : json(nullptr)},
         {"threads", r.threads}}},
       {"effects",
        {{"empty_space_detection", effect(cmp.construction.empty_space.enabled, cmp.construction.empty_space.reason)},

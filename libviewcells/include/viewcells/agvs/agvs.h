@@ -195,6 +195,17 @@ class AgvsSolver {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The PVS of every leaf of `s` by AGVS (config's sampling and stopping rule), per node of `s`
+/// (empty for inner nodes; bsp/subdivision.h's leaf_pvs has the same shape), each united with
+/// `base` (per node too; empty: none), typically the construction samples' leaf PVSs. What
+/// merging decides on when the construction samples are too few per leaf.
+struct LeafPvsRun {
+  std::vector<std::vector<uint32_t>> pvs;
+  AgvsStats stats;
+};
+LeafPvsRun leaf_pvs_by_agvs(const Scene& scene, const RayCaster& caster, const Subdivision& s,
+                            const AgvsConfig& config, const std::vector<std::vector<uint32_t>>& base = {});
+
 /// The measured pixel error of a solution (paper section 4.5, the estimator's definition):
 /// cameras at uniform random points of the view box, randomly oriented, `width` x `height`
 /// pixels over a `fov_degrees` horizontal field of view, rendered by ray casting. A pixel is

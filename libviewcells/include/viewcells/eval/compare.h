@@ -9,14 +9,15 @@
 #include <vector>
 
 #include "viewcells/eval/evaluate.h"
+#include "viewcells/eval/validated_merge.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
 
 namespace viewcells {
 
 struct CompareConfig {
-  /// av-m, av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp
-  std::vector<std::string> methods = {"av-m", "av-s", "kd-casm", "kd-lasm", "kd-vt", "kd-vt-star", "bsp"};
+  /// av-m, av-m-samples, av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp
+  std::vector<std::string> methods = {"av-m", "av-m-samples", "av-s", "kd-casm", "kd-lasm", "kd-vt", "kd-vt-star", "bsp"};
   uint32_t max_cells = 1000;
   SamplerConfig construction;  ///< samples for building
   SamplerConfig evaluation;    ///< independent samples for scoring (own seed, more of them)
@@ -27,6 +28,10 @@ struct CompareConfig {
   /// Optional: applied to every subdivision once built, before merging and evaluation (e.g.
   /// weight_by_view_space, when the view space is not the whole box).
   std::function<void(Subdivision&)> prepare;
+  /// AV-M: merging validated by AGVS runs over the leaves with this config
+  /// (eval/validated_merge.h). Unset: AV-M is greedy merging of the leaves on the construction
+  /// samples' PVSs alone, which av-m-samples always is.
+  std::optional<AgvsConfig> merge_agvs;
   /// Keep the segments, the AV-S subdivision and the AV-M merge history in the Comparison.
   bool keep_models = false;
 };
@@ -38,6 +43,12 @@ struct MethodResult {
   std::vector<CellCost> cells;  ///< evaluated cells at the histogram cell count (if reached)
   uint32_t leaves = 0;          ///< cells the method produced
   double build_seconds = 0;     ///< subdivision (and merging), without sampling
+  /// AV-M: the parts of build_seconds spent on the leaves' PVSs (AGVS's included), the
+  /// neighbour graph, and merging (the choice of the start included).
+  double leaf_pvs_seconds = 0, neighbour_seconds = 0, merge_seconds = 0;
+  uint64_t leaf_agvs_samples = 0;  ///< AV-M: AGVS samples of both runs (0: none)
+  uint32_t greedy_from = 0;        ///< AV-M: greedy merging from AV-S's cut at this count
+  std::vector<MergeStart> starts;  ///< AV-M with AGVS: every candidate start, scored
   std::string stop_reason;
   std::string geometry_aligned;  ///< whether geometry-aligned candidates were used, and why
   uint64_t axis_candidates = 0, geometry_candidates = 0;  ///< candidate planes evaluated

@@ -77,6 +77,10 @@ struct MergeHistory {
 
 struct MergeConfig {
   uint32_t min_cells = 1;  ///< stop merging at this many cells
+  /// Merges done first, in order, before the greedy ones: pairs of current MHT node ids (a
+  /// prefix merge j creates node leaf_count + j). E.g. subdivision_prefix: the subdivision's
+  /// own order back to a coarser cut, from which the greedy merging continues.
+  std::vector<std::pair<int32_t, int32_t>> prefix;
   bool show_progress = true;
 };
 
@@ -84,6 +88,11 @@ struct MergeConfig {
 /// Deterministic: ties go to the pair with the smaller node ids.
 MergeHistory merge_cells(const Scene& scene, const CellPartition& partition, const CostModel& model,
                          const MergeConfig& config = {});
+
+/// The subdivision's splits undone, the last first, down to `cells` cells, as merges of the
+/// partition_from_subdivision(s, ...) cells (MergeConfig::prefix): its cuts are then exactly
+/// the subdivision's own (AV-S's) cuts from leaf_count() down to `cells`.
+std::vector<std::pair<int32_t, int32_t>> subdivision_prefix(const Subdivision& s, size_t cells);
 
 /// A set of view cells cut from the merge history.
 struct ViewCellSet {

@@ -7,6 +7,7 @@
 /// With a work directory, a rerun with the same settings reuses the hierarchy and continues
 /// the AGVS state instead of starting over.
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "viewcells/agvs/agvs.h"
@@ -20,6 +21,7 @@ struct BakeConfig {
   SamplerConfig sampling;          ///< construction samples
   CostModel model;
   SubdivisionConfig subdivision;   ///< max_cells 0: derived from the budget
+  std::optional<AgvsConfig> merge_agvs;  ///< as BuildConfig::merge_agvs
   uint32_t cells = 0;              ///< budget: this many view cells ...
   uint64_t memory = 0;             ///< ... or a .pvs file of at most this many bytes
   AgvsConfig agvs;                 ///< stopping rule (pixel error, time, samples), seed, batch

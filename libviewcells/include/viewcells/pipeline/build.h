@@ -3,11 +3,13 @@
 /// view space on a Quake 3 map, compute the leaves' PVSs from the samples, merge them into a
 /// history, write the hierarchy (.vcells) and the views asked for.
 #include <cmath>
+#include <optional>
 #include <string>
 
 #include "viewcells/bsp/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/cells/hierarchy_file.h"
+#include "viewcells/eval/validated_merge.h"
 #include "viewcells/vis/cell_views.h"
 #include "viewcells/pipeline/sampling.h"
 
@@ -32,6 +34,9 @@ struct BuildConfig {
   CostModel model;
   SubdivisionConfig subdivision;
   bool merge = true;
+  /// Merging validated by AGVS runs over the leaves with this config (eval/validated_merge.h);
+  /// unset: greedy merging of the leaves on the construction samples' PVSs.
+  std::optional<AgvsConfig> merge_agvs;
   std::string hierarchy_path;  ///< .vcells to write; empty: none
   ViewsConfig views;
 };
@@ -41,6 +46,13 @@ struct BuildResult {
   CostModel model;
   SubdivisionConfig subdivision_config;  ///< as used (geometry-aligned decided)
   bool merge = true;
+  bool merge_validated = false;  ///< merged by merge_validated (the fields below)
+  uint32_t greedy_from = 0;      ///< greedy merging from AV-S's cut at this many cells
+  std::vector<MergeStart> merge_starts;
+  AgvsStats merge_agvs, validation_agvs;
+  /// Seconds of the leaves' PVSs (AGVS runs included), of the neighbour graph, and of merging
+  /// (the choice of the start included).
+  double leaf_pvs_seconds = 0, neighbour_seconds = 0, merge_seconds = 0;
   /// The hierarchy: the subdivision (its cells and per-leaf segments dropped once written),
   /// the leaves' PVSs and, when merged, the merge history.
   SubdivisionFile file;

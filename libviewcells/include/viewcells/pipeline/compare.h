@@ -27,6 +27,7 @@ struct CompareRunConfig {
   CostModel model;
   SubdivisionConfig subdivision;
   bool geometry_aligned_off = false;
+  std::optional<AgvsConfig> merge_agvs;  ///< AV-M's leaf PVSs by AGVS too (eval/compare.h)
   std::string output_dir;
 };
 

@@ -1,0 +1,60 @@
+#pragma once
+/// Merging that holds under independent samples (view-cell-construction paper 4.3, made
+/// robust to sampling noise). Greedy merging of elementary cells whose PVSs come from a few
+/// hundred samples each picks the pairs whose sampled PVSs happen to overlap most: it fits the
+/// gaps of the samples, and independent samples show cuts worse than the subdivision's own.
+/// Two remedies, measured in docs/results.md:
+///  1. the elementary cells' PVSs that merging decides on are the construction samples'
+///     united with those of an AGVS run over the cells ("merge" run, A);
+///  2. the greedy merging starts from a cut of the subdivision's own order (AV-S's, undone
+///     split by split from the leaves), at the count chosen by a second, independent AGVS run
+///     ("validation" run, B): each candidate start, from every leaf down by halves, is scored
+///     by its mean log cost ratio to AV-S's cuts over log-spaced counts, with PVSs from B
+///     alone, which no decision has seen. Pure AV-S (score 0) is a candidate, so merging is
+///     kept only where the held-out samples say it pays.
+/// The history written has the chosen merges with PVSs from the construction samples, A and
+/// B together (what extraction and compression then store).
+#include <cstdint>
+#include <vector>
+
+#include "viewcells/agvs/agvs.h"
+#include "viewcells/bsp/cost_model.h"
+#include "viewcells/bsp/subdivision.h"
+#include "viewcells/merge/merge.h"
+#include "viewcells/raycast/ray_caster.h"
+#include "viewcells/scene/scene.h"
+
+namespace viewcells {
+
+struct ValidatedMergeConfig {
+  /// Sampling and stopping rule of each of the two AGVS runs; the validation run's seed is
+  /// agvs.seed + 1.
+  AgvsConfig agvs;
+  MergeConfig merge;  ///< min_cells and progress (the prefix is chosen here)
+  /// Counts scored, log-spaced from min(16, leaves) to the leaves, factor 1.25.
+  uint32_t score_from = 16;
+};
+
+struct MergeStart {
+  uint32_t cells = 0;  ///< greedy merging from the subdivision's cut at this many cells
+  double score = 0;    ///< mean log(cost / AV-S cost) on the validation PVSs (< 0: better)
+};
+
+struct ValidatedMerge {
+  MergeHistory history;
+  /// Per node of the subdivision (leaves filled): the construction samples' PVSs united with
+  /// both AGVS runs'; the history's node PVSs are unions of these.
+  std::vector<std::vector<uint32_t>> leaf_pvs;
+  uint32_t greedy_from = 0;     ///< the chosen start (leaf count: merging from the leaves)
+  std::vector<MergeStart> starts;  ///< every candidate, with its score
+  AgvsStats merge_agvs, validation_agvs;
+  double agvs_seconds = 0, neighbour_seconds = 0, merge_seconds = 0, select_seconds = 0;
+};
+
+/// `base`: the construction samples' leaf PVSs, per node of `s` (bsp/subdivision.h leaf_pvs);
+/// `s` needs its cells (neighbours). Deterministic for any thread count.
+ValidatedMerge merge_validated(const Scene& scene, const RayCaster& caster, const Subdivision& s,
+                               const std::vector<std::vector<uint32_t>>& base, const CostModel& model,
+                               const ValidatedMergeConfig& config);
+
+}  // namespace viewcells

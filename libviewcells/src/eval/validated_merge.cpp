@@ -1,0 +1,102 @@
+// Merging decided on AGVS's PVSs and started where held-out samples say it pays
+// (eval/validated_merge.h).
+#include "viewcells/eval/validated_merge.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "viewcells/core/error.h"
+#include "viewcells/eval/evaluate.h"
+
+namespace viewcells {
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
+}
+
+std::vector<std::vector<uint32_t>> unite(const std::vector<std::vector<uint32_t>>& a,
+                                         const std::vector<std::vector<uint32_t>>& b) {
+  std::vector<std::vector<uint32_t>> out(a.size());
+  for (size_t n = 0; n < a.size(); ++n) out[n] = unite_sorted(a[n], b[n]);
+  return out;
+}
+
+/// Every merge of `h`, in order, as a prefix that replays it.
+std::vector<std::pair<int32_t, int32_t>> merges_of(const MergeHistory& h) {
+  std::vector<std::pair<int32_t, int32_t>> out;
+  for (size_t k = h.leaf_count; k < h.nodes.size(); ++k) out.emplace_back(h.nodes[k].child[0], h.nodes[k].child[1]);
+  return out;
+}
+
+}  // namespace
+
+ValidatedMerge merge_validated(const Scene& scene, const RayCaster& caster, const Subdivision& s,
+                               const std::vector<std::vector<uint32_t>>& base, const CostModel& model,
+                               const ValidatedMergeConfig& config) {
+  ValidatedMerge out;
+  auto t = std::chrono::steady_clock::now();
+  LeafPvsRun a = leaf_pvs_by_agvs(scene, caster, s, config.agvs, base);
+  AgvsConfig vc = config.agvs;
+  vc.seed += 1;
+  LeafPvsRun b = leaf_pvs_by_agvs(scene, caster, s, vc);
+  out.merge_agvs = std::move(a.stats);
+  out.validation_agvs = std::move(b.stats);
+  out.agvs_seconds = seconds_since(t);
+
+  t = std::chrono::steady_clock::now();
+  CellPartition partition = partition_from_subdivision(s, a.pvs);
+  out.neighbour_seconds = seconds_since(t);
+
+  t = std::chrono::steady_clock::now();
+  const size_t L = s.leaf_count();
+  MergeConfig mc = config.merge;
+  mc.prefix = subdivision_prefix(s, 1);
+  const MergeHistory av_s = merge_cells(scene, partition, model, mc);  // AV-S's own order
+  const CostCurve av_s_held_out = evaluate_merge_history(scene, s, av_s, b.pvs, model);
+  std::vector<size_t> counts;
+  for (size_t n = std::min<size_t>(config.score_from, L); n <= L; n = n * 5 / 4 + 1) counts.push_back(n);
+  if (counts.empty() || counts.back() != L) counts.push_back(L);
+  out.starts.push_back({1, 0.0});
+  out.greedy_from = 1;
+  mc.show_progress = false;
+  MergeHistory best = av_s;
+  double best_score = 0;
+  for (size_t start = L; start >= 2; start /= 2) {
+    mc.prefix = subdivision_prefix(s, start);
+    MergeHistory h = merge_cells(scene, partition, model, mc);
+    const CostCurve held_out = evaluate_merge_history(scene, s, h, b.pvs, model);
+    double score = 0;
+    size_t terms = 0;
+    for (size_t n : counts)
+      if (n >= h.min_cells() && n >= av_s.min_cells()) {
+        score += std::log(held_out.at(static_cast<uint32_t>(n)) / av_s_held_out.at(static_cast<uint32_t>(n)));
+        ++terms;
+      }
+    score = terms ? score / static_cast<double>(terms) : 0.0;
+    out.starts.push_back({static_cast<uint32_t>(start), score});
+    if (score < best_score) {  // ties keep the more conservative (AV-S's) order
+      best_score = score;
+      best = std::move(h);
+      out.greedy_from = static_cast<uint32_t>(start);
+    }
+  }
+  out.select_seconds = seconds_since(t);
+
+  // The chosen merges, replayed with every sample's PVSs.
+  t = std::chrono::steady_clock::now();
+  out.leaf_pvs = unite(a.pvs, b.pvs);
+  partition = partition_from_subdivision(s, out.leaf_pvs);
+  out.neighbour_seconds += seconds_since(t);
+  t = std::chrono::steady_clock::now();
+  mc.prefix = merges_of(best);
+  mc.show_progress = config.merge.show_progress;
+  out.history = merge_cells(scene, partition, model, mc);
+  out.merge_seconds = seconds_since(t);
+  out.history.stats.seconds = out.merge_seconds;
+  return out;
+}
+
+}  // namespace viewcells
