@@ -178,3 +178,62 @@ TEST(Evaluate, ReportCellCounts) {
 
 }  // namespace
 }  // namespace viewcells
+
+namespace viewcells {
+namespace {
+
+/// Merging must never make a cut worse than the subdivision's own cut of the same size by more
+/// than the evaluator's own noise. On a small rotated office (where greedy merging on the
+/// construction samples alone was 1.6x AV-S at 100 cells), AV-M with its default validated
+/// merge is scored against AV-S on two independent evaluation sample sets; their
+/// disagreement on AV-S's own cost is the evaluator's noise at each count.
+TEST(Evaluate, MergingIsNotWorseThanTheSubdivisionsOwnCuts) {
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 2});
+  const auto caster = make_embree_caster(scene);
+  CompareConfig config;
+  config.methods = {"av-m", "av-m-samples", "av-s"};
+  config.max_cells = 400;
+  config.construction.samples = 80000;
+  config.construction.seed = 1;
+  config.construction.show_progress = false;
+  config.evaluation = config.construction;
+  config.evaluation.samples = 320000;
+  config.evaluation.seed = 2;
+  config.show_progress = false;
+  config.keep_models = true;
+  AgvsConfig agvs;
+  agvs.seed = 5;
+  agvs.max_samples = 80000;
+  agvs.show_progress = false;
+  config.merge_agvs = agvs;
+  const Comparison c = compare_methods(scene, *caster, config);
+  ASSERT_EQ(c.methods.size(), 3u);
+  ASSERT_TRUE(c.av_s && c.av_m);
+  const MethodResult &avm = c.methods[0], &old = c.methods[1], &avs = c.methods[2];
+  EXPECT_GT(avm.leaf_agvs_samples, 2 * agvs.max_samples - 1);
+  EXPECT_FALSE(avm.starts.empty());
+
+  // A second, independent evaluation of AV-S: the evaluator's noise.
+  SamplerConfig second = config.evaluation;
+  second.seed = 3;
+  const SegmentSet eval2 = sample_segments(scene, *caster, second).segments;
+  const CostCurve avs2 = evaluate_subdivision(scene, *c.av_s, evaluation_pvs(*c.av_s, eval2), CostModel{});
+  const uint32_t leaves = avs.leaves;
+  int old_worse = 0;
+  for (uint32_t n : report_cell_counts(leaves)) {
+    if (n < 16) continue;
+    const double a = avs.evaluated.at(n);
+    const double noise = std::abs(a - avs2.at(n)) / a;
+    const double allowed = 1.02 + 3 * noise;
+    EXPECT_LE(avm.evaluated.at(n) / a, allowed) << n << " cells: AV-M " << avm.evaluated.at(n) << ", AV-S " << a
+                                                << ", evaluator noise " << noise;
+    old_worse += old.evaluated.at(n) / a > allowed;
+  }
+  // The test has teeth: the merge it replaced fails it on this scene.
+  EXPECT_GT(old_worse, 0) << "greedy merging on the construction samples alone passed too";
+  // The history's cut at the leaf count is the leaves, whatever the merge order.
+  EXPECT_NEAR(avm.evaluated.at(leaves), avs.evaluated.at(leaves), 1e-12 * avs.evaluated.at(leaves));
+}
+
+}  // namespace
+}  // namespace viewcells

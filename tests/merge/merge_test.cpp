@@ -258,3 +258,91 @@ TEST(Merge, BadInput) {
 
 }  // namespace
 }  // namespace viewcells
+
+namespace viewcells {
+namespace {
+
+/// The leaves under each node of a cut, as sets, for comparing cuts of different trees.
+std::vector<std::vector<uint32_t>> cut_leaves(const MergeHistory& h, size_t cells) {
+  std::vector<std::vector<uint32_t>> out;
+  for (int32_t n : h.cut_after(h.leaf_count - cells)) out.push_back(h.leaves_under(n));
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::vector<std::vector<uint32_t>> subdivision_cut_leaves(const Subdivision& s, size_t cells) {
+  const std::vector<int32_t> leaves = s.leaves();
+  std::vector<int32_t> index(s.nodes.size(), -1);
+  for (size_t i = 0; i < leaves.size(); ++i) index[leaves[i]] = static_cast<int32_t>(i);
+  std::vector<std::vector<uint32_t>> out;
+  for (int32_t n : s.leaves_after(cells - 1)) {
+    std::vector<uint32_t> under;
+    std::vector<int32_t> stack = {n};
+    while (!stack.empty()) {
+      const int32_t m = stack.back();
+      stack.pop_back();
+      if (s.nodes[m].plane < 0) under.push_back(static_cast<uint32_t>(index[m]));
+      else stack.insert(stack.end(), {s.nodes[m].child[0], s.nodes[m].child[1]});
+    }
+    std::sort(under.begin(), under.end());
+    out.push_back(under);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(Merge, PrefixReplaysTheSubdivisionsOwnCuts) {
+  const Fixture f = office(90);
+  MergeConfig config;
+  config.show_progress = false;
+  config.prefix = subdivision_prefix(f.sub, 1);
+  ASSERT_EQ(config.prefix.size(), 89u);
+  const MergeHistory h = merge_cells(f.scene, f.partition, CostModel{}, config);
+  EXPECT_EQ(h.stats.evaluations, 0u) << "nothing left to choose greedily";
+  for (size_t cells : {90ul, 60ul, 17ul, 5ul, 1ul}) {
+    EXPECT_EQ(cut_leaves(h, cells), subdivision_cut_leaves(f.sub, cells)) << cells << " cells";
+    // The subdivision's own cost at that count, from the same construction samples.
+    const double expected = cells == 1 ? f.sub.initial_cost : f.sub.splits[cells - 2].cost_after;
+    EXPECT_NEAR(h.cost_with(cells), expected, 1e-9 * expected) << cells << " cells";
+  }
+  // Part of the order, then greedy: the cuts down to the start are the subdivision's.
+  config.prefix = subdivision_prefix(f.sub, 30);
+  const MergeHistory g = merge_cells(f.scene, f.partition, CostModel{}, config);
+  EXPECT_EQ(cut_leaves(g, 30), subdivision_cut_leaves(f.sub, 30));
+  EXPECT_EQ(g.merges(), 89u);
+  EXPECT_LE(g.cost_with(10), h.cost_with(10) * 1.5);
+}
+
+TEST(Merge, BarrierKeepsGreedyMergesInsideTheSubdivisionsCut) {
+  const Fixture f = office(90);
+  MergeConfig config;
+  config.show_progress = false;
+  config.barrier_cells = 12;
+  config.block = subdivision_blocks(f.sub, 12);
+  const MergeHistory h = merge_cells(f.scene, f.partition, CostModel{}, config);
+  // At the barrier the cut is exactly the subdivision's; above it every cell lies in a block.
+  EXPECT_EQ(cut_leaves(h, 12), subdivision_cut_leaves(f.sub, 12));
+  for (size_t cells : {80ul, 40ul, 20ul, 13ul})
+    for (const std::vector<uint32_t>& cell : cut_leaves(h, cells))
+      for (uint32_t leaf : cell) EXPECT_EQ(config.block[leaf], config.block[cell.front()]) << cells << " cells";
+  EXPECT_EQ(h.merges(), 89u) << "greedy merging goes on below the barrier";
+}
+
+TEST(Merge, PrefixAndBlocksAreChecked) {
+  const Fixture f = office(20);
+  MergeConfig config;
+  config.show_progress = false;
+  config.prefix = {{0, 0}};
+  EXPECT_THROW(merge_cells(f.scene, f.partition, CostModel{}, config), Error);
+  config.prefix = {{0, 1}, {0, 2}};  // 0 has merged already
+  EXPECT_THROW(merge_cells(f.scene, f.partition, CostModel{}, config), Error);
+  config.prefix = {{0, 99}};
+  EXPECT_THROW(merge_cells(f.scene, f.partition, CostModel{}, config), Error);
+  config.prefix.clear();
+  config.block = {0, 1};
+  config.barrier_cells = 2;
+  EXPECT_THROW(merge_cells(f.scene, f.partition, CostModel{}, config), Error);
+}
+
+}  // namespace
+}  // namespace viewcells

@@ -47,7 +47,8 @@ MergeHistory merge_for_comparison(const Scene& scene, const RayCaster& caster, c
     r.neighbour_seconds = v.neighbour_seconds;
     r.merge_seconds = v.select_seconds + v.merge_seconds;
     r.leaf_agvs_samples = v.merge_agvs.samples + v.validation_agvs.samples;
-    r.greedy_from = v.greedy_from;
+    r.greedy_from = v.chosen.cells;
+    r.merge_barrier = v.chosen.barrier;
     r.starts = std::move(v.starts);
     return std::move(v.history);
   }

@@ -59,29 +59,38 @@ ValidatedMerge merge_validated(const Scene& scene, const RayCaster& caster, cons
   std::vector<size_t> counts;
   for (size_t n = std::min<size_t>(config.score_from, L); n <= L; n = n * 5 / 4 + 1) counts.push_back(n);
   if (counts.empty() || counts.back() != L) counts.push_back(L);
-  out.starts.push_back({1, 0.0});
-  out.greedy_from = 1;
+  out.chosen = {1, 0, 0.0, 0.0};
+  out.starts.push_back(out.chosen);
   mc.show_progress = false;
   MergeHistory best = av_s;
-  double best_score = 0;
-  for (size_t start = L; start >= 2; start /= 2) {
+  auto consider = [&](size_t start, size_t barrier) {
     mc.prefix = subdivision_prefix(s, start);
+    mc.barrier_cells = static_cast<uint32_t>(barrier);
+    mc.block = barrier ? subdivision_blocks(s, barrier) : std::vector<int32_t>{};
     MergeHistory h = merge_cells(scene, partition, model, mc);
     const CostCurve held_out = evaluate_merge_history(scene, s, h, b.pvs, model);
-    double score = 0;
+    MergeStart st{static_cast<uint32_t>(start), static_cast<uint32_t>(barrier), 0.0, -1e300};
     size_t terms = 0;
     for (size_t n : counts)
       if (n >= h.min_cells() && n >= av_s.min_cells()) {
-        score += std::log(held_out.at(static_cast<uint32_t>(n)) / av_s_held_out.at(static_cast<uint32_t>(n)));
+        const double r = std::log(held_out.at(static_cast<uint32_t>(n)) / av_s_held_out.at(static_cast<uint32_t>(n)));
+        st.score += r;
+        st.worst = std::max(st.worst, r);
         ++terms;
       }
-    score = terms ? score / static_cast<double>(terms) : 0.0;
-    out.starts.push_back({static_cast<uint32_t>(start), score});
-    if (score < best_score) {  // ties keep the more conservative (AV-S's) order
-      best_score = score;
+    st.score = terms ? st.score / static_cast<double>(terms) : 0.0;
+    if (!terms) st.worst = 0;
+    out.starts.push_back(st);
+    // The lowest mean among the starts whose worst count stays within the allowance; ties keep
+    // the earlier (AV-S's order first).
+    if (st.worst <= config.worst_allowed && st.score < out.chosen.score) {
+      out.chosen = st;
       best = std::move(h);
-      out.greedy_from = static_cast<uint32_t>(start);
     }
+  };
+  for (size_t start = L; start >= 2; start /= 2) {
+    consider(start, 0);
+    for (size_t barrier = start / 4; barrier >= 4; barrier /= 4) consider(start, barrier);
   }
   out.select_seconds = seconds_since(t);
 
@@ -92,6 +101,8 @@ ValidatedMerge merge_validated(const Scene& scene, const RayCaster& caster, cons
   out.neighbour_seconds += seconds_since(t);
   t = std::chrono::steady_clock::now();
   mc.prefix = merges_of(best);
+  mc.barrier_cells = 0;
+  mc.block.clear();
   mc.show_progress = config.merge.show_progress;
   out.history = merge_cells(scene, partition, model, mc);
   out.merge_seconds = seconds_since(t);

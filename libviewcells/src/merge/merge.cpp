@@ -57,6 +57,18 @@ std::vector<std::pair<int32_t, int32_t>> subdivision_prefix(const Subdivision& s
   return prefix;
 }
 
+std::vector<int32_t> subdivision_blocks(const Subdivision& s, size_t cells) {
+  const std::vector<int32_t> leaves = s.leaves();
+  std::vector<int32_t> block_of(s.nodes.size(), -1);
+  for (int32_t n : s.leaves_after(std::max<size_t>(cells, 1) - 1)) block_of[n] = n;
+  // Nodes are created parent first: a node without a block inherits its parent's.
+  for (size_t n = 0; n < s.nodes.size(); ++n)
+    if (block_of[n] < 0 && s.nodes[n].parent >= 0) block_of[n] = block_of[s.nodes[n].parent];
+  std::vector<int32_t> out(leaves.size());
+  for (size_t i = 0; i < leaves.size(); ++i) out[i] = block_of[leaves[i]];
+  return out;
+}
+
 CellPartition grid_partition(const SegmentSet& segs, int nx, int ny, int nz) {
   if (nx < 1 || ny < 1 || nz < 1) throw Error("a grid needs at least one cell along each axis");
   const Box3 box = segs.view_box;
@@ -206,15 +218,22 @@ class Merger {
       merge(h, graph, x, y, around);
       if (config.show_progress) progress.advance(1);
     }
-    // Every neighbouring pair of the current cells, evaluated in parallel (each is independent).
-    std::vector<Entry> entries;
-    for (size_t v = 0; v < h.nodes.size(); ++v)
-      for (auto [it, end] = boost::adjacent_vertices(v, graph); it != end; ++it)
-        if (v < *it) entries.push_back({0.0, static_cast<int32_t>(v), static_cast<int32_t>(*it)});
-    evaluate(h, entries);
-    std::priority_queue<Entry, std::vector<Entry>, Later> queue(Later{}, std::move(entries));
+    if (!config.block.empty()) {
+      if (config.block.size() != L) throw Error("the merge blocks do not match the partition");
+      block_.assign(2 * L, -1);
+      for (size_t i = 0; i < L; ++i) block_[i] = config.block[i];
+      for (size_t k = L; k < h.nodes.size(); ++k) block_[k] = block_[h.nodes[k].child[0]];
+    }
+    constrained_ = !config.block.empty() && alive_ > config.barrier_cells;
+    std::priority_queue<Entry, std::vector<Entry>, Later> queue(Later{}, all_pairs(h, graph));
     std::vector<Entry> fresh;
-    while (alive_ > target && !queue.empty()) {
+    while (alive_ > target) {
+      if (queue.empty()) {
+        if (!constrained_) break;
+        constrained_ = false;  // blocks that cannot merge further: the barrier is lifted
+        queue = decltype(queue)(Later{}, all_pairs(h, graph));
+        continue;
+      }
       const Entry e = queue.top();
       queue.pop();
       if (h.nodes[e.x].parent >= 0 || h.nodes[e.y].parent >= 0) {
@@ -222,11 +241,18 @@ class Merger {
         continue;
       }
       const int32_t z = merge(h, graph, e.x, e.y, around);
+      if (constrained_) block_[z] = block_[e.x];
+      if (config.show_progress) progress.advance(1);
+      if (constrained_ && alive_ <= config.barrier_cells) {
+        constrained_ = false;  // at the barrier: every neighbouring pair from now on
+        queue = decltype(queue)(Later{}, all_pairs(h, graph));
+        continue;
+      }
       fresh.clear();
-      for (int32_t n : around) fresh.push_back({0.0, n, z});
+      for (int32_t n : around)
+        if (allowed(n, z)) fresh.push_back({0.0, n, z});
       evaluate(h, fresh);
       for (const Entry& f : fresh) queue.push(f);
-      if (config.show_progress) progress.advance(1);
     }
     if (config.show_progress) progress.finish();
     h.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -234,6 +260,19 @@ class Merger {
   }
 
  private:
+  bool allowed(int32_t x, int32_t y) const { return !constrained_ || block_[x] == block_[y]; }
+
+  /// Every allowed neighbouring pair of the current cells, evaluated.
+  std::vector<Entry> all_pairs(MergeHistory& h, const Graph& graph) {
+    std::vector<Entry> entries;
+    for (size_t v = 0; v < h.nodes.size(); ++v)
+      for (auto [it, end] = boost::adjacent_vertices(v, graph); it != end; ++it)
+        if (v < *it && allowed(static_cast<int32_t>(v), static_cast<int32_t>(*it)))
+          entries.push_back({0.0, static_cast<int32_t>(v), static_cast<int32_t>(*it)});
+    evaluate(h, entries);
+    return entries;
+  }
+
   void check_prefix_pair(const MergeHistory& h, int32_t x, int32_t y) const {
     const int32_t n = static_cast<int32_t>(h.nodes.size());
     if (x < 0 || y < 0 || x >= n || y >= n || x == y || h.nodes[x].parent >= 0 || h.nodes[y].parent >= 0)
@@ -324,6 +363,8 @@ class Merger {
   double W_ = 1;
   size_t alive_ = 0;
   double cost_ = 0;
+  bool constrained_ = false;
+  std::vector<int32_t> block_;  ///< per MHT node, with a barrier
   std::vector<std::vector<uint32_t>> pvs_;  ///< per MHT node, while it is a current cell
 };
 

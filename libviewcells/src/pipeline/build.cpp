@@ -68,16 +68,17 @@ void merge_leaves(const BuildConfig& config, const SamplingRun& s, const Subdivi
     file.leaf_pvs = std::move(v.leaf_pvs);
     file.history = std::move(v.history);
     out.merge_validated = true;
-    out.greedy_from = v.greedy_from;
+    out.greedy_from = v.chosen.cells;
+    out.merge_barrier = v.chosen.barrier;
     out.merge_starts = std::move(v.starts);
     out.merge_agvs = std::move(v.merge_agvs);
     out.validation_agvs = std::move(v.validation_agvs);
     out.leaf_pvs_seconds += v.agvs_seconds;
     out.neighbour_seconds = v.neighbour_seconds;
     out.merge_seconds = v.select_seconds + v.merge_seconds;
-    log("viewcells: greedy merging from the subdivision's own cut at " + std::to_string(v.greedy_from) +
-        " cells (held-out score " + fmt(v.starts.empty() ? 0.0 : std::min_element(v.starts.begin(), v.starts.end(),
-            [](const MergeStart& x, const MergeStart& y) { return x.score < y.score; })->score, 4) + ")");
+    log("viewcells: greedy merging from the subdivision's own cut at " + std::to_string(v.chosen.cells) +
+        " cells" + (v.chosen.barrier ? ", within its cut at " + std::to_string(v.chosen.barrier) + " cells until there" : "") +
+        " (held-out mean log cost ratio to AV-S " + fmt(v.chosen.score, 4) + ", worst " + fmt(v.chosen.worst, 4) + ")");
   } else {
     log("viewcells: merging " + std::to_string(sub.leaf_count()) + " cells on the construction samples' PVSs");
     sw.restart();

@@ -232,9 +232,11 @@ std::string report_json(const BuildResult& r) {
     report["merge"] = merge_summary(*r.file.history);
     report["merge"]["pvs"] = r.merge_validated ? "construction samples and two AGVS runs" : "construction samples";
     report["merge"]["greedy_from_cells"] = r.greedy_from;
+    report["merge"]["barrier_cells"] = r.merge_barrier;
     if (r.merge_validated) {
       json starts = json::array();
-      for (const MergeStart& st : r.merge_starts) starts.push_back({{"cells", st.cells}, {"score", st.score}});
+      for (const MergeStart& st : r.merge_starts)
+        starts.push_back({{"cells", st.cells}, {"barrier", st.barrier}, {"score", st.score}, {"worst", st.worst}});
       report["merge"]["starts_scored"] = starts;
       report["merge"]["agvs_samples"] = {{"merge", r.merge_agvs.samples}, {"validation", r.validation_agvs.samples}};
     }
@@ -411,12 +413,14 @@ json compare_methods_json(const Comparison& cmp) {
                        {"constructed_cost_at_most_cells", m.constructed.at(last)}});
     if (m.method == "av-m" || m.method == "av-m-samples") {
       json starts = json::array();
-      for (const MergeStart& st : m.starts) starts.push_back({{"cells", st.cells}, {"score", st.score}});
+      for (const MergeStart& st : m.starts)
+        starts.push_back({{"cells", st.cells}, {"barrier", st.barrier}, {"score", st.score}, {"worst", st.worst}});
       methods.back()["merge"] = {{"leaf_pvs_seconds", m.leaf_pvs_seconds},
                                  {"neighbour_graph_seconds", m.neighbour_seconds},
                                  {"merge_seconds", m.merge_seconds},
                                  {"leaf_agvs_samples", m.leaf_agvs_samples},
                                  {"greedy_from_cells", m.greedy_from},
+                                 {"barrier_cells", m.merge_barrier},
                                  {"starts_scored", starts}};
     }
   }

@@ -48,6 +48,7 @@ struct MethodResult {
   double leaf_pvs_seconds = 0, neighbour_seconds = 0, merge_seconds = 0;
   uint64_t leaf_agvs_samples = 0;  ///< AV-M: AGVS samples of both runs (0: none)
   uint32_t greedy_from = 0;        ///< AV-M: greedy merging from AV-S's cut at this count
+  uint32_t merge_barrier = 0;      ///< AV-M: ... within the blocks of its cut at this count (0: none)
   std::vector<MergeStart> starts;  ///< AV-M with AGVS: every candidate start, scored
   std::string stop_reason;
   std::string geometry_aligned;  ///< whether geometry-aligned candidates were used, and why

@@ -33,11 +33,15 @@ struct ValidatedMergeConfig {
   MergeConfig merge;  ///< min_cells and progress (the prefix is chosen here)
   /// Counts scored, log-spaced from min(16, leaves) to the leaves, factor 1.25.
   uint32_t score_from = 16;
+  /// A start is taken only when its worst count is at most this (a log ratio) above AV-S's.
+  double worst_allowed = 0.01;
 };
 
 struct MergeStart {
-  uint32_t cells = 0;  ///< greedy merging from the subdivision's cut at this many cells
-  double score = 0;    ///< mean log(cost / AV-S cost) on the validation PVSs (< 0: better)
+  uint32_t cells = 0;    ///< greedy merging from the subdivision's cut at this many cells
+  uint32_t barrier = 0;  ///< within the blocks of its cut at this many cells until there (0: none)
+  double score = 0;      ///< mean log(cost / AV-S cost) on the validation PVSs (< 0: better)
+  double worst = 0;      ///< the largest log(cost / AV-S cost) among the counts scored
 };
 
 struct ValidatedMerge {
@@ -45,7 +49,7 @@ struct ValidatedMerge {
   /// Per node of the subdivision (leaves filled): the construction samples' PVSs united with
   /// both AGVS runs'; the history's node PVSs are unions of these.
   std::vector<std::vector<uint32_t>> leaf_pvs;
-  uint32_t greedy_from = 0;     ///< the chosen start (leaf count: merging from the leaves)
+  MergeStart chosen;            ///< the chosen start ({1, 0}: AV-S's own order)
   std::vector<MergeStart> starts;  ///< every candidate, with its score
   AgvsStats merge_agvs, validation_agvs;
   double agvs_seconds = 0, neighbour_seconds = 0, merge_seconds = 0, select_seconds = 0;

@@ -81,6 +81,12 @@ struct MergeConfig {
   /// prefix merge j creates node leaf_count + j). E.g. subdivision_prefix: the subdivision's
   /// own order back to a coarser cut, from which the greedy merging continues.
   std::vector<std::pair<int32_t, int32_t>> prefix;
+  /// A barrier: while more than `barrier_cells` cells remain, greedy merges join only cells
+  /// of the same block (`block`, per partition cell; empty: no barrier). With blocks that are
+  /// the subdivision's cut at barrier_cells cells (subdivision_blocks), the cut of the history
+  /// at that count is exactly the subdivision's, and greedy merging goes on from there.
+  uint32_t barrier_cells = 0;
+  std::vector<int32_t> block;
   bool show_progress = true;
 };
 
@@ -93,6 +99,10 @@ MergeHistory merge_cells(const Scene& scene, const CellPartition& partition, con
 /// partition_from_subdivision(s, ...) cells (MergeConfig::prefix): its cuts are then exactly
 /// the subdivision's own (AV-S's) cuts from leaf_count() down to `cells`.
 std::vector<std::pair<int32_t, int32_t>> subdivision_prefix(const Subdivision& s, size_t cells);
+
+/// Per partition_from_subdivision(s, ...) cell: the node of the subdivision's own cut at
+/// `cells` cells that holds it (MergeConfig::block).
+std::vector<int32_t> subdivision_blocks(const Subdivision& s, size_t cells);
 
 /// A set of view cells cut from the merge history.
 struct ViewCellSet {

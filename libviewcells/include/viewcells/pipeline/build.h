@@ -48,6 +48,7 @@ struct BuildResult {
   bool merge = true;
   bool merge_validated = false;  ///< merged by merge_validated (the fields below)
   uint32_t greedy_from = 0;      ///< greedy merging from AV-S's cut at this many cells
+  uint32_t merge_barrier = 0;    ///< ... within the blocks of its cut at this many cells (0: none)
   std::vector<MergeStart> merge_starts;
   AgvsStats merge_agvs, validation_agvs;
   /// Seconds of the leaves' PVSs (AGVS runs included), of the neighbour graph, and of merging
