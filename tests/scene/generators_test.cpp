@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "viewcells/core/error.h"
 #include "viewcells/scene/generators.h"
@@ -9,7 +10,8 @@ namespace viewcells {
 namespace {
 
 TEST(Generators, DeterministicBySeed) {
-  for (GeneratorKind kind : {GeneratorKind::kOffice, GeneratorKind::kCity, GeneratorKind::kRotatedOffice}) {
+  for (GeneratorKind kind :
+       {GeneratorKind::kOffice, GeneratorKind::kCity, GeneratorKind::kRotatedOffice, GeneratorKind::kTown}) {
     const Scene a = generate_scene({kind, 11, 2});
     const Scene b = generate_scene({kind, 11, 2});
     const Scene c = generate_scene({kind, 12, 2});
@@ -19,8 +21,9 @@ TEST(Generators, DeterministicBySeed) {
 }
 
 TEST(Generators, ScenesAreSolid) {
-  for (GeneratorKind kind : {GeneratorKind::kOffice, GeneratorKind::kCity, GeneratorKind::kRotatedOffice}) {
-    const Scene s = generate_scene({kind, 3, 3});
+  for (GeneratorKind kind :
+       {GeneratorKind::kOffice, GeneratorKind::kCity, GeneratorKind::kRotatedOffice, GeneratorKind::kTown}) {
+    const Scene s = generate_scene({kind, 3, kind == GeneratorKind::kTown ? 8 : 3});
     EXPECT_TRUE(s.all_solid) << to_string(kind);
     EXPECT_EQ(s.degenerate_dropped, 0u);
     for (const ObjectInfo& o : s.objects) EXPECT_TRUE(o.solid()) << o.name;
@@ -67,6 +70,39 @@ TEST(Generators, RotatedOfficeIsNotAxisAligned) {
   EXPECT_LT(s.non_axis_aligned_share(), 0.9);  // floors and ceilings stay horizontal
   const Scene o = generate_scene({GeneratorKind::kOffice, 1, 2});
   EXPECT_EQ(s.triangle_count(), o.triangle_count());
+}
+
+/// The town is not a grid: its buildings face many directions, its heights vary, and at
+/// size 23 it has over a million triangles.
+TEST(Generators, TownHasTurnedStreetsSquaresAndTowers) {
+  const Scene s = generate_scene({GeneratorKind::kTown, 1, 23});
+  EXPECT_GT(s.triangle_count(), 1'000'000u);
+  EXPECT_GT(s.non_axis_aligned_share(), 0.1);
+  std::vector<double> angles, heights;
+  int squares = 0;
+  for (const ObjectInfo& o : s.objects) {
+    if (o.name.find("square_") == 0) ++squares;
+    if (o.name.find("_building_") == std::string::npos) continue;
+    heights.push_back(o.bounds.hi.z);
+  }
+  // Wall directions: the angle of every vertical triangle's normal, folded into [0, 90).
+  for (size_t t = 0; t < s.triangles.size(); t += 97) {
+    const Vec3 a = s.vertices[s.triangles[t][0]], b = s.vertices[s.triangles[t][1]],
+               c = s.vertices[s.triangles[t][2]];
+    const Vec3 n = cross(b - a, c - a);
+    if (std::abs(n.z) > 1e-6 * length(n)) continue;
+    double deg = std::atan2(n.y, n.x) * 180 / 3.141592653589793;
+    deg = std::fmod(deg + 360.0, 90.0);
+    angles.push_back(std::floor(deg / 5));
+  }
+  std::sort(angles.begin(), angles.end());
+  angles.erase(std::unique(angles.begin(), angles.end()), angles.end());
+  EXPECT_GE(angles.size(), 8u) << "streets at many angles (5-degree bins of wall directions)";
+  EXPECT_GT(squares, 0) << "open squares with trees";
+  std::sort(heights.begin(), heights.end());
+  ASSERT_GT(heights.size(), 1000u);
+  EXPECT_GT(heights.back(), 100.0) << "landmark towers";
+  EXPECT_GT(heights[heights.size() * 9 / 10], 2 * heights[heights.size() / 10]);
 }
 
 TEST(Generators, RejectsBadParameters) {

@@ -15,7 +15,8 @@ GeneratorKind parse_generator_kind(const std::string& name) {
   if (name == "office") return GeneratorKind::kOffice;
   if (name == "city") return GeneratorKind::kCity;
   if (name == "rotated-office") return GeneratorKind::kRotatedOffice;
-  throw Error("unknown scene kind '" + name + "' (expected office, city or rotated-office)");
+  if (name == "town") return GeneratorKind::kTown;
+  throw Error("unknown scene kind '" + name + "' (expected office, city, rotated-office or town)");
 }
 
 const char* to_string(GeneratorKind kind) {
@@ -23,6 +24,7 @@ const char* to_string(GeneratorKind kind) {
     case GeneratorKind::kOffice: return "office";
     case GeneratorKind::kCity: return "city";
     case GeneratorKind::kRotatedOffice: return "rotated-office";
+    case GeneratorKind::kTown: return "town";
   }
   return "?";
 }
@@ -86,6 +88,19 @@ class MeshBuilder {
           }
         }
       }
+    }
+  }
+
+  /// A box of footprint w x d (centred on `centre`, turned `angle` radians about z) from z0
+  /// to z1, its faces split about every `step` metres.
+  void add_turned_box(Vec3 centre, double w, double d, double z0, double z1, double angle, double step) {
+    const size_t first = scene_.vertices.size();
+    add_box({-w / 2, -d / 2, z0}, {w / 2, d / 2, z1}, static_cast<int>(w / step) + 1, static_cast<int>(d / step) + 1,
+            std::max(1, static_cast<int>((z1 - z0) / step)));
+    const double c = std::cos(angle), s = std::sin(angle);
+    for (size_t v = first; v < scene_.vertices.size(); ++v) {
+      Vec3& p = scene_.vertices[v];
+      p = {centre.x + c * p.x - s * p.y, centre.y + s * p.x + c * p.y, p.z};
     }
   }
 
@@ -313,6 +328,122 @@ Scene generate_city(uint64_t seed, int size) {
   return scene;
 }
 
+
+// ------------------------------------------------------------------------------------ town
+
+/// A district of the town: its own street grid, turned and scaled.
+struct District {
+  double x, y;        ///< seed point (the districts are its Voronoi cells)
+  double angle;       ///< of its streets, radians
+  double block, street;
+  double height;      ///< median building height
+};
+
+/// Whether point (x, y) lies in district k's Voronoi cell at least `gap` (a distance
+/// difference) away from every other district.
+bool inside_district(const std::vector<District>& ds, size_t k, double x, double y, double gap) {
+  const double dk = std::hypot(x - ds[k].x, y - ds[k].y);
+  for (size_t j = 0; j < ds.size(); ++j)
+    if (j != k && std::hypot(x - ds[j].x, y - ds[j].y) - dk < gap) return false;
+  return true;
+}
+
+struct Square {
+  double x, y, r;
+};
+
+/// Buildings of one block (a w x w square centred on `c`, turned with its district): 1 to 3
+/// lots per side, one building each, an occasional landmark tower.
+void add_town_block(MeshBuilder& mb, Rng& rng, const District& d, Vec3 c, const std::string& name) {
+  const double ca = std::cos(d.angle), sa = std::sin(d.angle);
+  const int lots_u = 2 + static_cast<int>(rng.below(3)), lots_v = 2 + static_cast<int>(rng.below(3));
+  const double lu = d.block / lots_u, lv = d.block / lots_v;
+  int building = 0;
+  for (int i = 0; i < lots_u; ++i)
+    for (int j = 0; j < lots_v; ++j) {
+      const double margin = rng.uniform(1.0, 3.5);
+      const double w = lu - 2 * margin, dd = lv - 2 * margin;
+      if (w < 3 || dd < 3) continue;
+      const double u = -d.block / 2 + (i + 0.5) * lu, v = -d.block / 2 + (j + 0.5) * lv;
+      double h = std::exp(std::log(d.height) + 0.5 * (rng.uniform() + rng.uniform() + rng.uniform() - 1.5) * 2.0);
+      if (rng.uniform() < 0.012) h = rng.uniform(120.0, 260.0);  // a landmark tower
+      h = std::clamp(h, 4.0, 260.0);
+      mb.begin_object(name + "_building_" + std::to_string(building++));
+      const Vec3 centre{c.x + ca * u - sa * v, c.y + sa * u + ca * v, 0};
+      mb.add_turned_box(centre, w, dd, 0, h, d.angle, 2.4);
+      if (h > 60 && rng.uniform() < 0.5)  // a spire on tall buildings
+        mb.add_turned_box(centre, 0.3 * w, 0.3 * dd, h, h + 0.2 * h, d.angle, 2.4);
+    }
+}
+
+Scene generate_town(uint64_t seed, int size) {
+  Scene scene;
+  MeshBuilder mb(scene);
+  Rng rng(seed, 0x70a);
+  constexpr double kUnit = 76.0;
+  const double extent = size * kUnit + 16.0;
+  const double mid = extent / 2;
+  // Districts: Voronoi cells of random seeds, each with its own street angle, block size
+  // and (tallest in the middle) building heights.
+  std::vector<District> ds(std::max<size_t>(3, static_cast<size_t>(size) * size / 10));
+  for (District& d : ds) {
+    d.x = rng.uniform(0.0, extent);
+    d.y = rng.uniform(0.0, extent);
+    d.angle = rng.uniform(0.0, 1.5707963267948966);
+    d.block = rng.uniform(30.0, 90.0);
+    d.street = rng.uniform(9.0, 20.0);
+    const double r = std::hypot(d.x - mid, d.y - mid) / (0.5 * extent);
+    d.height = 8.0 + 22.0 * std::exp(-3.0 * r * r);
+  }
+  std::vector<Square> squares(std::max<size_t>(1, static_cast<size_t>(size) * size / 60));
+  for (Square& q : squares) q = {rng.uniform(0.15, 0.85) * extent, rng.uniform(0.15, 0.85) * extent, rng.uniform(20.0, 45.0)};
+
+  // The ground: tiles of an axis-aligned grid, below everything.
+  for (int i = 0; i < size; ++i)
+    for (int j = 0; j < size; ++j) {
+      mb.begin_object("ground_" + std::to_string(i) + "_" + std::to_string(j));
+      const double x0 = i * extent / size, y0 = j * extent / size;
+      mb.add_box({x0, y0, -1.0}, {x0 + extent / size, y0 + extent / size, 0.0}, 4, 4, 1);
+    }
+  for (size_t k = 0; k < ds.size(); ++k) {
+    const District& d = ds[k];
+    const double pitch = d.block + d.street, ca = std::cos(d.angle), sa = std::sin(d.angle);
+    const int reach = static_cast<int>(std::ceil(1.5 * extent / pitch));
+    for (int i = -reach; i <= reach; ++i)
+      for (int j = -reach; j <= reach; ++j) {
+        const double u = i * pitch, v = j * pitch;
+        const Vec3 c{d.x + ca * u - sa * v, d.y + sa * u + ca * v, 0};
+        bool keep = true;
+        for (int corner = 0; corner < 4 && keep; ++corner) {
+          const double du = (corner & 1 ? 0.5 : -0.5) * d.block, dv = (corner & 2 ? 0.5 : -0.5) * d.block;
+          const double x = c.x + ca * du - sa * dv, y = c.y + sa * du + ca * dv;
+          keep = x > 8 && y > 8 && x < extent - 8 && y < extent - 8 && inside_district(ds, k, x, y, d.street);
+        }
+        for (const Square& q : squares)
+          keep = keep && std::hypot(c.x - q.x, c.y - q.y) > q.r + 0.75 * d.block;
+        if (keep)
+          add_town_block(mb, rng, d, c, "district_" + std::to_string(k) + "_block_" + std::to_string(i) + "_" +
+                                            std::to_string(j));
+      }
+  }
+  // Open squares: a ring of trees.
+  for (size_t s = 0; s < squares.size(); ++s) {
+    const Square& q = squares[s];
+    const double ring = q.r - 8.0;
+    const int trees = std::max(0, static_cast<int>(2 * 3.14159 * ring / 9.0));
+    for (int t = 0; t < trees; ++t) {
+      const double a = 2 * 3.141592653589793 * t / trees;
+      const double px = q.x + ring * std::cos(a), py = q.y + ring * std::sin(a);
+      mb.begin_object("square_" + std::to_string(s) + "_tree_" + std::to_string(t));
+      mb.add_box({px - 0.2, py - 0.2, 0}, {px + 0.2, py + 0.2, 3.0}, 1, 1, 2);
+      const double r = rng.uniform(1.5, 2.5);
+      mb.add_box({px - r, py - r, 3.0}, {px + r, py + r, 3.0 + 2 * r}, 2, 2, 2);
+    }
+  }
+  scene.source = "generated town (size " + std::to_string(size) + ", seed " + std::to_string(seed) + ")";
+  return scene;
+}
+
 }  // namespace
 
 Scene generate_scene(const GeneratorConfig& config) {
@@ -323,6 +454,7 @@ Scene generate_scene(const GeneratorConfig& config) {
     case GeneratorKind::kOffice:
     case GeneratorKind::kRotatedOffice: scene = generate_office(config.seed, config.size); break;
     case GeneratorKind::kCity: scene = generate_city(config.seed, config.size); break;
+    case GeneratorKind::kTown: scene = generate_town(config.seed, config.size); break;
   }
   scene.grouping = ObjectGrouping::kGroups;
   scene.finalize();

@@ -14,9 +14,12 @@ enum class GeneratorKind {
   kOffice,         ///< multi-storey interior: rooms along corridors, doors, stairwell, furniture
   kCity,           ///< street grid, buildings of strongly varying heights, street furniture
   kRotatedOffice,  ///< the office rotated 30 degrees about the vertical axis
+  /// A city that is not a grid: districts (Voronoi cells) with streets at their own angles and
+  /// blocks of their own sizes, taller in the middle, open squares with trees, landmark towers
+  kTown,
 };
 
-/// Parses "office", "city", "rotated-office"; throws Error otherwise.
+/// Parses "office", "city", "rotated-office", "town"; throws Error otherwise.
 GeneratorKind parse_generator_kind(const std::string& name);
 const char* to_string(GeneratorKind kind);
 
@@ -25,7 +28,8 @@ struct GeneratorConfig {
   uint64_t seed = 1;
   /// Scale, >= 1. Office: 1 + size rooms per corridor side, 1 + (size-1)/3 floors (size 1 is
   /// about a thousand triangles). City: size x size blocks (size 20 is about a million
-  /// triangles and ten thousand objects).
+  /// triangles and ten thousand objects). Town: about size x size city blocks' area (size 23
+  /// is over a million triangles).
   int size = 1;
 };
 
