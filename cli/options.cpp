@@ -286,7 +286,8 @@ pipeline::CutRule CutOptions::rule() const {
 void add_cut_options(CLI::App* app, CutOptions& a) {
   app->add_option("--count", a.count, "Exactly this many view cells")->check(whole(1, kMaxCells));
   app->add_option("--memory", a.memory,
-                  "The most view cells whose approximate PVS storage fits this budget (bytes; K, M, G allowed)");
+                  "The most view cells whose .pvs file, as compress writes it (point location, hierarchy and "
+                  "compressed PVSs), fits this budget, measured (bytes; K, M, G allowed)");
   app->add_option("--cost-ratio", a.cost_ratio,
                   "The fewest view cells whose render cost is within this ratio (>= 1) of the elementary cells'");
 }

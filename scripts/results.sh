@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The method comparison of the paper's section 6.3 on the generated office, rotated office and
-# city at full size: every method built from the same construction samples and scored on
+# The method comparison of the paper's section 6.3 on the generated office, rotated office,
+# city (a street grid) and town (not a grid) at full size: every method built from the same construction samples and scored on
 # independent evaluation samples (4x as many, another seed). Writes docs/results.md and the
 # plots in docs/results/. Usage: scripts/results.sh [CELLS] [SAMPLES] [CITY_SIZE]
 set -euo pipefail
@@ -11,14 +11,16 @@ source "$(dirname "$0")/bench-setup.sh"
 office=$(bench_scene office 4)
 rotated=$(bench_scene rotated-office 4)
 city=$(bench_scene city "$size")
+town=$(bench_scene town "$size")
 mkdir -p docs/results
 # RESULTS_REUSE=1 keeps comparisons already in out/bench (to redo only the tables).
-for name in office rotated-office city; do
+for name in office rotated-office city town; do
   if [ "${RESULTS_REUSE:-0}" = 1 ] && [ -f "$dir/compare-$name/summary.json" ]; then continue; fi
   case "$name" in
     office) scene="$office" ;;
     rotated-office) scene="$rotated" ;;
     city) scene="$city" ;;
+    town) scene="$town" ;;
   esac
   "$vc" compare "$scene" --samples "$samples" --seed 1 --max-cells "$cells" -o "$dir/compare-$name" -q
   bash scripts/plot-compare.sh "$dir/compare-$name" "$name" >/dev/null

@@ -148,6 +148,16 @@ expect_ok "$VC" extract office.vcells --memory 1K -o mem.json -q
 python3 -c "
 import json; r=json.load(open('mem.json')); assert r['approximate_pvs_bytes'] <= 1024, r['approximate_pvs_bytes']
 " && ok || bad "extract --memory"
+# --memory holds for the .pvs file compress writes, measured, and is the most cells that do.
+expect_ok "$VC" extract office.vcells --memory 1800 -o mem3.json -q
+expect_ok "$VC" compress office.vcells --memory 1800 -o mem3.pvs --report mem3c.json -q
+n=$(json_get mem3.json "['cells']")
+[ "$(json_get mem3c.json "['cells']")" = "$n" ] && [ "$(stat -c %s mem3.pvs)" -le 1800 ] && ok \
+  || bad "compress --memory 1800: $(stat -c %s mem3.pvs) bytes for $(json_get mem3c.json "['cells']") cells (extract: $n)"
+if [ "$n" -lt 64 ]; then
+  expect_ok "$VC" compress office.vcells --count $((n + 1)) -o mem3more.pvs -q
+  [ "$(stat -c %s mem3more.pvs)" -gt 1800 ] && ok || bad "compress --memory 1800 left out a cell that fits"
+fi
 expect_ok "$VC" extract office.vcells --cost-ratio 1.5 -o ratio.json -q
 python3 -c "
 import json; r=json.load(open('ratio.json')); assert r['cost_ratio'] <= 1.5
@@ -409,7 +419,7 @@ for budget in 3000 6K 20000; do
   [ "$bytes" -le "$limit" ] && ok || bad "bake --memory $budget wrote $bytes bytes"
 done
 cp bake1.pvs keep.pvs
-expect_error "not even 1 view cell" "$VC" bake office.obj --memory 50 --samples 20000 --max-cells 300 --agvs-samples 50000 \
+expect_error "too small" "$VC" bake office.obj --memory 50 --samples 20000 --max-cells 300 --agvs-samples 50000 \
   -o keep.pvs -q
 cmp -s bake1.pvs keep.pvs && ok || bad "a failing bake replaced its output"
 expect_error "needs a budget" "$VC" bake office.obj -o x.pvs

@@ -126,12 +126,11 @@ void write_text_file(const std::string& path, const std::string& text) {
   install_file(tmp, path);
 }
 
-void write_container(const std::string& path, const char (&magic)[5], uint32_t version,
-                     const std::string& payload) {
+std::string container_image(const char (&magic)[5], uint32_t version, const std::string& payload) {
   std::string compressed(ZSTD_compressBound(payload.size()), '\0');
   const size_t csize = ZSTD_compress(compressed.data(), compressed.size(), payload.data(),
                                      payload.size(), /*level=*/1);
-  if (ZSTD_isError(csize)) throw Error(path, 0, std::string("zstd: ") + ZSTD_getErrorName(csize));
+  if (ZSTD_isError(csize)) throw Error(std::string("zstd: ") + ZSTD_getErrorName(csize));
   compressed.resize(csize);
   ByteWriter header;
   header.put<uint32_t>(0);  // placeholder replaced by the magic below
@@ -144,6 +143,17 @@ void write_container(const std::string& path, const char (&magic)[5], uint32_t v
   std::string file = header.data();
   std::memcpy(file.data(), magic, 4);
   file += compressed;
+  return file;
+}
+
+void write_container(const std::string& path, const char (&magic)[5], uint32_t version,
+                     const std::string& payload) {
+  std::string file;
+  try {
+    file = container_image(magic, version, payload);
+  } catch (const Error& e) {
+    throw Error(path, 0, e.what());
+  }
   write_text_file(path, file);
 }
 

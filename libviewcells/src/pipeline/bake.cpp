@@ -152,34 +152,16 @@ std::vector<std::vector<uint32_t>> coarsen(const MergeHistory& h, const std::vec
 
 namespace {
 
-/// Writes the .pvs of the view cells `set`: with the PVSs `lists`, or without them the
-/// construction samples' (what pvs_file_for puts there). Only a file that is kept is read back
-/// and compared (`check`); the sizes a search tries are just measured. Returns its bytes.
+/// The .pvs of the view cells `set` with the PVSs `lists`: written, read back and compared
+/// (`check`), or only measured (the sizes a search tries). Returns its bytes.
 uint64_t write_cut(const std::string& path, const SubdivisionFile& file, const ViewCellSet& set,
                    const std::vector<std::vector<uint32_t>>* lists, bool check) {
   PvsFile pf = pvs_file_for(file, set);
   pf.rule += "; PVS by agvs";
   if (lists) pf.pvs = compress_pvs(*file.history, set.cells, *lists);
-  if (check) write_pvs_checked(path, pf, *lists);
-  else write_pvs(path, pf);
+  if (!check) return pvs_file_bytes(pf);
+  write_pvs_checked(path, pf, *lists);
   return std::filesystem::file_size(staged_path(path));
-}
-
-/// The most view cells, from lo to hi, whose file of `bytes_of(count)` bytes fits in `memory`
-/// (a bisection: the file grows with the cells, each size measured); 0 when none does.
-size_t largest_fitting(size_t lo, size_t hi, uint64_t memory, const std::function<uint64_t(size_t)>& bytes_of) {
-  size_t best = 0;
-  while (lo <= hi) {
-    const size_t mid = lo + (hi - lo) / 2;
-    if (bytes_of(mid) <= memory) {
-      best = mid;
-      lo = mid + 1;
-    } else {
-      if (mid == 0) break;
-      hi = mid - 1;
-    }
-  }
-  return best;
 }
 
 /// The view cells to sample: the count asked for, or under a memory budget the most cells
@@ -188,16 +170,16 @@ size_t largest_fitting(size_t lo, size_t hi, uint64_t memory, const std::functio
 ViewCellSet first_cut(const BakeConfig& c, const SubdivisionFile& file, const Log& log) {
   const MergeHistory& h = *file.history;
   if (c.cells) return extract_by_count(h, std::min<size_t>(c.cells, h.leaf_count));
-  const size_t n = largest_fitting(h.min_cells(), h.leaf_count, c.memory, [&](size_t count) {
-    const ViewCellSet cut = extract_by_count(h, count);
-    return write_cut(c.output, file, cut, nullptr, false);
-  });
-  if (n == 0)
-    throw Error(c.output, 0, "not even " + std::to_string(h.min_cells()) + " view cell(s) fit in " +
-                                 std::to_string(c.memory) + " bytes");
+  ViewCellSet set;
+  try {
+    set = extract_by_file_size(file, c.memory);
+  } catch (const Error& e) {
+    throw Error(c.output, 0, e.what());
+  }
+  const size_t n = set.cells.size();
   log("viewcells: bake: " + std::to_string(n) + " view cells fit in " + std::to_string(c.memory) +
-      " bytes with the construction samples' PVSs");
-  return extract_by_count(h, n);
+      " bytes with the hierarchy's PVSs");
+  return set;
 }
 
 }  // namespace

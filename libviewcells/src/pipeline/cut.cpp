@@ -11,14 +11,47 @@
 
 namespace viewcells::pipeline {
 
-ViewCellSet choose_cells(const MergeHistory& h, const CutRule& rule, bool fallback_all) {
+ViewCellSet choose_cells(const SubdivisionFile& file, const CutRule& rule, bool fallback_all) {
+  const MergeHistory& h = *file.history;
   const int rules = (rule.count > 0) + rule.memory_given + (rule.cost_ratio != 0);
   if (rules > 1) throw Error("give only one of --count, --memory and --cost-ratio");
   if (rule.count > 0) return extract_by_count(h, rule.count);
-  if (rule.memory_given) return extract_by_memory(h, rule.memory);
+  if (rule.memory_given) return extract_by_file_size(file, rule.memory);
   if (rule.cost_ratio != 0) return extract_by_cost_ratio(h, rule.cost_ratio);
   if (!fallback_all) throw Error("say which cells: --count N, --memory BYTES or --cost-ratio R");
   return extract_by_count(h, h.leaf_count);
+}
+
+size_t largest_fitting(size_t lo, size_t hi, uint64_t memory, const std::function<uint64_t(size_t)>& bytes_of) {
+  size_t best = 0;
+  while (lo <= hi) {
+    const size_t mid = lo + (hi - lo) / 2;
+    if (bytes_of(mid) <= memory) {
+      best = mid;
+      lo = mid + 1;
+    } else {
+      if (mid == 0) break;
+      hi = mid - 1;
+    }
+  }
+  return best;
+}
+
+ViewCellSet extract_by_file_size(const SubdivisionFile& file, uint64_t bytes) {
+  const MergeHistory& h = *file.history;
+  const std::string rule = "most cells whose .pvs file fits in " + std::to_string(bytes) + " bytes";
+  auto cut = [&](size_t count) {
+    ViewCellSet set = extract_by_count(h, count);
+    set.rule = rule;  // the rule is in the file: measure it as written
+    return set;
+  };
+  auto bytes_of = [&](size_t count) { return pvs_file_bytes(pvs_file_for(file, cut(count))); };
+  const size_t n = largest_fitting(h.min_cells(), h.leaf_count, bytes, bytes_of);
+  if (n == 0)
+    throw Error("a budget of " + std::to_string(bytes) + " bytes is too small: the .pvs file of the coarsest " +
+                std::to_string(h.min_cells()) + " view cell(s) takes " + std::to_string(bytes_of(h.min_cells())) +
+                " bytes");
+  return cut(n);
 }
 
 SubdivisionFile read_merged(const std::string& path) {
@@ -49,7 +82,7 @@ ExtractResult extract(const ExtractConfig& config, const Log& log) {
   out.input = config.hierarchy_path;
   out.file = read_merged(config.hierarchy_path);
   const MergeHistory& h = *out.file.history;
-  out.set = choose_cells(h, config.cut, false);
+  out.set = choose_cells(out.file, config.cut, false);
   log("viewcells: " + std::to_string(out.set.cells.size()) + " view cells (" + out.set.rule + "), render cost " +
       fmt(out.set.cost, 1) + " (elementary cells: " + fmt(h.initial_cost, 1) + "), approximate PVS " +
       std::to_string(out.set.pvs_bytes) + " bytes");
@@ -66,7 +99,7 @@ ExtractResult extract(const ExtractConfig& config, const Log& log) {
 
 CompressResult compress(const CompressConfig& config, const Log& log) {
   const SubdivisionFile file = read_merged(config.hierarchy_path);
-  const ViewCellSet set = choose_cells(*file.history, config.cut, true);
+  const ViewCellSet set = choose_cells(file, config.cut, true);
   CompressResult out;
   out.input = config.hierarchy_path;
   out.output = config.output;

@@ -132,7 +132,7 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   const MergeHistory& h = *file.history;
   CutRule cut;
   cut.count = c.cells;
-  const ViewCellSet set = choose_cells(h, cut, true);
+  const ViewCellSet set = choose_cells(file, cut, true);
   Stopwatch sw;
   Scenes scenes;
   load_scenes(c, file, scenes);

@@ -242,7 +242,9 @@ PvsFile make_pvs_file(const Subdivision& s, const std::vector<std::vector<uint32
   return f;
 }
 
-void write_pvs(const std::string& path, const PvsFile& f) {
+namespace {
+
+std::string pvs_payload(const PvsFile& f) {
   ByteWriter w;
   w.put<uint64_t>(f.scene_fingerprint);
   w.put<uint32_t>(f.object_count);
@@ -268,8 +270,14 @@ void write_pvs(const std::string& path, const PvsFile& f) {
   std::string lists;
   for (const auto& l : f.pvs.stored) lists += encode_list(l);
   w.put_string(lists);
-  write_container(path, kMagic, kVersion, w.data());
+  return w.data();
 }
+
+}  // namespace
+
+void write_pvs(const std::string& path, const PvsFile& f) { write_container(path, kMagic, kVersion, pvs_payload(f)); }
+
+uint64_t pvs_file_bytes(const PvsFile& f) { return container_image(kMagic, kVersion, pvs_payload(f)).size(); }
 
 PvsFile read_pvs(const std::string& path) {
   uint32_t version = 0;

@@ -100,6 +100,8 @@ class ByteReader {
 /// format version and the Embree ISA this process casts with (embree_isa()).
 void write_container(const std::string& path, const char (&magic)[5], uint32_t version,
                      const std::string& payload);
+/// The bytes write_container would write (for measuring a file without writing it).
+std::string container_image(const char (&magic)[5], uint32_t version, const std::string& payload);
 /// Reads and verifies a container; returns the payload and sets `version` (and `isa`, the
 /// Embree ISA of the process that wrote it, when given). Throws Error for a missing or
 /// non-regular file, wrong magic, a version above max_version, or corruption.

@@ -2,6 +2,7 @@
 /// Cutting view cells from a merge history: `viewcells extract` (the cells, as JSON and
 /// pictures) and `viewcells compress` (their PVSs, compressed through the hierarchy, as .pvs).
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -16,13 +17,21 @@ namespace viewcells::pipeline {
 struct CutRule {
   uint32_t count = 0;        ///< exactly this many
   bool memory_given = false;
-  uint64_t memory = 0;       ///< the most cells whose approximate PVS storage fits
+  uint64_t memory = 0;       ///< the most cells whose .pvs file (as compress writes it) fits
   double cost_ratio = 0;     ///< the fewest cells within this ratio of the elementary cells' cost
 };
 
 /// The view cells `rule` asks for; `fallback_all` takes every elementary cell when no rule is
 /// given, else a rule is required (Error).
-ViewCellSet choose_cells(const MergeHistory& h, const CutRule& rule, bool fallback_all);
+ViewCellSet choose_cells(const SubdivisionFile& file, const CutRule& rule, bool fallback_all);
+
+/// The most view cells, from lo to hi, whose file of `bytes_of(count)` bytes fits in `memory`
+/// (a bisection: the file grows with the cells, each size measured); 0 when none does.
+size_t largest_fitting(size_t lo, size_t hi, uint64_t memory, const std::function<uint64_t(size_t)>& bytes_of);
+/// The most view cells of the history whose .pvs file, with the hierarchy's own PVSs (what
+/// compress writes: point location, hierarchy and compressed lists), is at most `bytes`
+/// long, measured. Error naming the smallest file when not even the coarsest cut fits.
+ViewCellSet extract_by_file_size(const SubdivisionFile& file, uint64_t bytes);
 
 /// Reads a hierarchy file that holds a merge history (Error naming the file otherwise).
 SubdivisionFile read_merged(const std::string& path);

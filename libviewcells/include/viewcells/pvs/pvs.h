@@ -66,6 +66,8 @@ PvsFile make_pvs_file(const Subdivision& s, const std::vector<std::vector<uint32
 
 /// Writes a versioned, checksummed `.pvs` file (atomically).
 void write_pvs(const std::string& path, const PvsFile& f);
+/// The size in bytes of the file write_pvs writes for `f`, measured without writing it.
+uint64_t pvs_file_bytes(const PvsFile& f);
 /// Reads and validates a `.pvs` file; any inconsistency is an Error naming the file.
 PvsFile read_pvs(const std::string& path);
 
