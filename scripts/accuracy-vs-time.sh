@@ -51,6 +51,12 @@ done
   build-release/bench/viewcells_leaks "$small_city" "$city" 50000 4000000 "$out/leaks.json" >/dev/null
 
 python3 scripts/vctables.py accuracy "$out" "$cells" "$size" > docs/accuracy-vs-time.md
+# Section 5 is scripts/merge-vs-time.sh's; keep what it last wrote.
+printf '\n## 5. Merging: what the validated merge costs and gains\n\n<!-- merge:begin -->\nNot generated yet: run scripts/merge-vs-time.sh.\n<!-- merge:end -->\n' >> docs/accuracy-vs-time.md
+if [ -f docs/accuracy/merge.md ] && [ -f docs/accuracy/merge.command ]; then
+  python3 scripts/vctables.py replace-section docs/accuracy-vs-time.md merge "$(cat docs/accuracy/merge.command)" \
+    docs/accuracy/merge.md
+fi
 
 # Plots: evaluated cost against cells per construction sample count; AA / AA+GA ratio.
 for scene in office city; do

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Our view cells against q3map2's on every OpenArena map that carries visibility data: for
-# each map, `viewcells compare MAP --methods av-m,q3-clusters` (AV-S to 3x the map's clusters,
+# each map, `viewcells compare MAP --methods av-m,av-s,q3-clusters` (AV-S to 3x the map's clusters,
 # merged; q3map2's clusters scored on the same evaluation samples over the map's non-solid
 # space). Writes docs/results/q3-maps.md, docs/results/q3-maps.csv and the section "Quake 3
 # maps" of docs/results.md.
@@ -29,7 +29,7 @@ for map in "${maps[@]}"; do
   fi
   start=$(date +%s.%N)
   if "$vc" compare "$map" --samples "$samples" --eval-samples "$eval_samples" --seed 1 \
-      --methods av-m,q3-clusters -o "$out/$name" -q 2> "$out/$name.err"; then
+      --methods av-m,av-s,q3-clusters -o "$out/$name" -q 2> "$out/$name.err"; then
     python3 scripts/vctables.py elapsed "$start" > "$out/$name/wall_seconds"
     echo "maps: [$i/${#maps[@]}] $name: $clusters clusters, $(cat "$out/$name/wall_seconds") s"
   else
