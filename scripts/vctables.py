@@ -573,6 +573,13 @@ def maps(*args):
             build_s=q["build_seconds"],
             sampling_s=t["construction_sampling_seconds"] + t["evaluation_sampling_seconds"],
             wall_s=float(open(f"{out}/{name}/wall_seconds").read())))
+        cv = {}
+        for r in csv.DictReader(open(f"{out}/{name}/curves.csv")):
+            cv.setdefault(r["method"], {})[int(r["cells"])] = float(r["cost"])
+        n = q["clusters"]
+        for key, count in (("avm_avs_clusters", n), ("avm_avs_quarter", max(1, n // 4))):
+            a, b = cv.get("av-m", {}).get(count), cv.get("av-s", {}).get(count)
+            rows[-1][key] = a / b if a is not None and b else None
 
     CAUSES = ("crack", "invisible", "void", "unlisted", "far", "rejected")
 
@@ -597,14 +604,15 @@ def maps(*args):
     lines.append("| map | triangles | clusters | q3map2 cost | AV-M cost at clusters | AV-M / q3map2 | AV-M cells to match q3map2 "
                  "| PVS ours / q3map2 | seen but excluded (crack / invisible / void / unlisted / far / rejected) "
                  "| q3map2 rows (B) | ours compressed (B) "
-                 "| build (s) |")
-    lines.append("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+                 "| build (s) | AV-M / AV-S at clusters | at clusters / 4 |")
+    lines.append("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     for r in rows:
         c = r["causes"]
         lines.append(f"| {r['map']} | {r['triangles']:,} | {r['clusters']:,} | {num(r['q3_cost'])} | {num(r['avm_cost'])} | "
                      f"{num(r['ratio'], 3)} | {num(r['cells_to_match'])} | {r['pvs_ratio']:.3f} | "
                      f"{r['excluded']:,} ({' / '.join(f'{c.get(k, 0):,}' for k in CAUSES)}) | "
-                     f"{r['q3_bytes']:,} | {r['ours_bytes']:,} | {r['build_s']:.1f} |")
+                     f"{r['q3_bytes']:,} | {r['ours_bytes']:,} | {r['build_s']:.1f} | "
+                     f"{num(r['avm_avs_clusters'], 3)} | {num(r['avm_avs_quarter'], 3)} |")
     lines.append("")
     ratios = [r["ratio"] for r in rows if r["ratio"] is not None]
     lower = [x for x in ratios if x < 1]
@@ -614,6 +622,12 @@ def maps(*args):
                      + f": AV-M / q3map2 median {statistics.median(ratios):.3f}, range {min(ratios):.3f} to {max(ratios):.3f}. "
                      f"Fewest AV-M cells that match q3map2's cost, as a share of its clusters: median "
                      f"{statistics.median([r['cells_to_match'] / r['clusters'] for r in rows if r['cells_to_match']]):.3f}.\n")
+    for key, what in (("avm_avs_clusters", "at q3map2's cluster count"), ("avm_avs_quarter", "at a quarter of it")):
+        vals = [r[key] for r in rows if r.get(key) is not None]
+        if vals:
+            lines.append(f"AV-M / AV-S {what}: at most 1 on {sum(v <= 1 for v in vals)} of {len(vals)} maps, at most "
+                         f"1.02 on {sum(v <= 1.02 for v in vals)}; median {statistics.median(vals):.3f}, worst "
+                         f"{max(vals):.3f} ({max((r for r in rows if r.get(key) is not None), key=lambda r: r[key])['map']}).\n")
     tot = {k: sum(r["causes"].get(k, 0) for r in rows) for k in CAUSES}
     worst = lambda k: ", ".join(f"{r['map']} {r['causes'][k]:,}" for r in sorted(rows, key=lambda r: -r["causes"].get(k, 0))[:3]
                                 if r["causes"].get(k, 0))

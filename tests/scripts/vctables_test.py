@@ -216,6 +216,8 @@ class Tables(unittest.TestCase):
         t = run("results", self.d, 1000, 1000, 23)
         self.assertEqual(row(t, "KD-CASM")[-1], "1.200")  # kd-casm / av-m at 1,000 cells
         self.assertIn("17% below at 1,000 cells", t)        # 1 - 50 / 60
+        # The worst ratios from 16 cells up: AV-M / AV-S is 1 / 1.1 everywhere, AV-M / KD-CASM 1 / 1.2.
+        self.assertIn("| office (size 4, two storeys) | 0.909 at 100 | - | 0.833 at 100 |", t)
 
     def test_accuracy_plot_data(self):
         for n in [50000, 200000, 1000000, 2000000]:
@@ -234,8 +236,9 @@ class Tables(unittest.TestCase):
               "storage_bytes": {"q3map2_rows": 1000, "q3map2_leaf_surface_lists": 50, "ours_compressed": 250,
                                 "ours_rle_rows": 400}, "build_seconds": 2.0}
         out = f"{self.d}/maps"
-        for name in ["m1", "m2"]:
-            self.compare_run(f"maps/{name}", ["av-m"], {"av-m": {10: 150.0}}, q3)
+        for name, avs in [("m1", 150.0), ("m2", 140.0)]:
+            self.compare_run(f"maps/{name}", ["av-m", "av-s"], {"av-m": {2: 300.0, 10: 150.0},
+                                                                 "av-s": {2: 310.0, 10: avs}}, q3)
             dump(f"{out}/{name}.info.json", {"quake3": {"surfaces": {"non_occluding": 1}}})
             open(f"{out}/{name}/wall_seconds", "w").write("4.0")
         dump(f"{out}/m3.info.json", {"quake3": {"surfaces": {"non_occluding": 0}}})
@@ -251,6 +254,10 @@ class Tables(unittest.TestCase):
         self.assertIn("(2 maps; 1 without vis data skipped)", md)
         self.assertIn("lower than q3map2's on 2 of 2 maps**: AV-M / q3map2 median 0.750", md)
         self.assertIn("500 B (0.25 x the rows", md)  # 500 / 2000 B over both maps
+        # AV-M / AV-S at the 10 clusters: 1.000 (m1) and 150 / 140 (m2); at a quarter (2 cells) 300 / 310.
+        self.assertIn("AV-M / AV-S at q3map2's cluster count: at most 1 on 1 of 2 maps, at most 1.02 on 1; "
+                      "median 1.036, worst 1.071 (m2)", md)
+        self.assertIn("AV-M / AV-S at a quarter of it: at most 1 on 2 of 2 maps", md)
 
     def test_runtime_table(self):
         bench = {"context": {"num_cpus": 2, "mhz_per_cpu": 2450, "library_version": "v1.7.1"},

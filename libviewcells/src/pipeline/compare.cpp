@@ -67,6 +67,10 @@ void write_curves(const CompareRunResult& r, const std::string& path) {
   for (const MethodResult& m : cmp.methods) {
     std::vector<uint32_t> at = counts;
     for (const MethodResult& other : cmp.methods) at.push_back(other.evaluated.cells.back());
+    if (r.q3) {  // q3map2's cluster count and a quarter of it, where maps are compared
+      at.push_back(r.q3->cluster_count);
+      at.push_back(std::max<uint32_t>(1, r.q3->cluster_count / 4));
+    }
     std::sort(at.begin(), at.end());
     at.erase(std::unique(at.begin(), at.end()), at.end());
     for (uint32_t n : at) {
