@@ -321,6 +321,35 @@ TEST(Sampler, SeeThroughObjectsAreSeenButStopNoRay) {
             r.stats.samples + r.stats.two_sided_samples);
 }
 
+/// A see-through surface on a wall (water against a wall, a decal): segments end on the wall
+/// within a hair of the crossing, and the search for further crossings must stop at the
+/// segment's end instead of asking the caster for an empty interval (found on a real map).
+TEST(Sampler, SeeThroughSurfaceOnAWallEndsTheCrossingSearch) {
+  RawMesh mesh;
+  auto quad = [&](double x, uint32_t group, bool facing_plus_x) {
+    const uint32_t b = static_cast<uint32_t>(mesh.vertices.size());
+    mesh.vertices.insert(mesh.vertices.end(), {{x, 0, 0}, {x, 10, 0}, {x, 10, 10}, {x, 0, 10}});
+    for (auto t : {std::array<uint32_t, 3>{b, b + 1, b + 2}, std::array<uint32_t, 3>{b, b + 2, b + 3}}) {
+      if (!facing_plus_x) std::swap(t[1], t[2]);
+      mesh.triangles.push_back(t);
+      mesh.triangle_group.push_back(group);
+    }
+  };
+  quad(0, 0, true);
+  quad(10, 1, false);
+  for (double gap : {0.0, 1e-9, 1e-7, 5e-7}) quad(10 - gap, 2, false);  // the decal, on and just off the wall
+  mesh.group_names = {"left", "right", "decal"};
+  mesh.group_occluder = {1, 1, 0};
+  const Scene scene = make_scene(mesh, ObjectGrouping::kGroups, "decal");
+  const auto caster = make_embree_caster(scene);
+  SamplerConfig config;
+  config.samples = 20000;
+  config.show_progress = false;
+  const SamplingResult r = sample_segments(scene, *caster, config);
+  EXPECT_GT(r.stats.see_through_segments, 1000u) << "the decal is seen";
+  for (size_t i = 0; i < r.segments.size(); ++i) ASSERT_TRUE(std::isfinite(r.segments.bx[i]));
+}
+
 TEST(Sampler, DirectionsAreUniformOnTheSphere) {
   const Scene scene = test::cube_grid(2);
   const auto caster = make_embree_caster(scene);

@@ -226,6 +226,7 @@ class BatchSampler {
         if (!h.hit()) break;
         if (std::find(crossed_.begin(), crossed_.end(), h.object) == crossed_.end()) crossed_.push_back(h.object);
         t0 = h.t + 1e-7;  // t in units of the segment: past this crossing
+        if (!(t0 < 1.0)) break;  // a crossing at the far end: nothing left of the segment
       }
       for (uint32_t o : crossed_) {
         if (out.valid >= segs_->size()) segs_->resize(2 * segs_->size() + 16);
