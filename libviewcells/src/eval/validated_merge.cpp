@@ -6,7 +6,10 @@
 #include <chrono>
 #include <cmath>
 
+#include <tbb/parallel_for.h>
+
 #include "viewcells/core/error.h"
+#include "viewcells/core/progress.h"
 #include "viewcells/eval/evaluate.h"
 
 namespace viewcells {
@@ -62,14 +65,27 @@ ValidatedMerge merge_validated(const Scene& scene, const RayCaster& caster, cons
   out.chosen = {1, 0, 0.0, 0.0};
   out.starts.push_back(out.chosen);
   mc.show_progress = false;
-  MergeHistory best = av_s;
-  auto consider = [&](size_t start, size_t barrier) {
-    mc.prefix = subdivision_prefix(s, start);
-    mc.barrier_cells = static_cast<uint32_t>(barrier);
-    mc.block = barrier ? subdivision_blocks(s, barrier) : std::vector<int32_t>{};
-    MergeHistory h = merge_cells(scene, partition, model, mc);
+  // Every candidate start, scored in parallel (each is independent; the choice below is made
+  // in a fixed order, so it does not depend on the thread count).
+  std::vector<MergeStart> candidates;
+  for (size_t start = L; start >= 2; start /= 2) {
+    candidates.push_back({static_cast<uint32_t>(start), 0, 0.0, 0.0});
+    for (size_t barrier = start / 4; barrier >= 4; barrier /= 4)
+      candidates.push_back({static_cast<uint32_t>(start), static_cast<uint32_t>(barrier), 0.0, 0.0});
+  }
+  auto config_for = [&](const MergeStart& st) {
+    MergeConfig c = mc;
+    c.prefix = subdivision_prefix(s, st.cells);
+    c.barrier_cells = st.barrier;
+    c.block = st.barrier ? subdivision_blocks(s, st.barrier) : std::vector<int32_t>{};
+    return c;
+  };
+  Progress progress("choosing where merging starts", candidates.size());
+  tbb::parallel_for(size_t{0}, candidates.size(), [&](size_t i) {
+    MergeStart& st = candidates[i];
+    const MergeHistory h = merge_cells(scene, partition, model, config_for(st));
     const CostCurve held_out = evaluate_merge_history(scene, s, h, b.pvs, model);
-    MergeStart st{static_cast<uint32_t>(start), static_cast<uint32_t>(barrier), 0.0, -1e300};
+    st.worst = -1e300;
     size_t terms = 0;
     for (size_t n : counts)
       if (n >= h.min_cells() && n >= av_s.min_cells()) {
@@ -80,18 +96,16 @@ ValidatedMerge merge_validated(const Scene& scene, const RayCaster& caster, cons
       }
     st.score = terms ? st.score / static_cast<double>(terms) : 0.0;
     if (!terms) st.worst = 0;
+    if (config.merge.show_progress) progress.advance(1);
+  });
+  if (config.merge.show_progress) progress.finish();
+  // The lowest mean among the starts whose worst count stays within the allowance; ties keep
+  // the earlier (AV-S's order first).
+  for (const MergeStart& st : candidates) {
     out.starts.push_back(st);
-    // The lowest mean among the starts whose worst count stays within the allowance; ties keep
-    // the earlier (AV-S's order first).
-    if (st.worst <= config.worst_allowed && st.score < out.chosen.score) {
-      out.chosen = st;
-      best = std::move(h);
-    }
-  };
-  for (size_t start = L; start >= 2; start /= 2) {
-    consider(start, 0);
-    for (size_t barrier = start / 4; barrier >= 4; barrier /= 4) consider(start, barrier);
+    if (st.worst <= config.worst_allowed && st.score < out.chosen.score) out.chosen = st;
   }
+  const MergeHistory best = out.chosen.cells == 1 ? av_s : merge_cells(scene, partition, model, config_for(out.chosen));
   out.select_seconds = seconds_since(t);
 
   // The chosen merges, replayed with every sample's PVSs.
