@@ -2,7 +2,9 @@
 # Merging and PVS compression benchmark (issue: merge history, extraction, compression).
 # The generated city (>= 1M triangles): 1.5M segments, 50k AV-S cells, merged to one; and the
 # compression ratios of the sampled PVSs on the office and the city at several view cell
-# counts. Rewrites the merging section of BENCHMARKS.md.
+# counts. The city is merged twice: validated by two AGVS runs over the leaves (the default)
+# and greedy on the construction samples' PVSs (--merge-pvs samples). Times include the leaf
+# PVSs and the neighbour graph. Rewrites the merging section of BENCHMARKS.md.
 # Usage: scripts/bench-merge.sh [CITY_SIZE] [CELLS]
 set -euo pipefail
 size="${1:-23}"
@@ -12,6 +14,8 @@ city=$(bench_scene city "$size")
 office=$(bench_scene office 4)
 "$vc" build "$city" --segments 1500000 --max-cells "$cells" --min-reduction 0 --seed 1 -q \
   -o "$dir/city-merge.vcells" --report "$dir/merge-city.json"
+"$vc" build "$city" --segments 1500000 --max-cells "$cells" --min-reduction 0 --seed 1 -q --merge-pvs samples \
+  -o "$dir/city-merge-samples.vcells" --report "$dir/merge-city-samples.json"
 "$vc" build "$office" --samples 1000000 --max-cells 2000 --seed 1 -q \
   -o "$dir/office-merge.vcells" --report "$dir/merge-office.json"
 for n in "$cells" 5000 500 50; do

@@ -14,15 +14,20 @@ city=$(bench_scene city "$size")
 town=$(bench_scene town "$size")
 mkdir -p docs/results
 # RESULTS_REUSE=1 keeps comparisons already in out/bench (to redo only the tables).
-for name in office rotated-office city town; do
+# The town twice: its whole bounding box (mostly sky, where every cell sees much of the town) and
+# its streets at eye level (z from 0.5 to 4 m; viewpoints inside buildings are empty space).
+ext=$((size * 76 + 16))
+for name in office rotated-office city town town-street; do
   if [ "${RESULTS_REUSE:-0}" = 1 ] && [ -f "$dir/compare-$name/summary.json" ]; then continue; fi
   case "$name" in
     office) scene="$office" ;;
     rotated-office) scene="$rotated" ;;
     city) scene="$city" ;;
-    town) scene="$town" ;;
+    town | town-street) scene="$town" ;;
   esac
-  "$vc" compare "$scene" --samples "$samples" --seed 1 --max-cells "$cells" -o "$dir/compare-$name" -q
+  box=()
+  [ "$name" = town-street ] && box=(--view-box "0,0,0.5,$ext,$ext,4")
+  "$vc" compare "$scene" --samples "$samples" --seed 1 --max-cells "$cells" "${box[@]}" -o "$dir/compare-$name" -q
   bash scripts/plot-compare.sh "$dir/compare-$name" "$name" >/dev/null
   for plot in cost ratio histogram; do cp "$dir/compare-$name/$plot.png" "docs/results/$name-$plot.png"; done
   cp "$dir/compare-$name/curves.csv" "docs/results/$name-curves.csv"

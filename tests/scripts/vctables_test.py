@@ -155,7 +155,8 @@ class Tables(unittest.TestCase):
                 "merge": {"cells_from": n, "pair_costs_evaluated": 5, "stale_entries_skipped": 2,
                           "cost_at_power_of_two_cells": [{"cells": 1, "cost": 400.0}, {"cells": 2, "cost": 300.0},
                                                          {"cells": 4, "cost": 200.0}, {"cells": 8, "cost": 100.0}]},
-                "timings": {"subdivision_seconds": 2.0, "merge_seconds": 0.5}})
+                "timings": {"subdivision_seconds": 2.0, "merge_seconds": 0.5, "leaf_pvs_seconds": 1.5,
+                            "neighbour_graph_seconds": 0.25}})
         for name, counts in [("city", [8, 5000, 500, 50]), ("office", [2000, 200, 20])]:
             for c in counts:
                 dump(f"{self.d}/compress-{name}-{c}.json", {
@@ -163,7 +164,8 @@ class Tables(unittest.TestCase):
                     "varint_bytes_before": 150, "varint_bytes_after": 60, "file_bytes": 500,
                     "flat": {"bit_row_bytes": 20, "run_length_bytes": 15}})
         t = run("merging", self.d, 23, 8)
-        self.assertIn("| city | 8 | 2.0 | 0.50 | 5 | 2 | 100 | 400 (1) | 400 (1) |", t)  # 8 / 10 is nearest 1
+        # 8 / 10 is nearest 1
+        self.assertIn("| city | construction samples | 8 | 2.0 | 1.5 | 0.25 | 0.50 | 5 | 8 / - | 100 | 400 (1) | 400 (1) |", t)
         self.assertIn("| office | 200 | 10 | 100 | 40 | 0.400 |", t)
 
     def test_compare_histogram_shares_sum_to_one(self):
