@@ -1,0 +1,1 @@
+scripts/merge-vs-time.sh 500000 2000
