@@ -1,1 +1,1 @@
-scripts/maps-table.sh 500000 2000000
+scripts/maps-table.sh 250000 1000000
