@@ -231,9 +231,10 @@ std::optional<AgvsConfig> MergeOptions::agvs(const Common& c, uint64_t seed, uin
 
 void add_merge_options(CLI::App* cmd, MergeOptions& a) {
   cmd->add_option("--merge-pvs", a.pvs,
-                  "PVSs of the elementary cells that merging decides on: agvs (the construction samples' united with "
-                  "adaptive global visibility sampling of the cells) or samples (the construction samples' alone: "
-                  "a few hundred per cell, whose gaps greedy merging fits)")
+                  "What merging decides on: agvs (the elementary cells' PVSs from the construction samples united with "
+                  "an AGVS run over the cells, and greedy merging started from the subdivision's own cut that a "
+                  "second, held-out AGVS run scores best) or samples (greedy merging on the construction samples' "
+                  "PVSs alone: a few hundred per cell, whose gaps it fits)")
       ->capture_default_str()
       ->check(CLI::IsMember({"agvs", "samples"}));
   cmd->add_option("--merge-samples", a.samples,

@@ -282,6 +282,15 @@ expect_error "fingerprints differ" "$VC" pvs office.vcells --scene city.obj --sa
 expect_error "unknown PVS method" "$VC" pvs office.vcells --scene office.obj --samples 10 --method fast -o x.pvs
 [ ! -e x.pvs ] && ok || bad "a refused pvs wrote its output"
 expect_ok "$VC" build office.obj --samples 5000 --max-cells 8 --no-merge -o nomerge.vcells -q
+expect_error "need --merge-pvs agvs" "$VC" build office.obj --samples 5000 --max-cells 8 --merge-pvs samples \
+  --merge-samples 100 -o x.vcells
+expect_error "--merge-pvs" "$VC" build office.obj --samples 5000 --max-cells 8 --merge-pvs fast -o x.vcells
+# The old greedy merge on request, and the validated one's report says what it chose.
+expect_ok "$VC" build office.obj --samples 5000 --max-cells 16 --merge-pvs samples -o oldmerge.vcells \
+  --report oldmerge.json -q
+[ "$(json_get oldmerge.json "['merge']['pvs']")" = "construction samples" ] && ok || bad "build --merge-pvs samples"
+expect_ok "$VC" build office.obj --samples 5000 --max-cells 16 -o newmerge.vcells --report newmerge.json -q
+[ "$(json_get newmerge.json "['merge']['agvs_samples']['validation']")" -ge 5000 ] && ok || bad "build's merge report"
 expect_error "no merge history" "$VC" extract nomerge.vcells --count 2
 # compare: every method from the same samples, scored on independent ones.
 expect_ok "$VC" compare office.obj --samples 20000 --max-cells 40 -o cmp -q
