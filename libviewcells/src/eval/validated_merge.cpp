@@ -3,6 +3,7 @@
 #include "viewcells/eval/validated_merge.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 
@@ -81,9 +82,12 @@ ValidatedMerge merge_validated(const Scene& scene, const RayCaster& caster, cons
     return c;
   };
   Progress progress("choosing where merging starts", candidates.size());
+  std::atomic<uint64_t> evaluations{0}, stale{0};  // the candidates' pair costs, for the report
   tbb::parallel_for(size_t{0}, candidates.size(), [&](size_t i) {
     MergeStart& st = candidates[i];
     const MergeHistory h = merge_cells(scene, partition, model, config_for(st));
+    evaluations += h.stats.evaluations;
+    stale += h.stats.stale;
     const CostCurve held_out = evaluate_merge_history(scene, s, h, b.pvs, model);
     st.worst = -1e300;
     size_t terms = 0;
@@ -121,6 +125,8 @@ ValidatedMerge merge_validated(const Scene& scene, const RayCaster& caster, cons
   out.history = merge_cells(scene, partition, model, mc);
   out.merge_seconds = seconds_since(t);
   out.history.stats.seconds = out.merge_seconds;
+  out.history.stats.evaluations = evaluations.load();  // the replay itself chooses nothing
+  out.history.stats.stale = stale.load();
   return out;
 }
 

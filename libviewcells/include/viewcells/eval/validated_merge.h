@@ -45,7 +45,7 @@ struct MergeStart {
 };
 
 struct ValidatedMerge {
-  MergeHistory history;
+  MergeHistory history;  ///< its stats count the pair costs of every candidate scored
   /// Per node of the subdivision (leaves filled): the construction samples' PVSs united with
   /// both AGVS runs'; the history's node PVSs are unions of these.
   std::vector<std::vector<uint32_t>> leaf_pvs;
