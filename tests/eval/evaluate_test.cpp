@@ -29,6 +29,22 @@ Subdivision build(const Scene& scene, const SegmentSet& segs, const std::string&
   return subdivide(scene, segs, CostModel{}, config);
 }
 
+/// A quiet comparison of `methods` up to `cells` cells: construction samples with seed 1,
+/// evaluation samples with seed 2.
+CompareConfig comparison(std::vector<std::string> methods, uint32_t cells, uint64_t samples, uint64_t eval_samples) {
+  CompareConfig config;
+  config.methods = std::move(methods);
+  config.max_cells = cells;
+  config.construction.samples = samples;
+  config.construction.seed = 1;
+  config.construction.show_progress = false;
+  config.evaluation = config.construction;
+  config.evaluation.samples = eval_samples;
+  config.evaluation.seed = 2;
+  config.show_progress = false;
+  return config;
+}
+
 TEST(Evaluate, ConstructionSamplesReproduceTheBuildersCosts) {
   // The evaluator's segment-to-leaf rule is the builder's: fed the construction segments, it
   // must give back the builder's own cost curve.
@@ -79,16 +95,7 @@ TEST(Evaluate, AvMBeatsKdCasmAtEqualCellCounts) {
   for (const GeneratorConfig& g : {GeneratorConfig{GeneratorKind::kOffice, 1, 2}, GeneratorConfig{GeneratorKind::kCity, 1, 3}}) {
     const Scene scene = generate_scene(g);
     const auto caster = make_embree_caster(scene);
-    CompareConfig config;
-    config.methods = {"av-m", "kd-casm"};
-    config.max_cells = 128;
-    config.construction.samples = 100000;
-    config.construction.seed = 1;
-    config.construction.show_progress = false;
-    config.evaluation = config.construction;
-    config.evaluation.samples = 160000;
-    config.evaluation.seed = 2;
-    config.show_progress = false;
+    const CompareConfig config = comparison({"av-m", "kd-casm"}, 128, 100000, 160000);
     const Comparison c = compare_methods(scene, *caster, config);
     ASSERT_EQ(c.methods.size(), 2u);
     const MethodResult &avm = c.methods[0], &kd = c.methods[1];
@@ -190,16 +197,7 @@ namespace {
 TEST(Evaluate, MergingIsNotWorseThanTheSubdivisionsOwnCuts) {
   const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 2});
   const auto caster = make_embree_caster(scene);
-  CompareConfig config;
-  config.methods = {"av-m", "av-m-samples", "av-s"};
-  config.max_cells = 400;
-  config.construction.samples = 80000;
-  config.construction.seed = 1;
-  config.construction.show_progress = false;
-  config.evaluation = config.construction;
-  config.evaluation.samples = 320000;
-  config.evaluation.seed = 2;
-  config.show_progress = false;
+  CompareConfig config = comparison({"av-m", "av-m-samples", "av-s"}, 400, 80000, 320000);
   config.keep_models = true;
   AgvsConfig agvs;
   agvs.seed = 5;
@@ -210,8 +208,8 @@ TEST(Evaluate, MergingIsNotWorseThanTheSubdivisionsOwnCuts) {
   ASSERT_EQ(c.methods.size(), 3u);
   ASSERT_TRUE(c.av_s && c.av_m);
   const MethodResult &avm = c.methods[0], &old = c.methods[1], &avs = c.methods[2];
-  EXPECT_GT(avm.leaf_agvs_samples, 2 * agvs.max_samples - 1);
-  EXPECT_FALSE(avm.starts.empty());
+  EXPECT_GT(avm.merge.merge_agvs_samples + avm.merge.validation_agvs_samples, 2 * agvs.max_samples - 1);
+  EXPECT_FALSE(avm.merge.starts.empty());
 
   // A second, independent evaluation of AV-S: the evaluator's noise.
   SamplerConfig second = config.evaluation;

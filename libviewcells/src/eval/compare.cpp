@@ -27,40 +27,6 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
 }
 
-/// AV-M's merge history over the leaves of `s`, with its timings in `r`: validated by AGVS
-/// (config.merge_agvs, method av-m) or greedy on the construction samples' PVSs.
-MergeHistory merge_for_comparison(const Scene& scene, const RayCaster& caster, const Subdivision& s,
-                                  const SegmentSet& built, const CompareConfig& config, const std::string& method,
-                                  MethodResult& r) {
-  MergeConfig mc;
-  mc.show_progress = config.show_progress;
-  auto t = std::chrono::steady_clock::now();
-  std::vector<std::vector<uint32_t>> leaves = leaf_pvs(s, built);
-  r.leaf_pvs_seconds = seconds_since(t);
-  r.greedy_from = static_cast<uint32_t>(s.leaf_count());
-  if (method == "av-m" && config.merge_agvs) {
-    ValidatedMergeConfig vc;
-    vc.agvs = *config.merge_agvs;
-    vc.merge = mc;
-    ValidatedMerge v = merge_validated(scene, caster, s, leaves, config.model, vc);
-    r.leaf_pvs_seconds += v.agvs_seconds;
-    r.neighbour_seconds = v.neighbour_seconds;
-    r.merge_seconds = v.select_seconds + v.merge_seconds;
-    r.leaf_agvs_samples = v.merge_agvs.samples + v.validation_agvs.samples;
-    r.greedy_from = v.chosen.cells;
-    r.merge_barrier = v.chosen.barrier;
-    r.starts = std::move(v.starts);
-    return std::move(v.history);
-  }
-  t = std::chrono::steady_clock::now();
-  const CellPartition partition = partition_from_subdivision(s, leaves);
-  r.neighbour_seconds = seconds_since(t);
-  t = std::chrono::steady_clock::now();
-  MergeHistory h = merge_cells(scene, partition, config.model, mc);
-  r.merge_seconds = seconds_since(t);
-  return h;
-}
-
 }  // namespace
 
 void check_methods(const std::vector<std::string>& methods) {
@@ -119,8 +85,13 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
     const auto t = std::chrono::steady_clock::now();
     const std::vector<std::vector<uint32_t>> pvs = evaluation_pvs(*s, eval.segments);
     if (merged) {
-      MergeHistory h = merge_for_comparison(scene, caster, *s, built.segments, config, method, r);
-      const double merge_seconds = r.leaf_pvs_seconds + r.neighbour_seconds + r.merge_seconds;
+      MergeConfig mc;
+      mc.show_progress = config.show_progress;
+      LeafMerge lm = merge_leaves(scene, caster, *s, built.segments, config.model,
+                                  method == "av-m" ? config.merge_agvs : std::nullopt, mc);
+      MergeHistory h = std::move(lm.history);
+      r.merge = std::move(lm.summary);
+      const double merge_seconds = r.merge.leaf_pvs_seconds + r.merge.neighbour_seconds + r.merge.merge_seconds;
       r.build_seconds += merge_seconds;
       out.evaluation_seconds -= merge_seconds;  // counted below with the evaluation otherwise
       const std::vector<double> node_cost = evaluated_merge_costs(scene, *s, h, pvs, config.model);

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -16,10 +15,6 @@
 namespace viewcells {
 
 namespace {
-
-double seconds_since(std::chrono::steady_clock::time_point t) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t).count();
-}
 
 std::vector<std::vector<uint32_t>> unite(const std::vector<std::vector<uint32_t>>& a,
                                          const std::vector<std::vector<uint32_t>>& b) {
@@ -37,24 +32,27 @@ std::vector<std::pair<int32_t, int32_t>> merges_of(const MergeHistory& h) {
 
 }  // namespace
 
-ValidatedMerge merge_validated(const Scene& scene, const RayCaster& caster, const Subdivision& s,
-                               const std::vector<std::vector<uint32_t>>& base, const CostModel& model,
-                               const ValidatedMergeConfig& config) {
-  ValidatedMerge out;
-  auto t = std::chrono::steady_clock::now();
-  LeafPvsRun a = leaf_pvs_by_agvs(scene, caster, s, config.agvs, base);
+LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Subdivision& s,
+                          std::vector<std::vector<uint32_t>> base, const CostModel& model,
+                          const ValidatedMergeConfig& config) {
+  LeafMerge out;
+  MergeSummary& sum = out.summary;
+  sum.validated = true;
+  Stopwatch t;
+  const LeafPvsRun a = leaf_pvs_by_agvs(scene, caster, s, config.agvs, base);
+  base.clear();
   AgvsConfig vc = config.agvs;
   vc.seed += 1;
-  LeafPvsRun b = leaf_pvs_by_agvs(scene, caster, s, vc);
-  out.merge_agvs = std::move(a.stats);
-  out.validation_agvs = std::move(b.stats);
-  out.agvs_seconds = seconds_since(t);
+  const LeafPvsRun b = leaf_pvs_by_agvs(scene, caster, s, vc);
+  sum.merge_agvs_samples = a.stats.samples;
+  sum.validation_agvs_samples = b.stats.samples;
+  sum.leaf_pvs_seconds = t.seconds();
 
-  t = std::chrono::steady_clock::now();
+  t.restart();
   CellPartition partition = partition_from_subdivision(s, a.pvs);
-  out.neighbour_seconds = seconds_since(t);
+  sum.neighbour_seconds = t.seconds();
 
-  t = std::chrono::steady_clock::now();
+  t.restart();
   const size_t L = s.leaf_count();
   MergeConfig mc = config.merge;
   mc.prefix = subdivision_prefix(s, 1);
@@ -63,8 +61,8 @@ ValidatedMerge merge_validated(const Scene& scene, const RayCaster& caster, cons
   std::vector<size_t> counts;
   for (size_t n = std::min<size_t>(config.score_from, L); n <= L; n = n * 5 / 4 + 1) counts.push_back(n);
   if (counts.empty() || counts.back() != L) counts.push_back(L);
-  out.chosen = {1, 0, 0.0, 0.0};
-  out.starts.push_back(out.chosen);
+  sum.chosen = {1, 0, 0.0, 0.0};
+  sum.starts.push_back(sum.chosen);
   mc.show_progress = false;
   // Every candidate start, scored in parallel (each is independent; the choice below is made
   // in a fixed order, so it does not depend on the thread count).
@@ -106,27 +104,52 @@ ValidatedMerge merge_validated(const Scene& scene, const RayCaster& caster, cons
   // The lowest mean among the starts whose worst count stays within the allowance; ties keep
   // the earlier (AV-S's order first).
   for (const MergeStart& st : candidates) {
-    out.starts.push_back(st);
-    if (st.worst <= config.worst_allowed && st.score < out.chosen.score) out.chosen = st;
+    sum.starts.push_back(st);
+    if (st.worst <= config.worst_allowed && st.score < sum.chosen.score) sum.chosen = st;
   }
-  const MergeHistory best = out.chosen.cells == 1 ? av_s : merge_cells(scene, partition, model, config_for(out.chosen));
-  out.select_seconds = seconds_since(t);
+  const MergeHistory best = sum.chosen.cells == 1 ? av_s : merge_cells(scene, partition, model, config_for(sum.chosen));
+  sum.merge_seconds = t.seconds();
 
   // The chosen merges, replayed with every sample's PVSs.
-  t = std::chrono::steady_clock::now();
+  t.restart();
   out.leaf_pvs = unite(a.pvs, b.pvs);
   partition = partition_from_subdivision(s, out.leaf_pvs);
-  out.neighbour_seconds += seconds_since(t);
-  t = std::chrono::steady_clock::now();
+  sum.neighbour_seconds += t.seconds();
+  t.restart();
   mc.prefix = merges_of(best);
   mc.barrier_cells = 0;
   mc.block.clear();
   mc.show_progress = config.merge.show_progress;
   out.history = merge_cells(scene, partition, model, mc);
-  out.merge_seconds = seconds_since(t);
-  out.history.stats.seconds = out.merge_seconds;
+  sum.merge_seconds += t.seconds();
+  out.history.stats.seconds = sum.merge_seconds;
   out.history.stats.evaluations = evaluations.load();  // the replay itself chooses nothing
   out.history.stats.stale = stale.load();
+  return out;
+}
+
+LeafMerge merge_leaves(const Scene& scene, const RayCaster& caster, const Subdivision& s, const SegmentSet& segments,
+                       const CostModel& model, const std::optional<AgvsConfig>& agvs, const MergeConfig& merge) {
+  Stopwatch t;
+  std::vector<std::vector<uint32_t>> base = leaf_pvs(s, segments);
+  const double base_seconds = t.seconds();
+  LeafMerge out;
+  if (agvs) {
+    ValidatedMergeConfig vc;
+    vc.agvs = *agvs;
+    vc.merge = merge;
+    out = merge_validated(scene, caster, s, std::move(base), model, vc);
+  } else {
+    MergeSummary& sum = out.summary;
+    sum.chosen = {static_cast<uint32_t>(s.leaf_count()), 0, 0.0, 0.0};
+    t.restart();
+    const CellPartition partition = partition_from_subdivision(s, base);
+    sum.neighbour_seconds = t.seconds();
+    out.history = merge_cells(scene, partition, model, merge);
+    sum.merge_seconds = out.history.stats.seconds;
+    out.leaf_pvs = std::move(base);
+  }
+  out.summary.leaf_pvs_seconds += base_seconds;
   return out;
 }
 

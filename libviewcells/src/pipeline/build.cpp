@@ -48,48 +48,32 @@ Subdivision subdivide_sampled(const SamplingRun& s, const CostModel& model, Subd
 void merge_leaves(const BuildConfig& config, const SamplingRun& s, const Subdivision& sub, BuildResult& out,
                   const Log& log) {
   SubdivisionFile& file = out.file;
-  Stopwatch sw;
-  file.leaf_pvs = leaf_pvs(sub, s.result.segments);
-  out.leaf_pvs_seconds = sw.seconds();
-  if (!config.merge) return;
-  const Scene& scene = *s.loaded.scene;
-  MergeConfig mc;
-  mc.show_progress = config.subdivision.show_progress;
+  if (!config.merge) {
+    file.leaf_pvs = leaf_pvs(sub, s.result.segments);
+    return;
+  }
   if (config.merge_agvs) {
     const AgvsConfig& a = *config.merge_agvs;
     log("viewcells: merging " + std::to_string(sub.leaf_count()) + " cells, on PVSs with two AGVS runs over them (" +
         (a.max_samples ? std::to_string(a.max_samples) + " samples" : "") +
         (a.max_samples && a.pixel_error > 0 ? " or " : "") +
         (a.pixel_error > 0 ? "pixel error " + fmt(a.pixel_error) : "") + " each: one to merge on, one to validate)");
-    ValidatedMergeConfig vc;
-    vc.agvs = a;
-    vc.merge = mc;
-    ValidatedMerge v = merge_validated(scene, *s.loaded.caster, sub, file.leaf_pvs, config.model, vc);
-    file.leaf_pvs = std::move(v.leaf_pvs);
-    file.history = std::move(v.history);
-    out.merge_validated = true;
-    out.greedy_from = v.chosen.cells;
-    out.merge_barrier = v.chosen.barrier;
-    out.merge_starts = std::move(v.starts);
-    out.merge_agvs = std::move(v.merge_agvs);
-    out.validation_agvs = std::move(v.validation_agvs);
-    out.leaf_pvs_seconds += v.agvs_seconds;
-    out.neighbour_seconds = v.neighbour_seconds;
-    out.merge_seconds = v.select_seconds + v.merge_seconds;
-    log("viewcells: greedy merging from the subdivision's own cut at " + std::to_string(v.chosen.cells) +
-        " cells" + (v.chosen.barrier ? ", within its cut at " + std::to_string(v.chosen.barrier) + " cells until there" : "") +
-        " (held-out mean log cost ratio to AV-S " + fmt(v.chosen.score, 4) + ", worst " + fmt(v.chosen.worst, 4) + ")");
   } else {
     log("viewcells: merging " + std::to_string(sub.leaf_count()) + " cells on the construction samples' PVSs");
-    sw.restart();
-    const CellPartition partition = partition_from_subdivision(sub, file.leaf_pvs);
-    out.neighbour_seconds = sw.seconds();
-    file.history = merge_cells(scene, partition, config.model, mc);
-    out.merge_seconds = file.history->stats.seconds;
-    out.greedy_from = static_cast<uint32_t>(sub.leaf_count());
   }
-  log("viewcells: leaf PVSs " + fmt(out.leaf_pvs_seconds, 2) + " s, neighbour graph " + fmt(out.neighbour_seconds, 2) +
-      " s, merging " + fmt(out.merge_seconds, 2) + " s (" + std::to_string(file.history->stats.evaluations) +
+  MergeConfig mc;
+  mc.show_progress = config.subdivision.show_progress;
+  LeafMerge m = viewcells::merge_leaves(*s.loaded.scene, *s.loaded.caster, sub, s.result.segments, config.model,
+                                        config.merge_agvs, mc);
+  file.leaf_pvs = std::move(m.leaf_pvs);
+  file.history = std::move(m.history);
+  const MergeSummary& v = out.merge_summary = std::move(m.summary);
+  if (v.validated)
+    log("viewcells: greedy merging from the subdivision's own cut at " + std::to_string(v.chosen.cells) + " cells" +
+        (v.chosen.barrier ? ", within its cut at " + std::to_string(v.chosen.barrier) + " cells until there" : "") +
+        " (held-out mean log cost ratio to AV-S " + fmt(v.chosen.score, 4) + ", worst " + fmt(v.chosen.worst, 4) + ")");
+  log("viewcells: leaf PVSs " + fmt(v.leaf_pvs_seconds, 2) + " s, neighbour graph " + fmt(v.neighbour_seconds, 2) +
+      " s, merging " + fmt(v.merge_seconds, 2) + " s (" + std::to_string(file.history->stats.evaluations) +
       " pair costs, " + std::to_string(file.history->stats.stale) + " stale queue entries skipped)");
 }
 

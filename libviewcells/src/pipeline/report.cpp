@@ -138,6 +138,13 @@ json cost_curve(const Subdivision& sub) {
   return curve;
 }
 
+json starts_json(const std::vector<MergeStart>& starts) {
+  json out = json::array();
+  for (const MergeStart& st : starts)
+    out.push_back({{"cells", st.cells}, {"barrier", st.barrier}, {"score", st.score}, {"worst", st.worst}});
+  return out;
+}
+
 json merge_summary(const MergeHistory& h) {
   json merged = json::array();
   for (size_t cells = 1; cells <= h.leaf_count; cells *= 2)
@@ -162,7 +169,7 @@ json build_effects(const BuildResult& r) {
                              fmt(config.density.hi, 2) + ", " + fmt(config.density.outside, 3) + " elsewhere")
           : effect(false, "uniform: p(i) = V_i / V (no --density-band)");
   e["merging"] = !r.merge ? effect(false, "--no-merge")
-                 : r.merge_validated
+                 : r.merge_summary.validated
                      ? effect(true, "default: merged on the leaves' PVSs from the construction samples and an AGVS run, "
                                     "from the subdivision's cut a second, held-out AGVS run chose")
                      : effect(true, "--merge-pvs samples: greedy merging on the construction samples' PVSs");
@@ -230,19 +237,17 @@ std::string report_json(const BuildResult& r) {
   report["final_cost"] = sub.cost();
   if (r.file.history) {
     report["merge"] = merge_summary(*r.file.history);
-    report["merge"]["pvs"] = r.merge_validated ? "construction samples and two AGVS runs" : "construction samples";
-    report["merge"]["greedy_from_cells"] = r.greedy_from;
-    report["merge"]["barrier_cells"] = r.merge_barrier;
-    if (r.merge_validated) {
-      json starts = json::array();
-      for (const MergeStart& st : r.merge_starts)
-        starts.push_back({{"cells", st.cells}, {"barrier", st.barrier}, {"score", st.score}, {"worst", st.worst}});
-      report["merge"]["starts_scored"] = starts;
-      report["merge"]["agvs_samples"] = {{"merge", r.merge_agvs.samples}, {"validation", r.validation_agvs.samples}};
+    const MergeSummary& v = r.merge_summary;
+    report["merge"]["pvs"] = v.validated ? "construction samples and two AGVS runs" : "construction samples";
+    report["merge"]["greedy_from_cells"] = v.chosen.cells;
+    report["merge"]["barrier_cells"] = v.chosen.barrier;
+    if (v.validated) {
+      report["merge"]["starts_scored"] = starts_json(v.starts);
+      report["merge"]["agvs_samples"] = {{"merge", v.merge_agvs_samples}, {"validation", v.validation_agvs_samples}};
     }
-    report["timings"]["leaf_pvs_seconds"] = r.leaf_pvs_seconds;
-    report["timings"]["neighbour_graph_seconds"] = r.neighbour_seconds;
-    report["timings"]["merge_seconds"] = r.merge_seconds;
+    report["timings"]["leaf_pvs_seconds"] = v.leaf_pvs_seconds;
+    report["timings"]["neighbour_graph_seconds"] = v.neighbour_seconds;
+    report["timings"]["merge_seconds"] = v.merge_seconds;
   }
   report["timings"]["subdivision_seconds"] = sub.stats.seconds;
   report["timings"]["write_seconds"] = r.write_seconds;
@@ -412,16 +417,14 @@ json compare_methods_json(const Comparison& cmp) {
                        {"evaluated_cost_at_most_cells", m.evaluated.at(last)},
                        {"constructed_cost_at_most_cells", m.constructed.at(last)}});
     if (m.method == "av-m" || m.method == "av-m-samples") {
-      json starts = json::array();
-      for (const MergeStart& st : m.starts)
-        starts.push_back({{"cells", st.cells}, {"barrier", st.barrier}, {"score", st.score}, {"worst", st.worst}});
-      methods.back()["merge"] = {{"leaf_pvs_seconds", m.leaf_pvs_seconds},
-                                 {"neighbour_graph_seconds", m.neighbour_seconds},
-                                 {"merge_seconds", m.merge_seconds},
-                                 {"leaf_agvs_samples", m.leaf_agvs_samples},
-                                 {"greedy_from_cells", m.greedy_from},
-                                 {"barrier_cells", m.merge_barrier},
-                                 {"starts_scored", starts}};
+      const MergeSummary& v = m.merge;
+      methods.back()["merge"] = {{"leaf_pvs_seconds", v.leaf_pvs_seconds},
+                                 {"neighbour_graph_seconds", v.neighbour_seconds},
+                                 {"merge_seconds", v.merge_seconds},
+                                 {"leaf_agvs_samples", v.merge_agvs_samples + v.validation_agvs_samples},
+                                 {"greedy_from_cells", v.chosen.cells},
+                                 {"barrier_cells", v.chosen.barrier},
+                                 {"starts_scored", starts_json(v.starts)}};
     }
   }
   return methods;

@@ -43,13 +43,7 @@ struct MethodResult {
   std::vector<CellCost> cells;  ///< evaluated cells at the histogram cell count (if reached)
   uint32_t leaves = 0;          ///< cells the method produced
   double build_seconds = 0;     ///< subdivision (and merging), without sampling
-  /// AV-M: the parts of build_seconds spent on the leaves' PVSs (AGVS's included), the
-  /// neighbour graph, and merging (the choice of the start included).
-  double leaf_pvs_seconds = 0, neighbour_seconds = 0, merge_seconds = 0;
-  uint64_t leaf_agvs_samples = 0;  ///< AV-M: AGVS samples of both runs (0: none)
-  uint32_t greedy_from = 0;        ///< AV-M: greedy merging from AV-S's cut at this count
-  uint32_t merge_barrier = 0;      ///< AV-M: ... within the blocks of its cut at this count (0: none)
-  std::vector<MergeStart> starts;  ///< AV-M with AGVS: every candidate start, scored
+  MergeSummary merge;  ///< AV-M: what its merge chose, and its seconds (part of build_seconds)
   std::string stop_reason;
   std::string geometry_aligned;  ///< whether geometry-aligned candidates were used, and why
   uint64_t axis_candidates = 0, geometry_candidates = 0;  ///< candidate planes evaluated

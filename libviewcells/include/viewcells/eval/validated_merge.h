@@ -15,6 +15,7 @@
 /// The history written has the chosen merges with PVSs from the construction samples, A and
 /// B together (what extraction and compression then store).
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "viewcells/agvs/agvs.h"
@@ -22,6 +23,7 @@
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/merge/merge.h"
 #include "viewcells/raycast/ray_caster.h"
+#include "viewcells/sampling/segments.h"
 #include "viewcells/scene/scene.h"
 
 namespace viewcells {
@@ -44,21 +46,35 @@ struct MergeStart {
   double worst = 0;      ///< the largest log(cost / AV-S cost) among the counts scored
 };
 
-struct ValidatedMerge {
+/// What a merge of the leaves chose and cost, for reports.
+struct MergeSummary {
+  bool validated = false;  ///< merge_validated; else greedy on the construction samples' PVSs
+  MergeStart chosen;       ///< the start taken ({leaf count, 0}: greedy from the leaves)
+  std::vector<MergeStart> starts;  ///< every candidate, scored (validated only)
+  uint64_t merge_agvs_samples = 0, validation_agvs_samples = 0;
+  /// The leaves' PVSs (AGVS runs included), the neighbour graph, and merging (the choice of
+  /// the start included).
+  double leaf_pvs_seconds = 0, neighbour_seconds = 0, merge_seconds = 0;
+};
+
+struct LeafMerge {
   MergeHistory history;  ///< its stats count the pair costs of every candidate scored
-  /// Per node of the subdivision (leaves filled): the construction samples' PVSs united with
-  /// both AGVS runs'; the history's node PVSs are unions of these.
+  /// Per node of the subdivision (leaves filled): the PVSs the history's are unions of (with
+  /// validation, the construction samples' united with both AGVS runs').
   std::vector<std::vector<uint32_t>> leaf_pvs;
-  MergeStart chosen;            ///< the chosen start ({1, 0}: AV-S's own order)
-  std::vector<MergeStart> starts;  ///< every candidate, with its score
-  AgvsStats merge_agvs, validation_agvs;
-  double agvs_seconds = 0, neighbour_seconds = 0, merge_seconds = 0, select_seconds = 0;
+  MergeSummary summary;
 };
 
 /// `base`: the construction samples' leaf PVSs, per node of `s` (bsp/subdivision.h leaf_pvs);
 /// `s` needs its cells (neighbours). Deterministic for any thread count.
-ValidatedMerge merge_validated(const Scene& scene, const RayCaster& caster, const Subdivision& s,
-                               const std::vector<std::vector<uint32_t>>& base, const CostModel& model,
-                               const ValidatedMergeConfig& config);
+LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Subdivision& s,
+                          std::vector<std::vector<uint32_t>> base, const CostModel& model,
+                          const ValidatedMergeConfig& config);
+
+/// The leaves of `s` merged into a history from the construction samples `segments`: by
+/// merge_validated when `agvs` is set, else greedily on the construction samples' PVSs alone.
+/// What build and compare call.
+LeafMerge merge_leaves(const Scene& scene, const RayCaster& caster, const Subdivision& s, const SegmentSet& segments,
+                       const CostModel& model, const std::optional<AgvsConfig>& agvs, const MergeConfig& merge);
 
 }  // namespace viewcells

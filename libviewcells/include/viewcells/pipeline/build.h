@@ -46,14 +46,7 @@ struct BuildResult {
   CostModel model;
   SubdivisionConfig subdivision_config;  ///< as used (geometry-aligned decided)
   bool merge = true;
-  bool merge_validated = false;  ///< merged by merge_validated (the fields below)
-  uint32_t greedy_from = 0;      ///< greedy merging from AV-S's cut at this many cells
-  uint32_t merge_barrier = 0;    ///< ... within the blocks of its cut at this many cells (0: none)
-  std::vector<MergeStart> merge_starts;
-  AgvsStats merge_agvs, validation_agvs;
-  /// Seconds of the leaves' PVSs (AGVS runs included), of the neighbour graph, and of merging
-  /// (the choice of the start included).
-  double leaf_pvs_seconds = 0, neighbour_seconds = 0, merge_seconds = 0;
+  MergeSummary merge_summary;  ///< what merging chose, and its seconds (with a history)
   /// The hierarchy: the subdivision (its cells and per-leaf segments dropped once written),
   /// the leaves' PVSs and, when merged, the merge history.
   SubdivisionFile file;
