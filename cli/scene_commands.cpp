@@ -76,11 +76,11 @@ int run_info(const InfoArgs& a, const Common& c) {
             << fmt(scene.surface_area, 1) << " surface area\n";
   if (info.map) print_map(*info.map);
   if (a.list) {
-    std::cout << "\n#id\ttriangles\tclosed\toriented\tsolid\tname\n";
+    std::cout << "\n#id\ttriangles\tclosed\toriented\tsolid\trendered\toccluder\tname\n";
     for (size_t i = 0; i < scene.objects.size(); ++i) {
       const ObjectInfo& o = scene.objects[i];
       std::cout << i << '\t' << o.triangle_count << '\t' << o.closed << '\t' << o.oriented << '\t' << o.solid()
-                << '\t' << o.name << '\n';
+                << '\t' << o.rendered << '\t' << o.occluder << '\t' << o.name << '\n';
     }
   }
   if (!a.json_path.empty()) {
@@ -125,7 +125,7 @@ void add_scene_commands(CLI::App& app, const Common& common, Commands& commands)
   auto info = std::make_shared<InfoArgs>();
   auto* i = app.add_subcommand("info", "Describe a scene: objects, triangles, bounds, closedness, axis alignment");
   i->add_option("scene", info->scene, "Scene file (.obj, .ply, .off, .stl, or a Quake 3 .bsp)")->required();
-  i->add_option("--objects", info->objects, "Object grouping: auto | groups | components | triangles")
+  i->add_option("--objects", info->objects, "Object grouping: auto | groups | components | triangles | nodes | meshes (nodes and meshes: glTF, FBX and other formats read through Assimp; auto there means nodes)")
       ->capture_default_str();
   i->add_flag("--list", info->list, "List every object");
   i->add_option("--json", info->json_path, "Also write the description as JSON");

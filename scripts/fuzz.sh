@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Fuzzes every reader with libFuzzer (clang-14, AddressSanitizer and UBSan): OBJ, PLY, OFF, STL,
-# Quake 3 BSP, .vseg, .vcells, .pvs and .vagvs. Seed corpora are made by the project's own
+# Quake 3 BSP, binary glTF and FBX (through Assimp), .vseg, .vcells, .pvs and .vagvs. Seed corpora are made by the project's own
 # generators and commands (in build-fuzz/corpus, not in git); the toolkit's own formats are
 # fuzzed as container payloads, so that inputs get past the checksum to the parsers.
 # Each target runs SECONDS (default 60), two at a time; findings (crash-, leak-, oom-,
@@ -11,7 +11,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 shift $(( $# > 0 ? 1 : 0 ))
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(obj ply off stl bsp vseg vcells pvs vagvs)
+[ ${#targets[@]} -gt 0 ] || targets=(obj ply off stl bsp glb fbx vseg vcells pvs vagvs)
 
 bash scripts/install-deps.sh --fuzz
 CC=clang-14 CXX=clang++-14 bash scripts/build.sh build-fuzz RelWithDebInfo -DVIEWCELLS_FUZZ=ON -DVIEWCELLS_BUILD_TESTS=OFF
@@ -45,11 +45,17 @@ obj_to_stl() {
 if [ ! -f "$corpus/done" ]; then
   echo "fuzz: making seed corpora"
   rm -rf "$corpus"
-  for t in obj ply off stl bsp vseg vcells pvs vagvs; do mkdir -p "$corpus/$t"; done
+  for t in obj ply off stl bsp glb fbx vseg vcells pvs vagvs; do mkdir -p "$corpus/$t"; done
   work=$(mktemp -d)
   "$vc" -q generate office --size 1 -o "$corpus/obj/office.obj"
   "$vc" -q generate rotated-office --size 1 --seed 2 -o "$corpus/obj/rotated.obj"
   head -c 20000 "$corpus/obj/office.obj" | sed '$d' >"$corpus/obj/office-part.obj"
+  # Real binary glTF and FBX files from Debian's assimp-testmodels.
+  for f in /usr/share/assimp/models/glTF2/BoxTextured-glTF-Binary/BoxTextured.glb \
+           /usr/share/assimp/models/glTF2/BoxBadNormals-glTF-Binary/BoxBadNormals.glb; do
+    cp "$f" "$corpus/glb/"
+  done
+  for f in box.fbx cubes_with_names.fbx boxWithCompressedCTypeArray.FBX; do cp "/usr/share/assimp/models/FBX/$f" "$corpus/fbx/"; done
   obj_to_off "$corpus/obj/office.obj" >"$corpus/off/office.off"
   obj_to_stl "$corpus/obj/rotated.obj" >"$corpus/stl/rotated.stl"
   "$vc" -q sample "$corpus/obj/office.obj" --samples 2000 -o "$work/s.vseg"

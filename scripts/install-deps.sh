@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
-# Installs every build, test and plotting dependency of viewcells from Debian 12 packages.
-# Idempotent: packages already present are skipped, and apt is only asked when something is missing.
+# Installs every build, test and plotting dependency of viewcells from Debian 12 packages, and the
+# web viewer's (three.js, esbuild, playwright-core) from the npm registry into web/node_modules,
+# pinned by web/package-lock.json.
+# Idempotent: packages already present are skipped, and apt and npm are only asked when something
+# is missing.
 # Usage: scripts/install-deps.sh [--fuzz]
 set -euo pipefail
 
@@ -15,12 +18,18 @@ packages=(
   nlohmann-json3-dev     # reports and configuration
   libzstd-dev            # compressed binary files
   libpng-dev             # slice images
+  libassimp-dev          # glTF, FBX and other scene-graph formats
+  assimp-testmodels      # real models in those formats, for the tests
+  chromium               # the web viewer's test, headless
   libgtest-dev libgmock-dev libbenchmark-dev   # tests and micro-benchmarks
   gnuplot-nox                                  # plots of comparisons and studies (scripts/plot-*.sh)
 )
 
 # scripts/fuzz.sh also needs clang with libFuzzer's runtime.
 if [ "${1:-}" = "--fuzz" ]; then packages+=(clang-14 libclang-rt-14-dev); fi
+
+# Node.js and npm build the web viewer; Debian's serve when the machine has none of its own.
+if ! command -v npm >/dev/null 2>&1; then packages+=(nodejs npm); fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -31,12 +40,20 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages already installed"
-  exit 0
+else
+  echo "install-deps: installing ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -q
+  $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-echo "install-deps: installing ${missing[*]}"
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -q
-$SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+# The web viewer's packages, exactly as the lockfile pins them (npm ci), unless already there.
+web="$(cd "$(dirname "$0")/.." && pwd)/web"
+if [ ! -f "$web/node_modules/.package-lock.json" ] || [ "$web/package-lock.json" -nt "$web/node_modules/.package-lock.json" ]; then
+  echo "install-deps: npm ci in web/"
+  (cd "$web" && npm ci --no-audit --no-fund --loglevel=error)
+else
+  echo "install-deps: web/node_modules up to date"
+fi

@@ -94,6 +94,16 @@ void entry_stl(const uint8_t* data, size_t size) {
 void entry_bsp(const uint8_t* data, size_t size) {
   expecting_errors([&] { q3_world_mesh(parse_q3bsp(std::string(bytes_of(data, size)), "fuzz.bsp")); });
 }
+void entry_glb(const uint8_t* data, size_t size) {
+  expecting_errors([&] {
+    scene_of(read_assimp_bytes(bytes_of(data, size), ".glb", AssimpObjects::kNodes, "fuzz.glb"), "fuzz.glb");
+  });
+}
+void entry_fbx(const uint8_t* data, size_t size) {
+  expecting_errors([&] {
+    scene_of(read_assimp_bytes(bytes_of(data, size), ".fbx", AssimpObjects::kMeshes, "fuzz.fbx"), "fuzz.fbx");
+  });
+}
 void entry_vseg(const uint8_t* data, size_t size) {
   expecting_errors([&] { read_segments(container_file(data, size, "VSEG", 1, ".vseg")); });
 }

@@ -14,6 +14,9 @@ void entry_ply(const uint8_t* data, size_t size);
 void entry_off(const uint8_t* data, size_t size);
 void entry_stl(const uint8_t* data, size_t size);
 void entry_bsp(const uint8_t* data, size_t size);
+/// Scene-graph formats through Assimp: binary glTF and FBX.
+void entry_glb(const uint8_t* data, size_t size);
+void entry_fbx(const uint8_t* data, size_t size);
 /// The toolkit's own formats: the input is a payload (its first byte picks the format
 /// version), wrapped in a valid container so that it gets past the checksum.
 void entry_vseg(const uint8_t* data, size_t size);

@@ -463,8 +463,16 @@ Scene load_scene(const std::string& path, ObjectGrouping grouping) {
     if (in.bad()) throw Error(path, 0, "read error");
     return bytes;
   };
+  const bool assimp = is_assimp_extension(ext);
+  if (!assimp && (grouping == ObjectGrouping::kNodes || grouping == ObjectGrouping::kMeshes))
+    throw Error(path, 0, std::string("--objects ") + to_string(grouping) +
+                             " applies to scene-graph formats read through Assimp (glTF, FBX, ...), not to '" + ext +
+                             "' files");
   RawMesh mesh;
-  if (ext == ".obj") {
+  if (assimp) {
+    mesh = read_assimp(path, grouping == ObjectGrouping::kMeshes ? AssimpObjects::kMeshes : AssimpObjects::kNodes);
+    if (grouping == ObjectGrouping::kAuto || grouping == ObjectGrouping::kGroups) grouping = ObjectGrouping::kNodes;
+  } else if (ext == ".obj") {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path, 0, "cannot open file");
     mesh = read_obj(in, path);
@@ -479,7 +487,9 @@ Scene load_scene(const std::string& path, ObjectGrouping grouping) {
     // (neither rendered), patches at level 4.
     mesh = q3_world_mesh(read_q3bsp(path));
   } else {
-    throw Error(path, 0, "unknown scene format '" + ext + "' (expected .obj, .ply, .off, .stl or .bsp)");
+    throw Error(path, 0, "unknown scene format '" + ext +
+                             "' (expected .obj, .ply, .off, .stl, .bsp, or through Assimp .gltf, .glb, .fbx, .dae, "
+                             ".3ds, .x, .ase, .lwo, .ms3d)");
   }
   for (size_t i = 0; i < mesh.vertices.size(); ++i) {  // binary files (text readers say the line)
     const Vec3& v = mesh.vertices[i];

@@ -16,7 +16,9 @@ ObjectGrouping parse_grouping(const std::string& name) {
   if (name == "groups") return ObjectGrouping::kGroups;
   if (name == "components") return ObjectGrouping::kComponents;
   if (name == "triangles") return ObjectGrouping::kTriangles;
-  throw Error("unknown object grouping '" + name + "' (expected auto, groups, components or triangles)");
+  if (name == "nodes") return ObjectGrouping::kNodes;
+  if (name == "meshes") return ObjectGrouping::kMeshes;
+  throw Error("unknown object grouping '" + name + "' (expected auto, groups, components, triangles, nodes or meshes)");
 }
 
 const char* to_string(ObjectGrouping g) {
@@ -25,6 +27,8 @@ const char* to_string(ObjectGrouping g) {
     case ObjectGrouping::kGroups: return "groups";
     case ObjectGrouping::kComponents: return "components";
     case ObjectGrouping::kTriangles: return "triangles";
+    case ObjectGrouping::kNodes: return "nodes";
+    case ObjectGrouping::kMeshes: return "meshes";
   }
   return "?";
 }
@@ -191,6 +195,8 @@ Scene make_scene(RawMesh mesh, ObjectGrouping grouping, const std::string& sourc
   scene.triangle_object.resize(n);
   switch (grouping) {
     case ObjectGrouping::kAuto:  // resolved above
+    case ObjectGrouping::kNodes:  // the Assimp reader made one group per node (or mesh)
+    case ObjectGrouping::kMeshes:
     case ObjectGrouping::kGroups: {
       // Objects in order of first appearance; groups that lost all triangles vanish.
       std::vector<uint32_t> remap(std::max<size_t>(mesh.group_names.size(), 1), kNoObject);

@@ -1,9 +1,10 @@
 #pragma once
 /// Scene files: OBJ (keeps `o`/`g` groups), PLY (ASCII and binary), OFF (ASCII) and STL
-/// (ASCII and binary), as raw triangles without manifold repair, and an OBJ writer. Every
-/// reader is our own and strict: errors name the file and, in text, the line; declared counts
+/// (ASCII and binary), as raw triangles without manifold repair, and an OBJ writer. These
+/// readers are our own and strict: errors name the file and, in text, the line; declared counts
 /// are checked against the bytes left before anything is allocated; a truncated file is an
-/// error, never a shorter or invented mesh.
+/// error, never a shorter or invented mesh. glTF 2.0 (.gltf, .glb), FBX and a few more formats
+/// of the tools artists use are read through Assimp, with the scene graph's nodes as objects.
 #include <istream>
 #include <string>
 #include <string_view>
@@ -12,9 +13,28 @@
 
 namespace viewcells {
 
-/// Loads a scene by extension (.obj, .ply, .off, .stl). Throws Error naming the file (and the
-/// line for OBJ) when it is missing, malformed, empty or has NaN/infinite coordinates.
+/// Loads a scene by extension (.obj, .ply, .off, .stl, .bsp, and through Assimp .gltf, .glb,
+/// .fbx, .dae, .3ds, .x, .ase, .lwo, .ms3d). Throws Error naming the file (and the line for
+/// OBJ) when it is missing, malformed, empty or has NaN/infinite coordinates. The groupings
+/// kNodes and kMeshes apply to the Assimp formats only (for them kAuto and kGroups mean kNodes).
 Scene load_scene(const std::string& path, ObjectGrouping grouping = ObjectGrouping::kAuto);
+
+/// What becomes an object of a scene read through Assimp.
+enum class AssimpObjects {
+  kNodes,   ///< each node instance of the scene graph with meshes (its see-through meshes apart)
+  kMeshes,  ///< each mesh of each node instance
+};
+/// True for the extensions (lower case, with the dot) that load_scene reads through Assimp.
+bool is_assimp_extension(const std::string& ext);
+/// Reads a scene through Assimp: transforms applied (in double), the file's up axis turned to
+/// z, an instanced mesh once per node that references it, node names kept (made unique), groups
+/// not occluding (RawMesh::group_occluder) where the material is alpha-blended, alpha-tested,
+/// transmissive or not fully opaque. Points and lines are dropped.
+RawMesh read_assimp(const std::string& path, AssimpObjects mode);
+/// The same from bytes in memory; `extension` tells the format (".glb"). External buffers
+/// (a .gltf's .bin) cannot be resolved this way.
+RawMesh read_assimp_bytes(std::string_view bytes, const std::string& extension, AssimpObjects mode,
+                          const std::string& name);
 
 /// Largest coordinate magnitude a scene may hold: Embree's rays stop working beyond about 1.8e18.
 inline constexpr double kMaxCoordinate = 1e18;

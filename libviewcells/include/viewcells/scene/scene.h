@@ -19,9 +19,11 @@ enum class ObjectGrouping {
   kGroups,      ///< file groups (a file without groups gives a single object)
   kComponents,  ///< connected components (triangles sharing a vertex position)
   kTriangles,   ///< every triangle is an object
+  kNodes,       ///< scene-graph formats (glTF, FBX): each node instance with meshes
+  kMeshes,      ///< scene-graph formats: each mesh of each node instance
 };
 
-/// Parses "auto", "groups", "components", "triangles"; throws Error otherwise.
+/// Parses "auto", "groups", "components", "triangles", "nodes", "meshes"; throws Error otherwise.
 ObjectGrouping parse_grouping(const std::string& name);
 const char* to_string(ObjectGrouping g);
 

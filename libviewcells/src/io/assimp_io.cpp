@@ -1,0 +1,239 @@
+// Scenes through Assimp (glTF 2.0, FBX, COLLADA, 3DS and the other formats it reads well): the
+// scene graph's nodes, transforms and instances become objects. Assimp stays inside this file.
+#include <assimp/DefaultLogger.hpp>
+#include <assimp/GltfMaterial.h>
+#include <assimp/LogStream.hpp>
+#include <assimp/Importer.hpp>
+#include <assimp/material.h>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <mutex>
+#include <unordered_map>
+
+#include "viewcells/core/error.h"
+#include "viewcells/io/scene_io.h"
+
+namespace viewcells {
+namespace {
+
+// Guards against scene graphs that are cyclic or absurdly deep (a malformed file), and against
+// instancing that multiplies a small file into more geometry than any level holds.
+constexpr size_t kMaxNodeDepth = 256;
+constexpr uint64_t kMaxInstancedTriangles = 200'000'000;
+
+/// True when a material lets one see through it: alpha-blended or alpha-tested in glTF, glTF's
+/// transmission, or an opacity below one (FBX, COLLADA, 3DS, glTF's base colour alpha).
+bool see_through_material(const aiMaterial* m) {
+  if (!m) return false;
+  float transmission = 0;
+  if (m->Get(AI_MATKEY_TRANSMISSION_FACTOR, transmission) == AI_SUCCESS && transmission > 0) return true;
+  aiString alpha_mode;
+  if (m->Get(AI_MATKEY_GLTF_ALPHAMODE, alpha_mode) == AI_SUCCESS) {
+    // glTF: the alpha mode decides; OPAQUE ignores the base colour's alpha (which Assimp
+    // reports as the opacity).
+    const std::string mode = alpha_mode.C_Str();
+    return mode == "BLEND" || mode == "MASK";
+  }
+  float opacity = 1;
+  if (m->Get(AI_MATKEY_OPACITY, opacity) == AI_SUCCESS && std::isfinite(opacity) && opacity < 0.999f) return true;
+  return false;
+}
+
+/// Which axis is up in the file, as Assimp leaves it: glTF, COLLADA (converted by Assimp) and
+/// most others are y-up; FBX says so in its metadata. Returns the rotation to viewcells' z-up.
+aiMatrix4x4 to_z_up(const aiScene* scene) {
+  int up = 1, sign = 1;
+  if (scene->mMetaData) {
+    int32_t v = 0;
+    if (scene->mMetaData->Get("UpAxis", v) && v >= 0 && v <= 2) up = v;
+    if (scene->mMetaData->Get("UpAxisSign", v) && (v == 1 || v == -1)) sign = v;
+  }
+  aiMatrix4x4 m;  // identity: z is up already
+  if (up == 1) {  // (x, y, z) -> (x, -z, y)
+    m = aiMatrix4x4(1, 0, 0, 0, 0, 0, -1, 0, 0, 1, 0, 0, 0, 0, 0, 1);
+  } else if (up == 0) {  // (x, y, z) -> (y, z, x)
+    m = aiMatrix4x4(0, 1, 0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 0, 0, 0, 1);
+  }
+  if (sign == -1) {  // up is the negative axis: turn upside down about x
+    m = aiMatrix4x4(1, 0, 0, 0, 0, -1, 0, 0, 0, 0, -1, 0, 0, 0, 0, 1) * m;
+  }
+  return m;
+}
+
+class Builder {
+ public:
+  Builder(const aiScene* scene, AssimpObjects mode, const std::string& name) : scene_(scene), mode_(mode), name_(name) {}
+
+  RawMesh build() {
+    if (!scene_->mRootNode) throw Error(name_, 0, "the file has no scene graph (no root node)");
+    visit(scene_->mRootNode, to_z_up(scene_), "", 0);
+    return std::move(mesh_);
+  }
+
+ private:
+  void visit(const aiNode* node, const aiMatrix4x4& parent, const std::string& parent_path, size_t depth) {
+    if (depth > kMaxNodeDepth)
+      throw Error(name_, 0, "the scene graph is deeper than " + std::to_string(kMaxNodeDepth) + " nodes (cyclic?)");
+    const aiMatrix4x4 world = parent * node->mTransformation;
+    std::string label = node->mName.length ? std::string(node->mName.C_Str()) : std::string();
+    if (label.empty()) label = parent_path.empty() ? "node" : parent_path + "/node";
+    const std::string node_name = unique(label);
+    for (unsigned i = 0; i < node->mNumMeshes; ++i) {
+      const unsigned mi = node->mMeshes[i];
+      if (mi >= scene_->mNumMeshes) throw Error(name_, 0, "node '" + node_name + "' references a missing mesh");
+      const aiMesh* mesh = scene_->mMeshes[mi];
+      const aiMaterial* material =
+          mesh->mMaterialIndex < scene_->mNumMaterials ? scene_->mMaterials[mesh->mMaterialIndex] : nullptr;
+      const bool see_through = see_through_material(material);
+      std::string object = node_name;
+      if (mode_ == AssimpObjects::kMeshes) {
+        const std::string mesh_name = mesh->mName.length ? mesh->mName.C_Str() : "mesh" + std::to_string(mi);
+        object += "/" + mesh_name + (node->mNumMeshes > 1 ? "#" + std::to_string(i) : "");
+      } else if (see_through) {
+        object += " (see-through)";  // a node's opaque and see-through meshes are two objects
+      }
+      add_mesh(mesh, world, group_of(object, see_through));
+    }
+    for (unsigned c = 0; c < node->mNumChildren; ++c) visit(node->mChildren[c], world, node_name, depth + 1);
+  }
+
+  std::string unique(const std::string& label) {
+    const size_t n = ++name_uses_[label];
+    return n == 1 ? label : label + "#" + std::to_string(n);
+  }
+
+  uint32_t group_of(const std::string& object, bool see_through) {
+    auto [it, inserted] = groups_.emplace(object, static_cast<uint32_t>(mesh_.group_names.size()));
+    if (inserted) {
+      mesh_.group_names.push_back(object);
+      mesh_.group_occluder.push_back(see_through ? 0 : 1);
+    }
+    return it->second;
+  }
+
+  void add_mesh(const aiMesh* mesh, const aiMatrix4x4& world, uint32_t group) {
+    if (!(mesh->mPrimitiveTypes & aiPrimitiveType_TRIANGLE) || !mesh->mVertices) return;
+    triangles_ += mesh->mNumFaces;
+    if (triangles_ > kMaxInstancedTriangles)
+      throw Error(name_, 0, "the scene graph instances more than " + std::to_string(kMaxInstancedTriangles) +
+                                " triangles");
+    const uint32_t base = static_cast<uint32_t>(mesh_.vertices.size());
+    for (unsigned v = 0; v < mesh->mNumVertices; ++v) {
+      const aiVector3D& p = mesh->mVertices[v];
+      // In double: a level's large offsets survive the transform better than in float.
+      const double x = p.x, y = p.y, z = p.z;
+      mesh_.vertices.push_back({world.a1 * x + world.a2 * y + world.a3 * z + world.a4,
+                                world.b1 * x + world.b2 * y + world.b3 * z + world.b4,
+                                world.c1 * x + world.c2 * y + world.c3 * z + world.c4});
+    }
+    for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
+      const aiFace& face = mesh->mFaces[f];
+      if (face.mNumIndices != 3) continue;  // points and lines: nothing that occludes or is drawn as a surface
+      std::array<uint32_t, 3> tri{};
+      for (int k = 0; k < 3; ++k) {
+        if (face.mIndices[k] >= mesh->mNumVertices)
+          throw Error(name_, 0, "mesh '" + std::string(mesh->mName.C_Str()) + "' has a face index out of range");
+        tri[k] = base + face.mIndices[k];
+      }
+      mesh_.triangles.push_back(tri);
+      mesh_.triangle_group.push_back(group);
+    }
+  }
+
+  const aiScene* scene_;
+  AssimpObjects mode_;
+  std::string name_;
+  RawMesh mesh_;
+  std::unordered_map<std::string, size_t> name_uses_;
+  std::map<std::string, uint32_t> groups_;
+  uint64_t triangles_ = 0;
+};
+
+// Assimp repairs some broken input with only a warning (faces with out-of-range indices are
+// dropped). Our readers reject such files, so its warnings are collected during a read and those
+// that report lost data become errors. Assimp's logger is global; the collector is per thread.
+thread_local std::vector<std::string>* t_warnings = nullptr;
+
+class WarningCollector : public Assimp::LogStream {
+ public:
+  void write(const char* message) override {
+    if (t_warnings && t_warnings->size() < 100) t_warnings->emplace_back(message);
+  }
+};
+
+void install_logger() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    Assimp::DefaultLogger::create("", Assimp::Logger::NORMAL, 0);
+    Assimp::DefaultLogger::get()->attachStream(new WarningCollector, Assimp::Logger::Warn | Assimp::Logger::Err);
+  });
+}
+
+class CollectWarnings {
+ public:
+  CollectWarnings() { install_logger(), t_warnings = &warnings; }
+  ~CollectWarnings() { t_warnings = nullptr; }
+  /// Throws when Assimp said it dropped or could not use part of the file.
+  void check(const std::string& name) const {
+    for (const std::string& w : warnings) {
+      if (w.find("out-of-range indices") != std::string::npos || w.find("dropped") != std::string::npos) {
+        std::string text = w;
+        while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
+        if (const size_t colon = text.find(": "); colon != std::string::npos && colon < 12) text = text.substr(colon + 2);
+        throw Error(name, 0, "broken scene data (Assimp: " + text + ")");
+      }
+    }
+  }
+  std::vector<std::string> warnings;
+};
+
+constexpr unsigned kFlags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
+                            aiProcess_ValidateDataStructure | aiProcess_FindInvalidData;
+
+RawMesh convert(Assimp::Importer& importer, const aiScene* scene, AssimpObjects mode, const std::string& name) {
+  if (!scene) {
+    std::string why = importer.GetErrorString();
+    if (why.empty()) why = "Assimp could not read it";
+    throw Error(name, 0, "not a readable scene: " + why);
+  }
+  if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) throw Error(name, 0, "the file holds no meshes (incomplete scene)");
+  return Builder(scene, mode, name).build();
+}
+
+void configure(Assimp::Importer& importer) {
+  importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+}
+
+}  // namespace
+
+bool is_assimp_extension(const std::string& ext) {
+  static const char* const kExtensions[] = {".gltf", ".glb", ".fbx", ".dae", ".3ds", ".x", ".ase", ".lwo", ".ms3d"};
+  return std::any_of(std::begin(kExtensions), std::end(kExtensions), [&](const char* e) { return ext == e; });
+}
+
+RawMesh read_assimp(const std::string& path, AssimpObjects mode) {
+  CollectWarnings warnings;
+  Assimp::Importer importer;
+  configure(importer);
+  const aiScene* scene = importer.ReadFile(path, kFlags);
+  warnings.check(path);
+  return convert(importer, scene, mode, path);
+}
+
+RawMesh read_assimp_bytes(std::string_view bytes, const std::string& extension, AssimpObjects mode,
+                          const std::string& name) {
+  if (bytes.empty()) throw Error(name, 0, "empty file");
+  CollectWarnings warnings;
+  Assimp::Importer importer;
+  configure(importer);
+  const std::string hint = extension.empty() || extension[0] != '.' ? extension : extension.substr(1);
+  const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), kFlags, hint.c_str());
+  warnings.check(name);
+  return convert(importer, scene, mode, name);
+}
+
+}  // namespace viewcells

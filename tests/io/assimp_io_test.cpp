@@ -1,0 +1,167 @@
+// Scenes through Assimp: a glTF file written here (instances, transforms, names, a see-through
+// material) and real files from Debian's assimp-testmodels; broken files are rejected.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "viewcells/core/error.h"
+#include "viewcells/io/scene_io.h"
+
+namespace viewcells {
+namespace {
+
+const std::string kModels = "/usr/share/assimp/models/";
+
+std::string base64(const std::string& bytes) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < bytes.size(); i += 3) {
+    uint32_t v = uint32_t(uint8_t(bytes[i])) << 16;
+    if (i + 1 < bytes.size()) v |= uint32_t(uint8_t(bytes[i + 1])) << 8;
+    if (i + 2 < bytes.size()) v |= uint8_t(bytes[i + 2]);
+    out += k[(v >> 18) & 63];
+    out += k[(v >> 12) & 63];
+    out += i + 1 < bytes.size() ? k[(v >> 6) & 63] : '=';
+    out += i + 2 < bytes.size() ? k[v & 63] : '=';
+  }
+  return out;
+}
+
+/// A glTF 2.0 file: one unit cube mesh (y-up) instanced by nodes "left" (at x = -2) and
+/// "right" (at x = +2, scaled by 2 along y), and node "glass" with the same cube under an
+/// alpha-blended material, a child of "right" (so at x = +2 + 0, y-scaled, then moved up 3).
+std::string cube_gltf(const std::string& alpha_mode = "BLEND") {
+  const float p[8][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
+  const uint16_t idx[36] = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                            2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+  std::string buffer(reinterpret_cast<const char*>(p), sizeof p);
+  buffer.append(reinterpret_cast<const char*>(idx), sizeof idx);
+  return R"({"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,1]}],
+ "nodes":[{"name":"left","mesh":0,"translation":[-2,0,0]},
+          {"name":"right","mesh":0,"translation":[2,0,0],"scale":[1,2,1],"children":[2]},
+          {"name":"glass","mesh":1,"translation":[0,3,0]}],
+ "meshes":[{"name":"cube","primitives":[{"attributes":{"POSITION":0},"indices":1,"material":0}]},
+           {"name":"pane","primitives":[{"attributes":{"POSITION":0},"indices":1,"material":1}]}],
+ "materials":[{"name":"stone"},{"name":"glass","alphaMode":")" +
+         alpha_mode + R"(","pbrMetallicRoughness":{"baseColorFactor":[1,1,1,0.3]}}],
+ "buffers":[{"byteLength":168,"uri":"data:application/octet-stream;base64,)" +
+         base64(buffer) + R"("}],
+ "bufferViews":[{"buffer":0,"byteOffset":0,"byteLength":96},{"buffer":0,"byteOffset":96,"byteLength":72}],
+ "accessors":[{"bufferView":0,"componentType":5126,"count":8,"type":"VEC3","min":[0,0,0],"max":[1,1,1]},
+              {"bufferView":1,"componentType":5123,"count":36,"type":"SCALAR"}]})";
+}
+
+std::string write_temp(const std::string& name, const std::string& text) {
+  const auto path = std::filesystem::temp_directory_path() / ("viewcells_assimp_" + name);
+  std::ofstream(path, std::ios::binary) << text;
+  return path.string();
+}
+
+const ObjectInfo& object_named(const Scene& s, const std::string& name) {
+  for (const ObjectInfo& o : s.objects)
+    if (o.name == name) return o;
+  throw std::runtime_error("no object " + name);
+}
+
+TEST(AssimpIo, GltfNodesAreObjectsWithTransformsInstancesAndSeeThroughMaterials) {
+  const Scene s = load_scene(write_temp("cubes.gltf", cube_gltf()));
+  EXPECT_EQ(s.grouping, ObjectGrouping::kNodes);
+  ASSERT_EQ(s.object_count(), 3u);
+  EXPECT_EQ(s.triangle_count(), 36u);
+  const ObjectInfo& left = object_named(s, "left");
+  const ObjectInfo& right = object_named(s, "right");
+  const ObjectInfo& glass = object_named(s, "glass (see-through)");
+  // glTF's y is up; viewcells' z: (x, y, z) -> (x, -z, y).
+  EXPECT_NEAR(left.bounds.lo.x, -2, 1e-9);
+  EXPECT_NEAR(left.bounds.hi.x, -1, 1e-9);
+  EXPECT_NEAR(left.bounds.lo.y, -1, 1e-9);
+  EXPECT_NEAR(left.bounds.hi.z, 1, 1e-9);
+  EXPECT_NEAR(right.bounds.lo.x, 2, 1e-9);
+  EXPECT_NEAR(right.bounds.hi.z, 2, 1e-9);  // scaled by 2 along glTF's y, which is up
+  // The child: its parent's transform applies to its own (y + 3, then the parent's y scale).
+  EXPECT_NEAR(glass.bounds.lo.z, 6, 1e-9);
+  EXPECT_NEAR(glass.bounds.hi.z, 8, 1e-9);
+  for (const ObjectInfo* o : {&left, &right}) {
+    EXPECT_TRUE(o->occluder);
+    EXPECT_TRUE(o->solid()) << o->name;  // a transform keeps a closed, outward cube so
+  }
+  EXPECT_FALSE(glass.occluder);
+  EXPECT_TRUE(glass.rendered);
+}
+
+TEST(AssimpIo, MeshesGroupingAndTheOtherGroupingsApply) {
+  const std::string path = write_temp("cubes2.gltf", cube_gltf("MASK"));
+  const Scene meshes = load_scene(path, ObjectGrouping::kMeshes);
+  EXPECT_EQ(meshes.grouping, ObjectGrouping::kMeshes);
+  ASSERT_EQ(meshes.object_count(), 3u);
+  EXPECT_FALSE(object_named(meshes, "glass/pane").occluder);  // alpha-tested: seen through too
+  EXPECT_EQ(load_scene(path, ObjectGrouping::kTriangles).object_count(), 36u);
+  EXPECT_EQ(load_scene(path, ObjectGrouping::kComponents).object_count(), 3u);
+  const Scene opaque = load_scene(write_temp("cubes3.gltf", cube_gltf("OPAQUE")));
+  // OPAQUE ignores the base colour's alpha (glTF 2.0, 3.9.4), though Assimp reports it as the
+  // opacity: all three occlude.
+  for (const ObjectInfo& o : opaque.objects) EXPECT_TRUE(o.occluder) << o.name;
+  EXPECT_EQ(opaque.object_count(), 3u);
+}
+
+TEST(AssimpIo, NodesAndMeshesApplyOnlyToSceneGraphFormats) {
+  const std::string obj = write_temp("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  EXPECT_THROW(load_scene(obj, ObjectGrouping::kNodes), Error);
+  EXPECT_THROW(load_scene(obj, ObjectGrouping::kMeshes), Error);
+  EXPECT_EQ(parse_grouping("nodes"), ObjectGrouping::kNodes);
+  EXPECT_STREQ(to_string(ObjectGrouping::kMeshes), "meshes");
+}
+
+TEST(AssimpIo, RealFilesFromAssimpTestModels) {
+  ASSERT_TRUE(std::filesystem::exists(kModels)) << "install assimp-testmodels (scripts/install-deps.sh)";
+  const Scene engine = load_scene(kModels + "glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb");
+  EXPECT_GT(engine.triangle_count(), 100000u);
+  EXPECT_GT(engine.object_count(), 50u);
+  const Scene cubes = load_scene(kModels + "FBX/cubes_with_names.fbx");
+  EXPECT_EQ(cubes.object_count(), 4u);
+  for (const ObjectInfo& o : cubes.objects) EXPECT_TRUE(o.closed) << o.name;
+  const Scene duck = load_scene(kModels + "Collada/duck.dae");
+  EXPECT_GT(duck.triangle_count(), 1000u);
+  // Clear-coat samples: one of its materials is alpha-blended.
+  const Scene coat = load_scene(kModels + "glTF2/ClearCoat-glTF/ClearCoatTest.gltf");
+  int see_through = 0;
+  for (const ObjectInfo& o : coat.objects) see_through += !o.occluder;
+  EXPECT_GE(see_through, 1);
+}
+
+void expect_error(const std::string& path, const std::string& fragment) {
+  try {
+    load_scene(path);
+    FAIL() << "no error for " << path;
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+}
+
+TEST(AssimpIo, BrokenFilesAreErrorsNamingTheFile) {
+  expect_error(kModels + "glTF2/IndexOutOfRange/IndexOutOfRange.gltf", "out-of-range");
+  expect_error(kModels + "glTF2/RecursiveNodes/RecursiveNodes.gltf", "not a readable scene");
+  expect_error(kModels + "glTF2/MissingBin/BoxTextured.gltf", "not a readable scene");
+  expect_error(kModels + "glTF2/TestNoRootNode/NoScene.gltf", "not a readable scene");
+  // Truncated binary glTF and FBX, at several lengths.
+  for (const std::string& real :
+       {kModels + "glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb", kModels + "FBX/cubes_with_names.fbx"}) {
+    std::ifstream in(real, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    ASSERT_GT(bytes.size(), 1000u);
+    const std::string ext = std::filesystem::path(real).extension().string();
+    for (double share : {0.0, 0.01, 0.5, 0.9}) {
+      const std::string cut = bytes.substr(0, static_cast<size_t>(share * bytes.size()));
+      EXPECT_THROW(load_scene(write_temp("cut" + ext, cut)), Error) << real << " cut at " << share;
+      EXPECT_THROW(read_assimp_bytes(cut, ext, AssimpObjects::kNodes, "memory" + ext), Error);
+    }
+  }
+  expect_error(write_temp("garbage.glb", std::string(4096, '\x7f')), "not a readable scene");
+}
+
+}  // namespace
+}  // namespace viewcells
