@@ -18,7 +18,7 @@ int run(int argc, char** argv) {
       "viewcells: builds view cells for visibility preprocessing from the visibility of the scene itself.\n"
       "Pipeline: generate or load a scene -> sample visibility segments -> subdivide the view space\n"
       "into cells and merge them into a hierarchy (build) -> cut view cells from it (extract) ->\n"
-      "write their compressed PVS (compress, or by AGVS: pvs) -> look a viewpoint up (query).\n"
+      "write their compressed PVS (compress, or by AGVS: pvs) -> look a viewpoint up (query), look at the cells (view: web page, glTF).\n"
       "bake does the whole chain in one command under a budget of cells or bytes."};
   app.require_subcommand(1);
   app.fallthrough();

@@ -1,9 +1,12 @@
-// extract, compress, query: view cells cut from the merge history, their PVSs, a viewpoint.
+// extract, compress, query, view: view cells cut from the merge history, their PVSs, a viewpoint,
+// and views of them for people (a web page, glTF).
 #include <iostream>
 #include <memory>
 
 #include "options.h"
 #include "viewcells/core/error.h"
+#include "viewcells/io/scene_io.h"
+#include "viewcells/vis/level_view.h"
 #include "viewcells/pipeline/cut.h"
 #include "viewcells/pipeline/report.h"
 
@@ -72,6 +75,36 @@ int run_query(const QueryArgs& q) {
   return 0;
 }
 
+struct ViewArgs {
+  std::string input, scene, site, gltf, objects = "auto";
+  double cost_a = CostModel{}.a, cost_b = CostModel{}.b;
+};
+
+int run_view(const ViewArgs& a, const Common& c) {
+  if (a.site.empty() && a.gltf.empty()) throw Error("view writes a web page (-o DIR) or glTF (--gltf FILE): give one");
+  check_files({a.input, a.scene}, {a.gltf});
+  if (!a.site.empty() && !web_viewer_available())  // before any work
+    throw Error("this viewcells was built without the web viewer (web/node_modules was missing): run "
+                "scripts/install-deps.sh, then build again");
+  CostModel model;
+  model.a = a.cost_a;
+  model.b = a.cost_b;
+  model.validate();
+  PvsFile f = read_pvs(a.input);
+  const Scene scene = load_scene(a.scene, parse_grouping(a.objects));
+  const LevelView view = make_level_view(std::move(f), scene, model);
+  if (!a.gltf.empty()) {
+    write_level_gltf(a.gltf, view);
+    c.log("viewcells: wrote " + a.gltf + " (" + std::to_string(view.pvs.size()) + " view cells, " +
+          std::to_string(view.object_names.size()) + " objects)");
+  }
+  if (!a.site.empty()) {
+    write_web_viewer(a.site, view);
+    c.log("viewcells: wrote " + a.site + "/index.html (open it in a browser; it needs no server)");
+  }
+  return 0;
+}
+
 }  // namespace
 
 void add_cut_commands(CLI::App& app, const Common& common, Commands& commands) {
@@ -101,6 +134,23 @@ void add_cut_commands(CLI::App& app, const Common& common, Commands& commands) {
   qy->add_option("point", q->point, "X Y Z")->required()->expected(3);
   qy->add_flag("--json", q->json_out, "Print JSON");
   commands.push_back({qy, [q] { return run_query(*q); }});
+
+  auto v = std::make_shared<ViewArgs>();
+  auto* vw = app.add_subcommand(
+      "view",
+      "Look at view cells and what they see: a static web page (three.js; the scene, the cells coloured by render "
+      "cost or PVS size, a clicked cell's PVS lit and the rest dimmed) and/or a glTF file for Blender or an engine");
+  vw->add_option("pvs", v->input, "A .pvs file (from compress, pvs or bake)")->required();
+  vw->add_option("--scene", v->scene, "The scene the .pvs file was made for")->required();
+  vw->add_option("-o,--output", v->site, "Directory to write the web page into (index.html, viewer.js, data.js)");
+  vw->add_option("--gltf", v->gltf,
+                 "Binary glTF (.glb) to write: the scene's objects, and one node per view cell coloured by render "
+                 "cost with its PVS in the node's extras");
+  vw->add_option("--objects", v->objects, "Object grouping used when the .pvs file was made")->capture_default_str();
+  vw->add_option("--cost-a", v->cost_a, "Render cost model for the colours: r = max(a, b * triangles)")
+      ->capture_default_str();
+  vw->add_option("--cost-b", v->cost_b, "Render cost model: cost per triangle")->capture_default_str();
+  commands.push_back({vw, [v, &common] { return run_view(*v, common); }});
 }
 
 }  // namespace viewcells::cli

@@ -126,7 +126,7 @@ void add_view_options(CLI::App* app, pipeline::ViewsConfig& v, const std::string
 /// The subcommands, by file.
 void add_scene_commands(CLI::App& app, const Common& common, Commands& commands);    // generate, info, sample, isa
 void add_build_commands(CLI::App& app, const Common& common, Commands& commands);    // build, export
-void add_cut_commands(CLI::App& app, const Common& common, Commands& commands);      // extract, compress, query
+void add_cut_commands(CLI::App& app, const Common& common, Commands& commands);      // extract, compress, query, view
 void add_pvs_commands(CLI::App& app, const Common& common, Commands& commands);      // pvs, bake
 void add_compare_command(CLI::App& app, const Common& common, Commands& commands);   // compare
 

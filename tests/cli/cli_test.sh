@@ -38,7 +38,7 @@ json_get() {
 
 # --help explains every subcommand.
 expect_ok "$VC" --help
-for sub in generate info sample build export extract compress pvs query compare bake; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
+for sub in generate info sample build export extract compress pvs query view compare bake; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
 expect_ok "$VC" sample --help
 grep -q -- "--measure-raw" out.txt && ok || bad "sample --help lacks --measure-raw"
 
@@ -187,6 +187,19 @@ import json; r=json.load(open('out.txt')); assert r['cells'] == 16 and len(r['pv
 expect_error "outside the view space" "$VC" query office.pvs 1e6 0 0
 head -c 60 office.pvs > cut.pvs
 expect_error "cut.pvs" "$VC" query cut.pvs 2 2 1.5
+# view: the cells as a web page and as glTF (read back through Assimp: the scene's objects and
+# one translucent object per view cell).
+expect_ok "$VC" view office.pvs --scene office.obj -o site --gltf cells.glb -q
+[ -s site/index.html ] && [ -s site/viewer.js ] && grep -q "^window.VIEWCELLS_DATA = " site/data.js && ok || bad "view: site"
+expect_ok "$VC" info cells.glb --list
+[ "$(grep -c '	cell [0-9]* (see-through)$' out.txt)" = 16 ] && ok || bad "view: glTF cells: $(grep -c cell out.txt)"
+cp cells.glb cells-before.glb
+expect_error "fingerprints differ" "$VC" view office.pvs --scene rotated.obj --gltf cells.glb
+cmp -s cells.glb cells-before.glb && ok || bad "a failed view changed the earlier glTF"
+expect_error "give one" "$VC" view office.pvs --scene office.obj
+expect_error "not a directory" "$VC" view office.pvs --scene office.obj -o office.obj
+expect_error "cut.pvs" "$VC" view cut.pvs --scene office.obj -o site2
+[ ! -e site2 ] && ok || bad "a failed view created its directory"
 # pvs: the cells' PVSs by global visibility sampling, written like compress's.
 expect_ok "$VC" pvs office.vcells --scene office.obj --cells 16 --samples 40000 -o agvs.pvs --report agvs.json -q
 python3 -c "

@@ -95,9 +95,12 @@ TEST(SceneLoader, EmptyMissingAndUnknownFilesAreErrors) {
   test::write_file(flat, "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n");
   expect_load_error(flat, {"degenerate"});
   expect_load_error(test::temp_path("missing.obj"), {"no such file"});
-  const std::string unknown = test::temp_path("scene.fbx");
+  const std::string unknown = test::temp_path("scene.blend");
   test::write_file(unknown, "x");
   expect_load_error(unknown, {"unknown scene format"});
+  const std::string one_byte_fbx = test::temp_path("scene.fbx");  // read through Assimp, and refused
+  test::write_file(one_byte_fbx, "x");
+  expect_load_error(one_byte_fbx, {"not a readable scene"});
 }
 
 // A closed unit cube in each mesh format (ASCII, inline so the bytes are visible).

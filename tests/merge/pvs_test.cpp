@@ -2,17 +2,23 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstring>
 #include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
 
 #include "support/test_scenes.h"
 #include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/rng.h"
+#include "viewcells/io/scene_io.h"
 #include "viewcells/merge/merge.h"
 #include "viewcells/pvs/pvs.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
 #include "viewcells/scene/generators.h"
+#include "viewcells/vis/level_view.h"
 
 namespace viewcells {
 namespace {
@@ -183,6 +189,94 @@ TEST(Pvs, HierarchyFileKeepsTheMergeHistory) {
   bad.history->nodes[h.leaf_count].child[0] = static_cast<int32_t>(h.nodes.size() - 1);
   write_subdivision(path, bad);
   EXPECT_THROW(read_subdivision(path), Error);
+}
+
+/// The .pvs file of `count` view cells, as compress writes it.
+PvsFile pvs_file_of(const Built& b, size_t count) {
+  PvsFile f = make_pvs_file(b.file.subdivision, b.file.leaf_pvs, *b.file.history, extract_by_count(*b.file.history, count).cells);
+  f.object_count = b.file.object_count;
+  f.object_names = b.file.object_names;
+  f.scene_fingerprint = b.file.scene_fingerprint;
+  return f;
+}
+
+/// Signed volume enclosed by the triangles of group g (divergence theorem).
+double group_volume(const GroupedMesh& m, size_t g) {
+  double v = 0;
+  for (uint32_t i = m.first_index[g]; i < m.first_index[g + 1]; i += 3) {
+    auto p = [&](uint32_t k) {
+      const uint32_t x = m.indices[i + k];
+      return Vec3{m.positions[3 * x], m.positions[3 * x + 1], m.positions[3 * x + 2]};
+    };
+    v += dot(p(0), cross(p(1), p(2))) / 6;
+  }
+  return v;
+}
+
+TEST(LevelView, CellsFillTheViewBoxAndCarryTheirPvs) {
+  const Built b = build(GeneratorKind::kOffice, 1, 15000, 80);
+  const PvsFile f = pvs_file_of(b, 12);
+  const LevelView v = make_level_view(f, b.scene, CostModel{});
+  ASSERT_EQ(v.cells.group_count(), 12u);
+  ASSERT_EQ(v.scene.group_count(), b.scene.object_count());
+  // The cells' leaves, each shrunk by 0.97 about its centroid, fill the view box.
+  double volume = 0;
+  for (size_t c = 0; c < 12; ++c) {
+    const double cv = group_volume(v.cells, c);
+    EXPECT_GT(cv, 0) << "cell " << c << " has no outward closed geometry";
+    volume += cv;
+  }
+  const Box3& box = f.bsp.view_box;
+  const double box_volume = (box.hi.x - box.lo.x) * (box.hi.y - box.lo.y) * (box.hi.z - box.lo.z);
+  EXPECT_NEAR(volume, std::pow(0.97, 3) * box_volume, 1e-4 * box_volume);
+  const std::vector<double> base = per_object_costs(b.scene, CostModel{});
+  for (uint32_t c = 0; c < 12; ++c) {
+    EXPECT_EQ(v.pvs[c], f.pvs.cell_pvs(c));
+    double cost = 0;
+    for (uint32_t o : v.pvs[c]) cost += base[o];
+    EXPECT_DOUBLE_EQ(v.cell_cost[c], cost);
+  }
+  for (uint32_t o = 0; o < b.scene.object_count(); ++o)
+    EXPECT_EQ(v.scene.first_index[o + 1] - v.scene.first_index[o], 3 * b.scene.objects[o].triangle_count);
+  // A different scene is refused.
+  EXPECT_THROW(make_level_view(f, generate_scene({GeneratorKind::kOffice, 2, 1}), CostModel{}), Error);
+}
+
+TEST(LevelView, GltfRoundTripsThroughAssimpWithTheCellsPvsInExtras) {
+  const Built b = build(GeneratorKind::kOffice, 1, 15000, 80);
+  const PvsFile f = pvs_file_of(b, 9);
+  const LevelView v = make_level_view(f, b.scene, CostModel{});
+  const std::string path = test::temp_path("level.glb");
+  write_level_gltf(path, v);
+  // Read back (glTF is y-up; the writer turned z-up into it, the reader turns it back).
+  const Scene back = load_scene(path, ObjectGrouping::kNodes);
+  ASSERT_EQ(back.object_count(), b.scene.object_count() + 9);
+  for (uint32_t o = 0; o < b.scene.object_count(); ++o) {
+    const ObjectInfo &a = b.scene.objects[o], &r = back.objects[o];
+    EXPECT_EQ(r.name, a.name);
+    EXPECT_EQ(r.triangle_count, a.triangle_count);
+    EXPECT_NEAR(r.bounds.lo.x, a.bounds.lo.x, 1e-5);
+    EXPECT_NEAR(r.bounds.hi.z, a.bounds.hi.z, 1e-5);
+    EXPECT_NEAR(r.bounds.lo.y, a.bounds.lo.y, 1e-5);
+  }
+  for (uint32_t c = 0; c < 9; ++c) EXPECT_FALSE(back.objects[b.scene.object_count() + c].occluder);
+  // The cells' extras: id, render cost, PVS.
+  std::ifstream in(path, std::ios::binary);
+  const std::string glb((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  ASSERT_EQ(glb.substr(0, 4), "glTF");
+  uint32_t json_bytes = 0;
+  std::memcpy(&json_bytes, glb.data() + 12, 4);
+  const auto doc = nlohmann::json::parse(glb.substr(20, json_bytes));
+  size_t seen = 0;
+  for (const auto& node : doc["nodes"]) {
+    if (!node.contains("extras") || !node["extras"].contains("cell")) continue;
+    const uint32_t c = node["extras"]["cell"];
+    EXPECT_EQ(node["extras"]["pvs"].get<std::vector<uint32_t>>(), f.pvs.cell_pvs(c));
+    EXPECT_DOUBLE_EQ(node["extras"]["render_cost"].get<double>(), v.cell_cost[c]);
+    ++seen;
+  }
+  EXPECT_EQ(seen, 9u);
+  EXPECT_EQ(doc["asset"]["extras"]["viewcells"]["objects"].size(), b.scene.object_count());
 }
 
 }  // namespace

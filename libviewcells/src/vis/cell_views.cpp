@@ -13,9 +13,6 @@
 
 namespace viewcells {
 
-namespace {
-
-/// Blue -> cyan -> green -> yellow -> red for t in [0, 1].
 void cost_colour(double t, unsigned char rgb[3]) {
   t = std::clamp(t, 0.0, 1.0);
   const double r = std::clamp(std::min(4 * t - 1.5, -4 * t + 4.5), 0.0, 1.0);
@@ -25,6 +22,8 @@ void cost_colour(double t, unsigned char rgb[3]) {
   rgb[1] = static_cast<unsigned char>(255 * g);
   rgb[2] = static_cast<unsigned char>(255 * b);
 }
+
+namespace {
 
 double max_leaf_value(const Subdivision& s, const CellView* view) {
   double m = 0;

@@ -11,6 +11,9 @@
 
 namespace viewcells {
 
+/// The colour scale of every view: blue -> cyan -> green -> yellow -> red for t in [0, 1].
+void cost_colour(double t, unsigned char rgb[3]);
+
 /// How the views below draw the leaves when they show larger cells (e.g. extracted ones):
 /// per BSP node, the value its colour comes from and the cell it belongs to.
 struct CellView {

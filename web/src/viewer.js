@@ -1,0 +1,273 @@
+// The viewcells web viewer: the scene, the view cells coloured by render cost or PVS size, and
+// a chosen cell's PVS lit with the rest dimmed. Reads window.VIEWCELLS_DATA (data.js, written
+// by `viewcells view`); bundled with three.js by esbuild into viewer.js.
+// window.viewcells exposes the state for tests and scripts: ready, selected {point, cell, pvs},
+// select(point), locate(point), frameTimes().
+import * as THREE from 'three';
+import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
+
+const D = window.VIEWCELLS_DATA;
+
+function decode(text, Type) {
+  const bin = atob(text);
+  const bytes = new Uint8Array(bin.length);
+  for (let i = 0; i < bin.length; ++i) bytes[i] = bin.charCodeAt(i);
+  return new Type(bytes.buffer);
+}
+
+// The colour scale of the toolkit's PNG and PLY views: blue, cyan, green, yellow, red.
+function scale(t) {
+  t = Math.min(1, Math.max(0, t));
+  const c = (x) => Math.min(1, Math.max(0, x));
+  return [c(Math.min(4 * t - 1.5, -4 * t + 4.5)), c(Math.min(4 * t - 0.5, -4 * t + 3.5)),
+          c(Math.min(4 * t + 0.5, -4 * t + 2.5))];
+}
+
+// Point location in the .pvs file's BSP, by the toolkit's rule (points on a plane go to its
+// negative side; outside the view box: -1).
+const planes = D.bsp.planes, nodes = D.bsp.nodes, leafCell = D.bsp.leaf_cell, box = D.view_box;
+function locate(p) {
+  for (let k = 0; k < 3; ++k) if (!(p[k] >= box[k] && p[k] <= box[k + 3])) return -1;
+  let n = 0;
+  while (nodes[n][0] >= 0) {
+    const [nx, ny, nz, offset, axis] = planes[nodes[n][0]];
+    const d = axis >= 0 ? p[axis] - offset : nx * p[0] + ny * p[1] + nz * p[2] - offset;
+    n = nodes[n][d > 0 ? 2 : 1];
+  }
+  return leafCell[n];
+}
+
+// --- scene ---------------------------------------------------------------------------------
+const objects = {
+  count: D.objects.count,
+  triangles: decode(D.objects.triangles, Uint32Array),
+  cost: decode(D.objects.cost, Float32Array),
+  seeThrough: decode(D.objects.see_through, Uint8Array),
+  firstVertex: decode(D.objects.first_vertex, Uint32Array),
+};
+const sceneGeometry = new THREE.BufferGeometry();
+const scenePositions = decode(D.objects.positions, Float32Array);
+sceneGeometry.setAttribute('position', new THREE.BufferAttribute(scenePositions, 3));
+sceneGeometry.setIndex(new THREE.BufferAttribute(decode(D.objects.indices, Uint32Array), 1));
+const sceneColours = new Uint8Array(scenePositions.length);
+sceneGeometry.setAttribute('color', new THREE.BufferAttribute(sceneColours, 3, true));
+sceneGeometry.computeBoundingBox();
+sceneGeometry.computeBoundingSphere();
+const sceneMesh = new THREE.Mesh(sceneGeometry,
+    new THREE.MeshLambertMaterial({ vertexColors: true, flatShading: true, side: THREE.DoubleSide }));
+
+function paintObject(o, rgb) {
+  for (let v = objects.firstVertex[o]; v < objects.firstVertex[o + 1]; ++v) {
+    sceneColours[3 * v] = rgb[0]; sceneColours[3 * v + 1] = rgb[1]; sceneColours[3 * v + 2] = rgb[2];
+  }
+}
+const PLAIN = [190, 188, 180], GLASS = [120, 170, 220], LIT = [255, 214, 140], LIT_GLASS = [150, 220, 255],
+      DIM = [52, 55, 62];
+function paintScene(pvs) {
+  const lit = pvs ? new Uint8Array(objects.count) : null;
+  if (pvs) for (const o of pvs) lit[o] = 1;
+  for (let o = 0; o < objects.count; ++o) {
+    const glass = objects.seeThrough[o];
+    paintObject(o, !pvs ? (glass ? GLASS : PLAIN) : lit[o] ? (glass ? LIT_GLASS : LIT) : DIM);
+  }
+  sceneGeometry.attributes.color.needsUpdate = true;
+}
+
+// --- cells ---------------------------------------------------------------------------------
+const cells = {
+  count: D.cells.count,
+  pvs: D.cells.pvs,
+  cost: decode(D.cells.cost, Float32Array),
+  positions: decode(D.cells.positions, Float32Array),
+  indices: decode(D.cells.indices, Uint32Array),
+  firstVertex: decode(D.cells.first_vertex, Uint32Array),
+  firstIndex: decode(D.cells.first_index, Uint32Array),
+};
+const cellGeometry = new THREE.BufferGeometry();
+cellGeometry.setAttribute('position', new THREE.BufferAttribute(cells.positions, 3));
+cellGeometry.setIndex(new THREE.BufferAttribute(cells.indices, 1));
+const cellColours = new Float32Array(cells.positions.length);
+cellGeometry.setAttribute('color', new THREE.BufferAttribute(cellColours, 3));
+const cellMesh = new THREE.Mesh(cellGeometry, new THREE.MeshBasicMaterial({
+  vertexColors: true, transparent: true, opacity: 0.22, depthWrite: false, side: THREE.DoubleSide }));
+cellMesh.renderOrder = 1;
+
+function cellValue(c, mode) { return mode === 'pvs' ? cells.pvs[c].length : cells.cost[c]; }
+function paintCells(mode) {
+  let max = 0;
+  for (let c = 0; c < cells.count; ++c) max = Math.max(max, cellValue(c, mode));
+  max = max > 0 ? max : 1;
+  for (let c = 0; c < cells.count; ++c) {
+    const rgb = scale(cellValue(c, mode) / max);
+    for (let v = cells.firstVertex[c]; v < cells.firstVertex[c + 1]; ++v) cellColours.set(rgb, 3 * v);
+  }
+  cellGeometry.attributes.color.needsUpdate = true;
+  document.getElementById('range').textContent = mode === 'pvs'
+    ? `PVS size: 0 to ${max} objects`
+    : `r(PVS) = sum of max(${D.cost_model.a}, ${D.cost_model.b} × triangles): 0 to ${Math.round(max)}`;
+}
+
+// The chosen cell, drawn on its own: translucent white and its edges.
+const selectedGroup = new THREE.Group();
+function showSelectedCell(c) {
+  selectedGroup.clear();
+  if (c < 0) return;
+  const v0 = cells.firstVertex[c], v1 = cells.firstVertex[c + 1];
+  const i0 = cells.firstIndex[c], i1 = cells.firstIndex[c + 1];
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.BufferAttribute(cells.positions.slice(3 * v0, 3 * v1), 3));
+  g.setIndex(Array.from(cells.indices.subarray(i0, i1), (i) => i - v0));
+  const fill = new THREE.Mesh(g, new THREE.MeshBasicMaterial({
+    color: 0xffffff, transparent: true, opacity: 0.25, depthWrite: false, side: THREE.DoubleSide }));
+  fill.renderOrder = 2;
+  selectedGroup.add(fill);
+  selectedGroup.add(new THREE.LineSegments(new THREE.EdgesGeometry(g), new THREE.LineBasicMaterial({ color: 0xffffff })));
+}
+
+// --- view ----------------------------------------------------------------------------------
+const container = document.getElementById('view');
+const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio || 1);
+renderer.setSize(container.clientWidth, container.clientHeight);
+container.appendChild(renderer.domElement);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0x15171c);
+scene.add(new THREE.HemisphereLight(0xffffff, 0x404050, 1.6));
+const sun = new THREE.DirectionalLight(0xffffff, 1.4);
+sun.position.set(0.4, -0.6, 1);
+scene.add(sun, sceneMesh, cellMesh, selectedGroup);
+
+const bounds = sceneGeometry.boundingBox;
+const size = new THREE.Vector3(), centre = new THREE.Vector3();
+bounds.getSize(size); bounds.getCenter(centre);
+const diagonal = size.length();
+const camera = new THREE.PerspectiveCamera(60, container.clientWidth / container.clientHeight,
+                                           diagonal * 1e-4, diagonal * 10);
+camera.up.set(0, 0, 1);
+const controls = new OrbitControls(camera, renderer.domElement);
+
+// The start view: #camera=x,y,z&target=x,y,z in the address, else from above one corner.
+const hash = new URLSearchParams(location.hash.slice(1));
+const vec = (s) => { const v = (s || '').split(',').map(Number); return v.length === 3 && v.every(Number.isFinite) ? v : null; };
+const target = vec(hash.get('target')) || centre.toArray();
+const eye = vec(hash.get('camera')) ||
+    [centre.x - 0.55 * size.x, centre.y - 0.85 * size.y, centre.z + 0.6 * size.z + 0.45 * Math.max(size.x, size.y)];
+camera.position.fromArray(eye);
+controls.target.fromArray(target);
+controls.update();
+
+window.addEventListener('resize', () => {
+  camera.aspect = container.clientWidth / container.clientHeight;
+  camera.updateProjectionMatrix();
+  renderer.setSize(container.clientWidth, container.clientHeight);
+});
+
+// --- choosing a cell -----------------------------------------------------------------------
+const state = { ready: false, selected: null, follow: false };
+const totalTriangles = objects.triangles.reduce((a, b) => a + b, 0);
+const fmt = (x) => x.toLocaleString('en-US', { maximumFractionDigits: 0 });
+
+function select(point) {
+  const cell = point ? locate(point) : -1;
+  if (!point) {
+    state.selected = null;
+    paintScene(null);
+    showSelectedCell(-1);
+    document.getElementById('selection').textContent = 'Nothing chosen.';
+    return state.selected;
+  }
+  const p = point.map((x) => +x.toFixed(4));
+  if (cell < 0) {
+    state.selected = { point: p, cell: -1, pvs: [] };
+    paintScene(null);
+    showSelectedCell(-1);
+    document.getElementById('selection').textContent = `(${p.join(', ')}) is outside the view space.`;
+    return state.selected;
+  }
+  const pvs = cells.pvs[cell];
+  let triangles = 0, cost = 0;
+  for (const o of pvs) { triangles += objects.triangles[o]; cost += objects.cost[o]; }
+  state.selected = { point: p, cell, pvs: pvs.slice() };
+  paintScene(pvs);
+  showSelectedCell(cellsMode() === 'none' ? -1 : cell);
+  cellMesh.visible = cellsMode() === 'all';
+  document.getElementById('selection').textContent =
+      `cell ${cell} of ${cells.count} at (${p.join(', ')})\n` +
+      `sees ${fmt(pvs.length)} of ${fmt(objects.count)} objects, ` +
+      `${fmt(triangles)} of ${fmt(totalTriangles)} triangles\n` +
+      `r(PVS) = ${fmt(cost)}`;
+  return state.selected;
+}
+
+const cellsMode = () => document.getElementById('cells').value;
+document.getElementById('cells').addEventListener('change', () => {
+  cellMesh.visible = cellsMode() === 'all';
+  showSelectedCell(state.selected && cellsMode() !== 'none' ? state.selected.cell : -1);
+});
+document.getElementById('colour').addEventListener('change', (e) => paintCells(e.target.value));
+const follow = document.getElementById('follow');
+follow.addEventListener('change', () => { state.follow = follow.checked; lastFollowCell = null; });
+
+const raycaster = new THREE.Raycaster();
+// A click (not a drag) on a surface: the viewpoint is a little in front of the surface, on the
+// ray towards the camera.
+let down = null;
+renderer.domElement.addEventListener('pointerdown', (e) => { down = [e.clientX, e.clientY]; });
+renderer.domElement.addEventListener('pointerup', (e) => {
+  if (!down || Math.hypot(e.clientX - down[0], e.clientY - down[1]) > 4) return;
+  const r = renderer.domElement.getBoundingClientRect();
+  const ndc = new THREE.Vector2(((e.clientX - r.left) / r.width) * 2 - 1, -((e.clientY - r.top) / r.height) * 2 + 1);
+  raycaster.setFromCamera(ndc, camera);
+  const hit = raycaster.intersectObject(sceneMesh, false)[0];
+  if (!hit) return;
+  const back = Math.min(hit.distance * 0.5, diagonal * 0.002);
+  const p = hit.point.clone().addScaledVector(raycaster.ray.direction, -back);
+  follow.checked = state.follow = false;
+  select(p.toArray());
+});
+window.addEventListener('keydown', (e) => {
+  if (e.key === 'Escape') select(null);
+  if (e.key === 'f' || e.key === 'F') { follow.checked = state.follow = !state.follow; lastFollowCell = null; }
+});
+
+// --- frames --------------------------------------------------------------------------------
+const frameTimes = [];
+let last = performance.now(), lastFollowCell = null;
+const spin = hash.get('spin') === '1';
+function frame(now) {
+  frameTimes.push(now - last);
+  if (frameTimes.length > 240) frameTimes.shift();
+  last = now;
+  if (spin) {  // turn about the target: every frame draws a new view (for measuring)
+    const o = camera.position.clone().sub(controls.target);
+    o.applyAxisAngle(new THREE.Vector3(0, 0, 1), 0.01);
+    camera.position.copy(controls.target).add(o);
+  }
+  controls.update();
+  if (state.follow) {
+    const p = camera.position.toArray();
+    const c = locate(p);
+    if (c !== lastFollowCell) { lastFollowCell = c; select(p); }
+  }
+  renderer.render(scene, camera);
+  if (frameTimes.length % 30 === 0) {
+    const recent = frameTimes.slice(-30);
+    document.getElementById('fps').textContent =
+        `${(recent.reduce((a, b) => a + b, 0) / recent.length).toFixed(1)} ms per frame`;
+  }
+  requestAnimationFrame(frame);
+}
+
+document.getElementById('title').textContent = `viewcells: ${D.scene.split('/').pop()}`;
+document.getElementById('summary').textContent =
+    `${fmt(cells.count)} view cells (${D.rule}) · ${fmt(objects.count)} objects · ${fmt(totalTriangles)} triangles`;
+paintScene(null);
+paintCells('cost');
+window.viewcells = {
+  get ready() { return state.ready; },
+  get selected() { return state.selected; },
+  select, locate,
+  frameTimes: () => frameTimes.slice(),
+  camera, controls,
+};
+requestAnimationFrame((t) => { last = t; state.ready = true; frame(t); });

@@ -1,0 +1,88 @@
+// The web viewer in a real browser: a generated office is baked, `viewcells view` writes the
+// site, headless Chromium opens it, the test clicks the middle of the picture and checks that
+// the cell and PVS the page highlights are what `viewcells query` says for the point the page
+// chose; the screenshot (kept in WORK/viewer.png) must not be blank, and the page must log no
+// errors. Usage: node viewer_test.mjs VIEWCELLS_BINARY WORK_DIR
+import { execFileSync } from 'node:child_process';
+import { mkdirSync, rmSync, readFileSync } from 'node:fs';
+import { join, resolve } from 'node:path';
+import { launch, openSite } from './browser.mjs';
+
+const [viewcells, workArg] = process.argv.slice(2);
+if (!viewcells || !workArg) { console.error('usage: node viewer_test.mjs VIEWCELLS WORK_DIR'); process.exit(2); }
+const work = resolve(workArg);
+rmSync(work, { recursive: true, force: true });
+mkdirSync(work, { recursive: true });
+const run = (...args) => execFileSync(viewcells, ['-q', ...args], { cwd: work, encoding: 'utf8' });
+const fail = (why) => { console.error('FAIL: ' + why); process.exitCode = 1; };
+
+run('generate', 'office', '--size', '1', '-o', 'office.obj');
+run('bake', 'office.obj', '--cells', '24', '--samples', '60000', '--max-cells', '150', '--agvs-samples', '100000',
+    '--merge-pvs', 'samples', '-o', 'office.pvs');
+run('view', 'office.pvs', '--scene', 'office.obj', '-o', 'site', '--gltf', 'office-cells.glb');
+
+// Inside the building, at eye height over the middle of the floor plan, looking down ahead.
+const info = JSON.parse(readFileSync(join(work, 'site', 'data.js'), 'utf8').replace(/^window\.VIEWCELLS_DATA = /, '').replace(/;\s*$/, ''));
+const [x0, y0, z0, x1, y1] = info.view_box;
+const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2, eyeZ = z0 + 1.6;
+const hash = `camera=${cx - 2},${cy},${eyeZ}&target=${cx + 1},${cy},${z0 + 0.2}`;
+
+const browser = await launch();
+try {
+  const { page, errors } = await openSite(browser, join(work, 'site', 'index.html'), hash);
+  const box = await page.locator('canvas').boundingBox();
+  await page.mouse.click(box.x + box.width / 2, box.y + box.height / 2);
+  await page.waitForFunction(() => window.viewcells.selected !== null, null, { timeout: 60000 });
+  const selected = await page.evaluate(() => window.viewcells.selected);
+  console.log(`clicked: point (${selected.point.join(', ')}), cell ${selected.cell}, PVS of ${selected.pvs.length} objects`);
+  if (selected.cell < 0) fail('the click chose no cell');
+  // What the toolkit says for that point.
+  const query = JSON.parse(run('query', 'office.pvs', ...selected.point.map(String), '--json'));
+  if (query.cell !== selected.cell) fail(`page shows cell ${selected.cell}, query says ${query.cell}`);
+  const expected = query.pvs.map((o) => o.id);
+  if (JSON.stringify(expected) !== JSON.stringify(selected.pvs))
+    fail(`page highlights ${JSON.stringify(selected.pvs)}, query says ${JSON.stringify(expected)}`);
+  // The highlight is on the objects: their colours in the page's buffers.
+  const lit = await page.evaluate(() => {
+    const s = window.viewcells.selected;
+    return { cellText: document.getElementById('selection').textContent };
+  });
+  if (!lit.cellText.includes(`cell ${selected.cell} of`) || !lit.cellText.includes(`sees ${selected.pvs.length} of`))
+    fail('the panel does not say the chosen cell and its PVS size: ' + lit.cellText);
+  await page.waitForTimeout(300);
+  const shot = join(work, 'viewer.png');
+  await page.screenshot({ path: shot });
+  // Not blank: many colours, and most pixels differ from the background.
+  const stats = await page.evaluate(async (png) => {
+    const img = new Image();
+    img.src = 'data:image/png;base64,' + png;
+    await img.decode();
+    const c = document.createElement('canvas');
+    c.width = img.width; c.height = img.height;
+    const g = c.getContext('2d');
+    g.drawImage(img, 0, 0);
+    const d = g.getImageData(0, 0, c.width, c.height).data;
+    const colours = new Set();
+    let background = 0;
+    for (let i = 0; i < d.length; i += 4) {
+      colours.add((d[i] << 16) | (d[i + 1] << 8) | d[i + 2]);
+      if (Math.abs(d[i] - 0x15) + Math.abs(d[i + 1] - 0x17) + Math.abs(d[i + 2] - 0x1c) < 6) ++background;
+    }
+    return { colours: colours.size, background: background / (d.length / 4) };
+  }, readFileSync(shot).toString('base64'));
+  console.log(`screenshot ${shot}: ${stats.colours} colours, ${(100 * stats.background).toFixed(1)}% background`);
+  if (stats.colours < 50) fail(`the screenshot has only ${stats.colours} colours`);
+  if (stats.background > 0.9) fail('the screenshot is mostly background');
+  // Escape clears the choice; the camera's own cell can be followed.
+  await page.keyboard.press('Escape');
+  if ((await page.evaluate(() => window.viewcells.selected)) !== null) fail('Escape did not clear the choice');
+  await page.keyboard.press('f');
+  await page.waitForFunction(() => window.viewcells.selected !== null, null, { timeout: 60000 });
+  const followed = await page.evaluate(() => window.viewcells.selected);
+  const cameraCell = JSON.parse(run('query', 'office.pvs', ...followed.point.map(String), '--json')).cell;
+  if (followed.cell !== cameraCell) fail(`following the camera shows cell ${followed.cell}, query says ${cameraCell}`);
+  if (errors.length) fail('the page logged errors: ' + errors.join('; '));
+} finally {
+  await browser.close();
+}
+if (!process.exitCode) console.log('PASS');
