@@ -5,7 +5,8 @@
 # space subdivision into 2000 cells and merging, 100 view cells cut from the merge history,
 # their PVSs compressed into a .pvs file, then computed again by adaptive global visibility
 # sampling (AGVS, 20 s, with the measured pixel error), and a viewpoint looked up in it.
-# Coloured cell mesh and slice images.
+# Coloured cell mesh and slice images; the baked cells as a web page (out/demo/site/index.html,
+# open it in a browser) and as glTF (out/demo/office-cells.glb, for Blender or an engine).
 # Outputs: out/demo/.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -28,6 +29,7 @@ mkdir -p "$out"
 "$vc" pvs "$out/office.vcells" --scene "$out/office.obj" --cells 100 --time 20 --seed 1 -o "$out/office-agvs.pvs" \
   --report "$out/pvs-report.json" --measure-cameras 5000 --measure-size 32 --save "$out/office.vagvs"
 "$vc" query "$out/office-agvs.pvs" 3 12 1.5 | head -n 8
+"$vc" view "$out/office-baked.pvs" --scene "$out/office.obj" -o "$out/site" --gltf "$out/office-cells.glb"
 echo
 echo "demo: baked in one command: $out/office-baked.pvs ($out/bake.json)"
 echo "      scene $out/office.obj; hierarchy $out/office.vcells (look at $out/slice.png, $out/cells.ply);"
@@ -35,3 +37,5 @@ echo "      100 view cells $out/view-cells.json ($out/view-cells.png); PVS from 
 echo "      $out/office.pvs, by AGVS $out/office-agvs.pvs (continue with --resume $out/office.vagvs);"
 echo "      what was enabled and why, costs and timings: $out/build-report.json, $out/compress-report.json,"
 echo "      $out/pvs-report.json"
+echo "      look at the baked cells and what each sees: open $out/site/index.html in a browser (no server"
+echo "      needed; click a surface), or $out/office-cells.glb in Blender"

@@ -2,7 +2,7 @@
 // a chosen cell's PVS lit with the rest dimmed. Reads window.VIEWCELLS_DATA (data.js, written
 // by `viewcells view`); bundled with three.js by esbuild into viewer.js.
 // window.viewcells exposes the state for tests and scripts: ready, selected {point, cell, pvs},
-// select(point), locate(point), frameTimes().
+// select(point), locate(point), pick(x, y), frameTimes(), drawn (frames drawn so far).
 import * as THREE from 'three';
 import { OrbitControls } from 'three/examples/jsm/controls/OrbitControls.js';
 
@@ -44,11 +44,14 @@ const objects = {
   cost: decode(D.objects.cost, Float32Array),
   seeThrough: decode(D.objects.see_through, Uint8Array),
   firstVertex: decode(D.objects.first_vertex, Uint32Array),
+  firstIndex: decode(D.objects.first_index, Uint32Array),
 };
 const sceneGeometry = new THREE.BufferGeometry();
 const scenePositions = decode(D.objects.positions, Float32Array);
 sceneGeometry.setAttribute('position', new THREE.BufferAttribute(scenePositions, 3));
-sceneGeometry.setIndex(new THREE.BufferAttribute(decode(D.objects.indices, Uint32Array), 1));
+const sceneIndices = decode(D.objects.indices, Uint32Array);
+const fullIndex = new THREE.BufferAttribute(sceneIndices, 1);
+sceneGeometry.setIndex(fullIndex);
 const sceneColours = new Uint8Array(scenePositions.length);
 sceneGeometry.setAttribute('color', new THREE.BufferAttribute(sceneColours, 3, true));
 sceneGeometry.computeBoundingBox();
@@ -71,6 +74,20 @@ function paintScene(pvs) {
     paintObject(o, !pvs ? (glass ? GLASS : PLAIN) : lit[o] ? (glass ? LIT_GLASS : LIT) : DIM);
   }
   sceneGeometry.attributes.color.needsUpdate = true;
+}
+
+// "Draw only the chosen cell's PVS": what an engine with this PVS would draw from there.
+function drawOnly(pvs) {
+  if (!pvs) { sceneGeometry.setIndex(fullIndex); return; }
+  let n = 0;
+  for (const o of pvs) n += objects.firstIndex[o + 1] - objects.firstIndex[o];
+  const subset = new Uint32Array(n);
+  let at = 0;
+  for (const o of pvs) {
+    subset.set(sceneIndices.subarray(objects.firstIndex[o], objects.firstIndex[o + 1]), at);
+    at += objects.firstIndex[o + 1] - objects.firstIndex[o];
+  }
+  sceneGeometry.setIndex(new THREE.BufferAttribute(subset, 1));
 }
 
 // --- cells ---------------------------------------------------------------------------------
@@ -167,7 +184,14 @@ const state = { ready: false, selected: null, follow: false };
 const totalTriangles = objects.triangles.reduce((a, b) => a + b, 0);
 const fmt = (x) => x.toLocaleString('en-US', { maximumFractionDigits: 0 });
 
+const drawMode = () => document.getElementById('draw').value;
 function select(point) {
+  const chosen = selectCell(point);
+  drawOnly(drawMode() === 'pvs' && chosen && chosen.cell >= 0 ? chosen.pvs : null);
+  dirty = true;
+  return chosen;
+}
+function selectCell(point) {
   const cell = point ? locate(point) : -1;
   if (!point) {
     state.selected = null;
@@ -203,45 +227,60 @@ const cellsMode = () => document.getElementById('cells').value;
 document.getElementById('cells').addEventListener('change', () => {
   cellMesh.visible = cellsMode() === 'all';
   showSelectedCell(state.selected && cellsMode() !== 'none' ? state.selected.cell : -1);
+  dirty = true;
 });
-document.getElementById('colour').addEventListener('change', (e) => paintCells(e.target.value));
+document.getElementById('colour').addEventListener('change', (e) => { paintCells(e.target.value); dirty = true; });
+document.getElementById('draw').addEventListener('change', () => {
+  const sel = state.selected;
+  drawOnly(drawMode() === 'pvs' && sel && sel.cell >= 0 ? sel.pvs : null);
+  dirty = true;
+});
 const follow = document.getElementById('follow');
-follow.addEventListener('change', () => { state.follow = follow.checked; lastFollowCell = null; });
+follow.addEventListener('change', () => { state.follow = follow.checked; lastFollowCell = null; dirty = true; });
 
 const raycaster = new THREE.Raycaster();
 // A click (not a drag) on a surface: the viewpoint is a little in front of the surface, on the
 // ray towards the camera.
+// pick(x, y): the point in front of the surface under normalised device coordinates (x, y),
+// chosen and returned, or null when the ray hits nothing.
+function pick(x, y) {
+  raycaster.setFromCamera(new THREE.Vector2(x, y), camera);
+  const hit = raycaster.intersectObject(sceneMesh, false)[0];
+  if (!hit) return null;
+  const back = Math.min(hit.distance * 0.5, diagonal * 0.002);
+  const p = hit.point.clone().addScaledVector(raycaster.ray.direction, -back);
+  follow.checked = state.follow = false;
+  return select(p.toArray());
+}
 let down = null;
 renderer.domElement.addEventListener('pointerdown', (e) => { down = [e.clientX, e.clientY]; });
 renderer.domElement.addEventListener('pointerup', (e) => {
   if (!down || Math.hypot(e.clientX - down[0], e.clientY - down[1]) > 4) return;
   const r = renderer.domElement.getBoundingClientRect();
-  const ndc = new THREE.Vector2(((e.clientX - r.left) / r.width) * 2 - 1, -((e.clientY - r.top) / r.height) * 2 + 1);
-  raycaster.setFromCamera(ndc, camera);
-  const hit = raycaster.intersectObject(sceneMesh, false)[0];
-  if (!hit) return;
-  const back = Math.min(hit.distance * 0.5, diagonal * 0.002);
-  const p = hit.point.clone().addScaledVector(raycaster.ray.direction, -back);
-  follow.checked = state.follow = false;
-  select(p.toArray());
+  pick(((e.clientX - r.left) / r.width) * 2 - 1, -((e.clientY - r.top) / r.height) * 2 + 1);
 });
 window.addEventListener('keydown', (e) => {
   if (e.key === 'Escape') select(null);
-  if (e.key === 'f' || e.key === 'F') { follow.checked = state.follow = !state.follow; lastFollowCell = null; }
+  if (e.key === 'f' || e.key === 'F') { follow.checked = state.follow = !state.follow; lastFollowCell = null; dirty = true; }
 });
 
-// --- frames --------------------------------------------------------------------------------
+// --- frames ---------------------------------------------------------------------------------
+// A frame is drawn when something changed (the camera, a choice, the window), or on every
+// animation frame with #spin=1 (turning about the target) or #spin=eye (turning on the spot),
+// for measuring. frameTimes() are
+// the times between drawn frames that followed each other.
 const frameTimes = [];
-let last = performance.now(), lastFollowCell = null;
-const spin = hash.get('spin') === '1';
+let last = null, lastFollowCell = null, dirty = true, drawn = 0;
+const spin = hash.get('spin');
+controls.addEventListener('change', () => { dirty = true; });
+window.addEventListener('resize', () => { dirty = true; });
 function frame(now) {
-  frameTimes.push(now - last);
-  if (frameTimes.length > 240) frameTimes.shift();
-  last = now;
-  if (spin) {  // turn about the target: every frame draws a new view (for measuring)
-    const o = camera.position.clone().sub(controls.target);
-    o.applyAxisAngle(new THREE.Vector3(0, 0, 1), 0.01);
-    camera.position.copy(controls.target).add(o);
+  requestAnimationFrame(frame);
+  if (spin === '1' || spin === 'eye') {
+    const [pivot, moved] = spin === 'eye' ? [camera.position, controls.target] : [controls.target, camera.position];
+    const o = moved.clone().sub(pivot).applyAxisAngle(new THREE.Vector3(0, 0, 1), 0.01);
+    moved.copy(pivot).add(o);
+    dirty = true;
   }
   controls.update();
   if (state.follow) {
@@ -249,25 +288,39 @@ function frame(now) {
     const c = locate(p);
     if (c !== lastFollowCell) { lastFollowCell = c; select(p); }
   }
+  if (!dirty) { last = null; return; }
+  dirty = false;
   renderer.render(scene, camera);
-  if (frameTimes.length % 30 === 0) {
+  ++drawn;
+  if (last !== null) frameTimes.push(now - last);
+  if (frameTimes.length > 240) frameTimes.shift();
+  last = now;
+  if (frameTimes.length && frameTimes.length % 10 === 0) {
     const recent = frameTimes.slice(-30);
     document.getElementById('fps').textContent =
         `${(recent.reduce((a, b) => a + b, 0) / recent.length).toFixed(1)} ms per frame`;
   }
-  requestAnimationFrame(frame);
 }
 
 document.getElementById('title').textContent = `viewcells: ${D.scene.split('/').pop()}`;
 document.getElementById('summary').textContent =
     `${fmt(cells.count)} view cells (${D.rule}) · ${fmt(objects.count)} objects · ${fmt(totalTriangles)} triangles`;
+// #cells=all|selected|none and #colour=cost|pvs in the address set the panel's choices.
+for (const [key, id] of [['cells', 'cells'], ['colour', 'colour'], ['draw', 'draw']]) {
+  const value = hash.get(key), el = document.getElementById(id);
+  if (value && [...el.options].some((o) => o.value === value)) el.value = value;
+}
+cellMesh.visible = cellsMode() === 'all';
+if (hash.get('follow') === '1') follow.checked = state.follow = true;
 paintScene(null);
-paintCells('cost');
+paintCells(document.getElementById('colour').value);
 window.viewcells = {
   get ready() { return state.ready; },
   get selected() { return state.selected; },
-  select, locate,
+  select, locate, pick,
   frameTimes: () => frameTimes.slice(),
+  get drawn() { return drawn; },
+  get sceneTrianglesDrawn() { return sceneGeometry.index.count / 3; },
   camera, controls,
 };
-requestAnimationFrame((t) => { last = t; state.ready = true; frame(t); });
+requestAnimationFrame((t) => { frame(t); state.ready = true; });

@@ -22,7 +22,7 @@ export async function openSite(browser, indexHtml, hash, viewport = { width: 960
   page.on('console', (m) => { if (m.type() === 'error') errors.push(m.text()); });
   await page.goto('file://' + indexHtml + (hash ? '#' + hash : ''));
   await page.waitForFunction(() => window.viewcells && window.viewcells.ready, null, { timeout: 120000 });
-  // A few frames, so that the picture is complete.
-  await page.waitForFunction(() => window.viewcells.frameTimes().length > 5, null, { timeout: 120000 });
+  // Drawn at least once (the viewer draws on demand).
+  await page.waitForFunction(() => window.viewcells.drawn > 0, null, { timeout: 120000 });
   return { page, errors };
 }

@@ -49,6 +49,17 @@ try {
   });
   if (!lit.cellText.includes(`cell ${selected.cell} of`) || !lit.cellText.includes(`sees ${selected.pvs.length} of`))
     fail('the panel does not say the chosen cell and its PVS size: ' + lit.cellText);
+  // Drawing only the PVS draws exactly its objects' triangles.
+  run('info', 'office.obj', '--json', 'info.json');
+  const sceneInfo = JSON.parse(readFileSync(join(work, 'info.json'), 'utf8'));
+  const pvsTriangles = selected.pvs.reduce((sum, o) => sum + sceneInfo.object_list[o].triangles, 0);
+  await page.selectOption('#draw', 'pvs');
+  const drawnPvs = await page.evaluate(() => window.viewcells.sceneTrianglesDrawn);
+  await page.selectOption('#draw', 'all');
+  const drawnAll = await page.evaluate(() => window.viewcells.sceneTrianglesDrawn);
+  if (drawnPvs !== pvsTriangles) fail(`drawing the PVS draws ${drawnPvs} triangles, its objects have ${pvsTriangles}`);
+  if (drawnAll !== sceneInfo.triangles) fail(`the page draws ${drawnAll} triangles, the scene has ${sceneInfo.triangles}`);
+  console.log(`draw only the PVS: ${drawnPvs} of ${drawnAll} triangles`);
   await page.waitForTimeout(300);
   const shot = join(work, 'viewer.png');
   await page.screenshot({ path: shot });
