@@ -21,6 +21,7 @@ corpus=build-fuzz/corpus
 findings=build-fuzz/findings
 mkdir -p "$findings"
 export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=0
+export LSAN_OPTIONS=suppressions=$PWD/tests/fuzz/lsan.supp:print_suppressions=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 
 # The payload of one of our containers (32-byte header, zstd frame) with the byte that picks

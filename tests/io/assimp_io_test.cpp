@@ -145,7 +145,7 @@ void expect_error(const std::string& path, const std::string& fragment) {
 TEST(AssimpIo, BrokenFilesAreErrorsNamingTheFile) {
   expect_error(kModels + "glTF2/IndexOutOfRange/IndexOutOfRange.gltf", "out-of-range");
   expect_error(kModels + "glTF2/RecursiveNodes/RecursiveNodes.gltf", "not a readable scene");
-  expect_error(kModels + "glTF2/MissingBin/BoxTextured.gltf", "not a readable scene");
+  expect_error(kModels + "glTF2/MissingBin/BoxTextured.gltf", "BoxTextured0.bin");
   expect_error(kModels + "glTF2/TestNoRootNode/NoScene.gltf", "not a readable scene");
   // Truncated binary glTF and FBX, at several lengths.
   for (const std::string& real :
@@ -160,7 +160,20 @@ TEST(AssimpIo, BrokenFilesAreErrorsNamingTheFile) {
       EXPECT_THROW(read_assimp_bytes(cut, ext, AssimpObjects::kNodes, "memory" + ext), Error);
     }
   }
-  expect_error(write_temp("garbage.glb", std::string(4096, '\x7f')), "not a readable scene");
+  expect_error(write_temp("garbage.glb", std::string(4096, '\x7f')), "broken glTF");
+  // Declared sizes beyond the file are refused before Assimp allocates them.
+  std::string glb;
+  {
+    std::ifstream in(kModels + "glTF2/BoxTextured-glTF-Binary/BoxTextured.glb", std::ios::binary);
+    glb.assign((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  }
+  std::string huge = glb;
+  const uint32_t two_gb = 0x80000000u;
+  std::memcpy(huge.data() + 8, &two_gb, 4);
+  expect_error(write_temp("huge.glb", huge), "declares 2147483648 bytes");
+  const std::string big_buffer = std::string(cube_gltf()).replace(cube_gltf().find("\"byteLength\":168"), 16,
+                                                                   "\"byteLength\":999999999");
+  expect_error(write_temp("big.gltf", big_buffer), "a buffer declares 999999999 bytes");
 }
 
 }  // namespace

@@ -46,22 +46,82 @@ const objects = {
   firstVertex: decode(D.objects.first_vertex, Uint32Array),
   firstIndex: decode(D.objects.first_index, Uint32Array),
 };
-const sceneGeometry = new THREE.BufferGeometry();
 const scenePositions = decode(D.objects.positions, Float32Array);
-sceneGeometry.setAttribute('position', new THREE.BufferAttribute(scenePositions, 3));
 const sceneIndices = decode(D.objects.indices, Uint32Array);
-const fullIndex = new THREE.BufferAttribute(sceneIndices, 1);
-sceneGeometry.setIndex(fullIndex);
-const sceneColours = new Uint8Array(scenePositions.length);
-sceneGeometry.setAttribute('color', new THREE.BufferAttribute(sceneColours, 3, true));
-sceneGeometry.computeBoundingBox();
-sceneGeometry.computeBoundingSphere();
-const sceneMesh = new THREE.Mesh(sceneGeometry,
-    new THREE.MeshLambertMaterial({ vertexColors: true, flatShading: true, side: THREE.DoubleSide }));
+const sceneMaterial = new THREE.MeshLambertMaterial({ vertexColors: true, flatShading: true, side: THREE.DoubleSide });
+
+// The scene in chunks of nearby objects (objects sorted along a Morton curve of their centres,
+// about 32k triangles a chunk), each its own mesh: three.js skips the chunks outside the view,
+// and a ray tests only the chunks whose bounds it meets.
+const CHUNK_TRIANGLES = 32768;
+const sceneBounds = new THREE.Box3();
+const centres = new Float32Array(3 * objects.count);
+for (let o = 0; o < objects.count; ++o) {
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let v = objects.firstVertex[o]; v < objects.firstVertex[o + 1]; ++v)
+    for (let k = 0; k < 3; ++k) {
+      lo[k] = Math.min(lo[k], scenePositions[3 * v + k]);
+      hi[k] = Math.max(hi[k], scenePositions[3 * v + k]);
+    }
+  if (objects.firstVertex[o + 1] > objects.firstVertex[o]) {
+    sceneBounds.expandByPoint(new THREE.Vector3(...lo));
+    sceneBounds.expandByPoint(new THREE.Vector3(...hi));
+  }
+  for (let k = 0; k < 3; ++k) centres[3 * o + k] = (lo[k] + hi[k]) / 2;
+}
+function morton(o) {
+  let code = 0;
+  for (let k = 0; k < 3; ++k) {
+    const lo = sceneBounds.min.getComponent(k), span = Math.max(1e-9, sceneBounds.max.getComponent(k) - lo);
+    const q = Math.min(1023, Math.max(0, Math.floor(((centres[3 * o + k] - lo) / span) * 1024)));
+    for (let b = 0; b < 10; ++b) code += ((q >> b) & 1) * 2 ** (3 * b + k);
+  }
+  return code;
+}
+const order = Array.from({ length: objects.count }, (_, o) => o);
+const codes = order.map(morton);
+order.sort((a, b) => codes[a] - codes[b] || a - b);
+
+const chunks = [];
+const objectChunk = new Int32Array(objects.count), objectVertex = new Uint32Array(objects.count),
+      objectIndex = new Uint32Array(objects.count);
+for (let at = 0; at < order.length;) {
+  const ids = [];
+  let vertices = 0, indices = 0;
+  while (at < order.length && (ids.length === 0 || indices < 3 * CHUNK_TRIANGLES)) {
+    const o = order[at++];
+    ids.push(o);
+    vertices += objects.firstVertex[o + 1] - objects.firstVertex[o];
+    indices += objects.firstIndex[o + 1] - objects.firstIndex[o];
+  }
+  const positions = new Float32Array(3 * vertices), index = new Uint32Array(indices);
+  let v = 0, i = 0;
+  for (const o of ids) {
+    const v0 = objects.firstVertex[o], v1 = objects.firstVertex[o + 1];
+    objectChunk[o] = chunks.length;
+    objectVertex[o] = v;
+    objectIndex[o] = i;
+    positions.set(scenePositions.subarray(3 * v0, 3 * v1), 3 * v);
+    for (let k = objects.firstIndex[o]; k < objects.firstIndex[o + 1]; ++k) index[i++] = sceneIndices[k] - v0 + v;
+    v += v1 - v0;
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(positions, 3));
+  geometry.setAttribute('color', new THREE.BufferAttribute(new Uint8Array(3 * vertices), 3, true));
+  const fullIndex = new THREE.BufferAttribute(index, 1);
+  geometry.setIndex(fullIndex);
+  geometry.computeBoundingSphere();
+  geometry.computeBoundingBox();
+  chunks.push({ ids, geometry, fullIndex, mesh: new THREE.Mesh(geometry, sceneMaterial) });
+}
+const sceneGroup = new THREE.Group();
+for (const c of chunks) sceneGroup.add(c.mesh);
 
 function paintObject(o, rgb) {
-  for (let v = objects.firstVertex[o]; v < objects.firstVertex[o + 1]; ++v) {
-    sceneColours[3 * v] = rgb[0]; sceneColours[3 * v + 1] = rgb[1]; sceneColours[3 * v + 2] = rgb[2];
+  const colours = chunks[objectChunk[o]].geometry.attributes.color.array;
+  const n = objects.firstVertex[o + 1] - objects.firstVertex[o];
+  for (let v = objectVertex[o]; v < objectVertex[o] + n; ++v) {
+    colours[3 * v] = rgb[0]; colours[3 * v + 1] = rgb[1]; colours[3 * v + 2] = rgb[2];
   }
 }
 const PLAIN = [190, 188, 180], GLASS = [120, 170, 220], LIT = [255, 214, 140], LIT_GLASS = [150, 220, 255],
@@ -73,22 +133,34 @@ function paintScene(pvs) {
     const glass = objects.seeThrough[o];
     paintObject(o, !pvs ? (glass ? GLASS : PLAIN) : lit[o] ? (glass ? LIT_GLASS : LIT) : DIM);
   }
-  sceneGeometry.attributes.color.needsUpdate = true;
+  for (const c of chunks) c.geometry.attributes.color.needsUpdate = true;
 }
 
 // "Draw only the chosen cell's PVS": what an engine with this PVS would draw from there.
 function drawOnly(pvs) {
-  if (!pvs) { sceneGeometry.setIndex(fullIndex); return; }
-  let n = 0;
-  for (const o of pvs) n += objects.firstIndex[o + 1] - objects.firstIndex[o];
-  const subset = new Uint32Array(n);
-  let at = 0;
-  for (const o of pvs) {
-    subset.set(sceneIndices.subarray(objects.firstIndex[o], objects.firstIndex[o + 1]), at);
-    at += objects.firstIndex[o + 1] - objects.firstIndex[o];
+  if (!pvs) {
+    for (const c of chunks) { c.geometry.setIndex(c.fullIndex); c.mesh.visible = true; }
+    return;
   }
-  sceneGeometry.setIndex(new THREE.BufferAttribute(subset, 1));
+  const byChunk = chunks.map(() => []);
+  for (const o of pvs) byChunk[objectChunk[o]].push(o);
+  chunks.forEach((c, k) => {
+    const ids = byChunk[k];
+    c.mesh.visible = ids.length > 0;
+    let n = 0;
+    for (const o of ids) n += objects.firstIndex[o + 1] - objects.firstIndex[o];
+    const subset = new Uint32Array(n);
+    let at = 0;
+    for (const o of ids) {
+      const count = objects.firstIndex[o + 1] - objects.firstIndex[o];
+      subset.set(c.fullIndex.array.subarray(objectIndex[o], objectIndex[o] + count), at);
+      at += count;
+    }
+    c.geometry.setIndex(new THREE.BufferAttribute(subset, 1));
+  });
 }
+const sceneTrianglesDrawn = () =>
+  chunks.reduce((sum, c) => sum + (c.mesh.visible ? c.geometry.index.count / 3 : 0), 0);
 
 // --- cells ---------------------------------------------------------------------------------
 const cells = {
@@ -152,11 +224,10 @@ scene.background = new THREE.Color(0x15171c);
 scene.add(new THREE.HemisphereLight(0xffffff, 0x404050, 1.6));
 const sun = new THREE.DirectionalLight(0xffffff, 1.4);
 sun.position.set(0.4, -0.6, 1);
-scene.add(sun, sceneMesh, cellMesh, selectedGroup);
+scene.add(sun, sceneGroup, cellMesh, selectedGroup);
 
-const bounds = sceneGeometry.boundingBox;
 const size = new THREE.Vector3(), centre = new THREE.Vector3();
-bounds.getSize(size); bounds.getCenter(centre);
+sceneBounds.getSize(size); sceneBounds.getCenter(centre);
 const diagonal = size.length();
 const camera = new THREE.PerspectiveCamera(60, container.clientWidth / container.clientHeight,
                                            diagonal * 1e-4, diagonal * 10);
@@ -245,7 +316,7 @@ const raycaster = new THREE.Raycaster();
 // chosen and returned, or null when the ray hits nothing.
 function pick(x, y) {
   raycaster.setFromCamera(new THREE.Vector2(x, y), camera);
-  const hit = raycaster.intersectObject(sceneMesh, false)[0];
+  const hit = raycaster.intersectObjects(chunks.filter((c) => c.mesh.visible).map((c) => c.mesh), false)[0];
   if (!hit) return null;
   const back = Math.min(hit.distance * 0.5, diagonal * 0.002);
   const p = hit.point.clone().addScaledVector(raycaster.ray.direction, -back);
@@ -320,7 +391,8 @@ window.viewcells = {
   select, locate, pick,
   frameTimes: () => frameTimes.slice(),
   get drawn() { return drawn; },
-  get sceneTrianglesDrawn() { return sceneGeometry.index.count / 3; },
+  get sceneTrianglesDrawn() { return sceneTrianglesDrawn(); },
+  get chunks() { return chunks.length; },
   camera, controls,
 };
 requestAnimationFrame((t) => { frame(t); state.ready = true; });
