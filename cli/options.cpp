@@ -7,17 +7,18 @@
 #include <iostream>
 #include <sstream>
 
+#include "viewcells/core/cluster.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/binary_file.h"
 
 namespace viewcells::cli {
 
 void Common::log(const std::string& s) const {
-  if (!quiet) std::cerr << s << '\n';
+  if (!quiet && cluster::writer()) std::cerr << s << '\n';
 }
 
 pipeline::Log Common::logger() const {
-  const bool q = quiet;
+  const bool q = quiet || !cluster::writer();  // on a cluster, rank 0 speaks for the run
   return [q](const std::string& s) {
     if (!q) std::cerr << s << '\n';
   };

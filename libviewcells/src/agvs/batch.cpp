@@ -10,6 +10,8 @@
 #include <span>
 #include <tuple>
 
+#include "viewcells/core/cluster.h"
+
 namespace viewcells {
 
 namespace {
@@ -121,6 +123,55 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
       c.dist = d;
       chunks.push_back(std::move(c));
     }
+  auto cells_of = [&](const BatchChunk& c, std::vector<std::vector<int32_t>>& out) {
+    out.assign(c.segs.size(), {});
+    if (config.method == AgvsMethod::kRef) return;
+    std::vector<std::tuple<int32_t, double, double>> stack;
+    std::vector<int32_t> leaves;
+    for (size_t i = 0; i < c.segs.size(); ++i) cells.cells_of_segment(c.segs.a(i), c.segs.b(i), out[i], stack, leaves);
+  };
+  if (cluster::size() > 1) {
+    // Several ranks: each casts the chunks it owns (numbered across batches, so that the work
+    // turns round the ranks) and finds their segments' cells; every rank receives all chunks,
+    // and applies them below in sample order, as one process does.
+    std::vector<std::string> items(chunks.size());
+    const uint64_t base = stats.batches * 4096;
+    tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
+      if (!cluster::mine(base + k)) return;
+      BatchChunk& c = chunks[k];
+      c.rays = caster().cast(std::span<const Vec3>(s.points.data() + c.first, c.size),
+                             std::span<const Vec3>(s.dirs.data() + c.first, c.size), c.segs, c.sample_of);
+      std::vector<std::vector<int32_t>> pierced;
+      cells_of(c, pierced);
+      cluster::Writer w;
+      w.put(c.rays);
+      w.put_array(c.sample_of.data(), c.sample_of.size());
+      put_segments(w, c.segs, c.segs.size());
+      for (const auto& p : pierced) w.put_array(p.data(), p.size());
+      items[k] = w.take();
+    });
+    // Ownership rotates with `base`, which counts batches, not ranks: a chunk's owner may differ
+    // between rank counts, its content does not.
+    cluster::share(items, base);
+    std::vector<std::string>& shared = items;
+    size_t total = 0;
+    std::vector<std::vector<std::vector<int32_t>>> pierced(chunks.size());
+    for (size_t k = 0; k < chunks.size(); ++k) {
+      BatchChunk& c = chunks[k];
+      cluster::Reader r(shared[k]);
+      c.rays = r.get<uint64_t>();
+      r.get_array(c.sample_of);
+      get_segments(r, c.segs);
+      pierced[k].resize(c.segs.size());
+      for (auto& p : pierced[k]) r.get_array(p);
+      c.seg_start = total;
+      total += c.segs.size();
+    }
+    seg_cells.assign(total, {});
+    for (size_t k = 0; k < chunks.size(); ++k)
+      for (size_t i = 0; i < pierced[k].size(); ++i) seg_cells[chunks[k].seg_start + i] = std::move(pierced[k][i]);
+    return chunks;
+  }
   tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
     BatchChunk& c = chunks[k];
     c.rays = caster().cast(std::span<const Vec3>(s.points.data() + c.first, c.size),

@@ -1,5 +1,7 @@
 #include "viewcells/core/binary_file.h"
 
+#include "viewcells/core/cluster.h"
+
 #include <unistd.h>
 #include <zstd.h>
 
@@ -41,6 +43,10 @@ void check_output_target(const std::string& path) {
 std::string temporary_for(const std::string& path) { return path + ".tmp." + std::to_string(getpid()); }
 
 void install_file(const std::string& tmp, const std::string& path) {
+  if (!cluster::writer()) {  // on a cluster, rank 0 writes; the others hold the same result
+    std::remove(tmp.c_str());
+    return;
+  }
   {
     std::lock_guard lock(g_batch_mutex);
     if (g_batch) {

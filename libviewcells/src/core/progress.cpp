@@ -1,5 +1,7 @@
 #include "viewcells/core/progress.h"
 
+#include "viewcells/core/cluster.h"
+
 #include <unistd.h>
 
 #include <cstdio>
@@ -9,7 +11,7 @@ namespace viewcells {
 Progress::Progress(std::string label, uint64_t total)
     : label_(std::move(label)),
       total_(total),
-      enabled_(isatty(STDERR_FILENO) == 1),
+      enabled_(isatty(STDERR_FILENO) == 1 && cluster::writer()),  // one bar per run, from rank 0
       start_(std::chrono::steady_clock::now()) {}
 
 Progress::~Progress() {

@@ -8,7 +8,12 @@
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -340,6 +345,109 @@ class GltfCheck {
   std::filesystem::path dir_;
 };
 
+// Assimp crashes on some malformed files (the fuzzer found a null dereference in its glTF 2.0
+// importer). So it reads in a child process: a crash there is an Error here, never ours. The
+// child sends the mesh (or its Error's message) back through a pipe.
+void write_all(int fd, const std::string& bytes) {
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return;
+    done += static_cast<size_t>(n);
+  }
+}
+
+std::string encode(const RawMesh& m) {
+  std::string out;
+  auto put = [&](const void* p, size_t n) { out.append(static_cast<const char*>(p), n); };
+  auto put_u64 = [&](uint64_t v) { put(&v, sizeof v); };
+  put_u64(m.vertices.size());
+  put(m.vertices.data(), m.vertices.size() * sizeof(Vec3));
+  put_u64(m.triangles.size());
+  put(m.triangles.data(), m.triangles.size() * sizeof(m.triangles[0]));
+  put(m.triangle_group.data(), m.triangle_group.size() * sizeof(uint32_t));
+  put_u64(m.group_names.size());
+  for (const std::string& g : m.group_names) {
+    put_u64(g.size());
+    put(g.data(), g.size());
+  }
+  put(m.group_occluder.data(), m.group_occluder.size());
+  return out;
+}
+
+RawMesh decode(const std::string& b, const std::string& name) {
+  size_t pos = 0;
+  auto get = [&](void* p, size_t n) {
+    if (n > b.size() - pos) throw Error(name, 0, "internal: the Assimp reader's answer is truncated");
+    std::memcpy(p, b.data() + pos, n);
+    pos += n;
+  };
+  auto get_u64 = [&] {
+    uint64_t v = 0;
+    get(&v, sizeof v);
+    if (v > b.size()) throw Error(name, 0, "internal: the Assimp reader's answer is malformed");
+    return v;
+  };
+  RawMesh m;
+  m.vertices.resize(get_u64());
+  get(m.vertices.data(), m.vertices.size() * sizeof(Vec3));
+  m.triangles.resize(get_u64());
+  get(m.triangles.data(), m.triangles.size() * sizeof(m.triangles[0]));
+  m.triangle_group.resize(m.triangles.size());
+  get(m.triangle_group.data(), m.triangle_group.size() * sizeof(uint32_t));
+  m.group_names.resize(get_u64());
+  for (std::string& g : m.group_names) {
+    g.resize(get_u64());
+    get(g.data(), g.size());
+  }
+  m.group_occluder.resize(m.group_names.size());
+  get(m.group_occluder.data(), m.group_occluder.size());
+  return m;
+}
+
+template <class F>
+RawMesh read_isolated(const std::string& name, F&& read) {
+  int fds[2];
+  if (pipe(fds) != 0) throw Error(name, 0, "cannot create a pipe for the Assimp reader");
+  const pid_t pid = fork();
+  if (pid < 0) {
+    close(fds[0]), close(fds[1]);
+    throw Error(name, 0, "cannot fork the Assimp reader");
+  }
+  if (pid == 0) {  // the child: read, answer, leave without running the parent's exit handlers
+    close(fds[0]);
+    std::string answer;
+    try {
+      answer = "M" + encode(read());
+    } catch (const std::exception& e) {
+      answer = std::string("E") + e.what();
+    }
+    write_all(fds[1], answer);
+    close(fds[1]);
+    _exit(0);
+  }
+  close(fds[1]);
+  std::string answer;
+  char buf[1 << 16];
+  while (true) {
+    const ssize_t n = ::read(fds[0], buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    answer.append(buf, static_cast<size_t>(n));
+  }
+  close(fds[0]);
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (WIFSIGNALED(status))
+    throw Error(name, 0, "Assimp crashed reading it (signal " + std::to_string(WTERMSIG(status)) +
+                             "): the file is malformed");
+  if (answer.empty()) throw Error(name, 0, "the Assimp reader ended without an answer");
+  if (answer[0] == 'E') throw Error(answer.substr(1));  // already names the file
+  return decode(answer.substr(1), name);
+}
+
 bool is_gltf(const std::string& ext) { return ext == ".gltf" || ext == ".glb"; }
 
 std::string lower_ext(const std::string& path) {
@@ -372,7 +480,7 @@ bool is_assimp_extension(const std::string& ext) {
   return std::any_of(std::begin(kExtensions), std::end(kExtensions), [&](const char* e) { return ext == e; });
 }
 
-RawMesh read_assimp(const std::string& path, AssimpObjects mode) {
+static RawMesh read_assimp_here(const std::string& path, AssimpObjects mode) {
   const std::string ext = lower_ext(path);
   if (is_gltf(ext)) {
     std::ifstream in(path, std::ios::binary);
@@ -389,8 +497,8 @@ RawMesh read_assimp(const std::string& path, AssimpObjects mode) {
   return convert(importer, scene, mode, path);
 }
 
-RawMesh read_assimp_bytes(std::string_view bytes, const std::string& extension, AssimpObjects mode,
-                          const std::string& name) {
+static RawMesh read_assimp_bytes_here(std::string_view bytes, const std::string& extension, AssimpObjects mode,
+                               const std::string& name) {
   if (bytes.empty()) throw Error(name, 0, "empty file");
   if (is_gltf(extension)) GltfCheck(name, ".").check(bytes, bytes.substr(0, 4) == "glTF");
   CollectWarnings warnings;
@@ -400,6 +508,19 @@ RawMesh read_assimp_bytes(std::string_view bytes, const std::string& extension, 
   const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), kFlags, hint.c_str());
   warnings.check(name);
   return convert(importer, scene, mode, name);
+}
+
+}  // namespace viewcells
+
+namespace viewcells {
+
+RawMesh read_assimp(const std::string& path, AssimpObjects mode) {
+  return read_isolated(path, [&] { return read_assimp_here(path, mode); });
+}
+
+RawMesh read_assimp_bytes(std::string_view bytes, const std::string& extension, AssimpObjects mode,
+                          const std::string& name) {
+  return read_isolated(name, [&] { return read_assimp_bytes_here(bytes, extension, mode, name); });
 }
 
 }  // namespace viewcells

@@ -3,6 +3,7 @@
 #include "viewcells/sampling/sampler.h"
 
 #include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
 #include <tbb/parallel_pipeline.h>
 #include <tbb/task_arena.h>
 
@@ -11,6 +12,7 @@
 
 #include <cmath>
 
+#include "viewcells/core/cluster.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/core/rng.h"
@@ -386,54 +388,94 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
   bool done = false;      // the target is reached (output stage only)
   bool finished = false;  // nothing more goes into the output (output stage only)
   std::atomic<bool> stop{false};
-  tbb::parallel_pipeline(
-      token_count,
-      tbb::make_filter<void, Token*>(tbb::filter_mode::serial_in_order,
-                                     [&](tbb::flow_control& fc) -> Token* {
-                                       const uint64_t first = next_batch * config.batch_size;
-                                       if (stop.load(std::memory_order_relaxed) || first >= limit) {
-                                         fc.stop();
-                                         return nullptr;
-                                       }
-                                       // In-flight batches are consecutive and at most token_count.
-                                       Token* t = &tokens[next_batch % token_count];
-                                       t->batch = next_batch++;
-                                       t->count = std::min<uint64_t>(config.batch_size, limit - first);
-                                       return t;
-                                     }) &
-          tbb::make_filter<Token*, Token*>(tbb::filter_mode::parallel,
-                                           [&](Token* t) {
-                                             t->out = BatchOutput{};
-                                             t->log.clear();
-                                             if (stop.load(std::memory_order_relaxed)) return t;
-                                             samplers.local().run(config.seed, t->batch, t->count, t->segments, t->out,
-                                                                  logs ? &t->log : nullptr);
-                                             return t;
-                                           }) &
-          tbb::make_filter<Token*, void>(tbb::filter_mode::serial_in_order, [&](Token* t) {
-            if (finished) return;  // in flight when the stream stopped: not part of the output
-            BatchOutput& out = t->out;
-            if (by_segments && segs.size() + out.valid >= config.target_segments) {
-              out.valid = config.target_segments - segs.size();  // the rest of this batch is dropped
-              done = finished = true;
-            }
-            segs.append(t->segments, 0, out.valid);
-            if (logs) logs->push_back(std::move(t->log));
-            stats.samples += t->count;
-            stats.rays += out.rays;
-            stats.recast_rays += out.recast_rays;
-            stats.missed_both += out.missed_both;
-            stats.stuck_in_solid += out.stuck;
-            stats.outside_view_box += out.outside;
-            stats.two_sided_samples += out.two_sided;
-            stats.rejected_origins += out.rejected;
-            stats.see_through_rays += out.see_through_rays;
-            stats.see_through_segments += out.see_through_segments;
-            if (show) progress.advance(by_segments ? out.valid : t->count);
-            // Nothing seen after a million samples: the target is out of reach, say so now.
-            if (by_segments && segs.size() == 0 && stats.samples >= kGiveUpSamples) finished = true;
-            if (finished) stop.store(true, std::memory_order_relaxed);
-          }));
+  // The output stage: batches arrive here in batch order.
+  auto consume = [&](const SegmentSet& batch_segs, BatchOutput& out, uint64_t count, std::vector<Ray>* log) {
+    if (finished) return;  // in flight when the stream stopped: not part of the output
+    if (by_segments && segs.size() + out.valid >= config.target_segments) {
+      out.valid = config.target_segments - segs.size();  // the rest of this batch is dropped
+      done = finished = true;
+    }
+    segs.append(batch_segs, 0, out.valid);
+    if (logs) logs->push_back(std::move(*log));
+    stats.samples += count;
+    stats.rays += out.rays;
+    stats.recast_rays += out.recast_rays;
+    stats.missed_both += out.missed_both;
+    stats.stuck_in_solid += out.stuck;
+    stats.outside_view_box += out.outside;
+    stats.two_sided_samples += out.two_sided;
+    stats.rejected_origins += out.rejected;
+    stats.see_through_rays += out.see_through_rays;
+    stats.see_through_segments += out.see_through_segments;
+    if (show) progress.advance(by_segments ? out.valid : count);
+    // Nothing seen after a million samples: the target is out of reach, say so now.
+    if (by_segments && segs.size() == 0 && stats.samples >= kGiveUpSamples) finished = true;
+    if (finished) stop.store(true, std::memory_order_relaxed);
+  };
+  if (cluster::size() > 1 && !logs) {
+    // Several ranks: rounds of a fixed number of batches (not depending on the ranks); each rank
+    // samples the batches it owns, every rank receives all of them and consumes them in batch
+    // order, so every rank holds the same output, the one a single process makes.
+    constexpr uint64_t kRoundBatches = 64;
+    SegmentSet batch_segs;
+    while (!finished) {
+      const uint64_t first = next_batch;
+      uint64_t n = 0;
+      while (n < kRoundBatches && (first + n) * config.batch_size < limit) ++n;
+      if (n == 0) break;
+      std::vector<std::string> items(n);
+      tbb::parallel_for(uint64_t{0}, n, [&](uint64_t i) {
+        const uint64_t batch = first + i;
+        if (!cluster::mine(batch)) return;
+        SegmentSet scratch;
+        scratch.resize(slots);
+        BatchOutput out;
+        samplers.local().run(config.seed, batch, std::min<uint64_t>(config.batch_size, limit - batch * config.batch_size),
+                             scratch, out, nullptr);
+        cluster::Writer w;
+        w.put(out);
+        put_segments(w, scratch, out.valid);
+        items[i] = w.take();
+      });
+      cluster::share(items);
+      for (uint64_t i = 0; i < n && !finished; ++i) {
+        const uint64_t batch = first + i;
+        cluster::Reader r(items[i]);
+        BatchOutput out = r.get<BatchOutput>();
+        batch_segs.view_box = segs.view_box;
+        get_segments(r, batch_segs);
+        consume(batch_segs, out, std::min<uint64_t>(config.batch_size, limit - batch * config.batch_size), nullptr);
+      }
+      next_batch = first + n;
+    }
+  } else {
+    tbb::parallel_pipeline(
+        token_count,
+        tbb::make_filter<void, Token*>(tbb::filter_mode::serial_in_order,
+                                       [&](tbb::flow_control& fc) -> Token* {
+                                         const uint64_t first = next_batch * config.batch_size;
+                                         if (stop.load(std::memory_order_relaxed) || first >= limit) {
+                                           fc.stop();
+                                           return nullptr;
+                                         }
+                                         // In-flight batches are consecutive and at most token_count.
+                                         Token* t = &tokens[next_batch % token_count];
+                                         t->batch = next_batch++;
+                                         t->count = std::min<uint64_t>(config.batch_size, limit - first);
+                                         return t;
+                                       }) &
+            tbb::make_filter<Token*, Token*>(tbb::filter_mode::parallel,
+                                             [&](Token* t) {
+                                               t->out = BatchOutput{};
+                                               t->log.clear();
+                                               if (stop.load(std::memory_order_relaxed)) return t;
+                                               samplers.local().run(config.seed, t->batch, t->count, t->segments,
+                                                                    t->out, logs ? &t->log : nullptr);
+                                               return t;
+                                             }) &
+            tbb::make_filter<Token*, void>(tbb::filter_mode::serial_in_order,
+                                           [&](Token* t) { consume(t->segments, t->out, t->count, &t->log); }));
+  }
   stats.valid_segments = segs.size();
   if (by_segments && !done)
     throw Error("gave up after " + std::to_string(stats.samples) + " samples with only " +

@@ -8,6 +8,7 @@
 #endif
 
 #include "viewcells/core/binary_file.h"
+#include "viewcells/core/error.h"
 
 namespace viewcells {
 
@@ -134,6 +135,20 @@ SegmentSet read_segments(const std::string& path, SegmentFileHeader* header) {
   }
   if (header) *header = h;
   return s;
+}
+
+void put_segments(cluster::Writer& w, const SegmentSet& s, size_t n) {
+  for (const auto* a : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) w.put_array(a->data(), n);
+  for (const auto* a : {&s.object_a, &s.object_b, &s.triangle_a, &s.triangle_b}) w.put_array(a->data(), n);
+}
+
+void get_segments(cluster::Reader& r, SegmentSet& s) {
+  for (auto* a : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) r.get_array(*a);
+  for (auto* a : {&s.object_a, &s.object_b, &s.triangle_a, &s.triangle_b}) r.get_array(*a);
+  const size_t n = s.ax.size();
+  for (const size_t m : {s.ay.size(), s.az.size(), s.bx.size(), s.by.size(), s.bz.size(), s.object_a.size(),
+                         s.object_b.size(), s.triangle_a.size(), s.triangle_b.size()})
+    if (m != n) throw Error("cluster: a shared segment set has arrays of different lengths");
 }
 
 }  // namespace viewcells

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "viewcells/core/cluster.h"
 #include "viewcells/core/default_init.h"
 #include "viewcells/core/vec3.h"
 #include "viewcells/scene/scene.h"
@@ -44,6 +45,11 @@ struct SegmentSet {
 };
 
 /// What a segment file records besides the segments.
+/// Segments [0, n) of `s` into a message between ranks (core/cluster.h), and back: get_segments
+/// replaces the segments of `s` (its view box stays).
+void put_segments(cluster::Writer& w, const SegmentSet& s, size_t n);
+void get_segments(cluster::Reader& r, SegmentSet& s);
+
 struct SegmentFileHeader {
   uint64_t seed = 0;
   uint64_t samples = 0;            ///< samples drawn (valid or not)

@@ -1,0 +1,92 @@
+#pragma once
+/// The processes of one run on a cluster (MPI ranks, when viewcells is built with
+/// VIEWCELLS_MPI and started by mpirun or srun), and the few collective operations the stages
+/// need. Without MPI, or when not started by an MPI launcher, there is one process and every
+/// operation is local. No MPI type appears here.
+///
+/// Every rank runs the same pipeline on the same data; the parallel stages split their work
+/// into items with a fixed numbering that does not depend on the number of ranks (sampling
+/// batches, casting chunks), each rank computes the items it owns, and share() gives every
+/// rank all results in item order. What follows is then the same on every rank and the same
+/// as in one process: results are identical, byte for byte, for any number of ranks. Only
+/// rank 0 writes files and prints.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace viewcells::cluster {
+
+/// While alive, the process is part of the run's ranks: initialises MPI when viewcells was
+/// built with it and an MPI launcher started the process (mpirun, srun), finalises it after.
+/// One per process, in main().
+class Session {
+ public:
+  Session(int* argc, char*** argv);
+  ~Session();
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+};
+
+int rank();  ///< 0 .. size() - 1
+int size();
+inline bool writer() { return rank() == 0; }
+/// Whether this build can run on several ranks (VIEWCELLS_MPI).
+bool built_with_mpi();
+
+/// Item i of a fixed numbering belongs to rank i mod size().
+inline bool mine(uint64_t item) { return static_cast<int>(item % static_cast<uint64_t>(size())) == rank(); }
+
+/// items[i] holds the serialised result of item first + i where mine(first + i); afterwards
+/// every rank holds all of them. Collective: every rank calls it with the same arguments.
+void share(std::vector<std::string>& items, uint64_t first = 0);
+
+/// What the collective operations have cost this rank so far.
+struct Traffic {
+  uint64_t calls = 0;
+  uint64_t bytes_sent = 0;      ///< this rank's own results, sent to the others
+  uint64_t bytes_received = 0;  ///< the others' results
+  double seconds = 0;           ///< waiting in collectives (imbalance included)
+};
+const Traffic& traffic();
+
+/// Appends and reads back plain values and arrays for share().
+class Writer {
+ public:
+  template <class T>
+  void put(const T& v) {
+    bytes_.append(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  template <class T>
+  void put_array(const T* data, uint64_t n) {
+    put(n);
+    bytes_.append(reinterpret_cast<const char*>(data), n * sizeof(T));
+  }
+  std::string take() { return std::move(bytes_); }
+
+ private:
+  std::string bytes_;
+};
+
+class Reader {
+ public:
+  explicit Reader(const std::string& bytes) : bytes_(bytes) {}
+  template <class T>
+  T get() {
+    T v;
+    read(&v, sizeof v);
+    return v;
+  }
+  template <class V>
+  void get_array(V& out) {
+    const uint64_t n = get<uint64_t>();
+    out.resize(n);
+    read(out.data(), n * sizeof(out[0]));
+  }
+
+ private:
+  void read(void* dst, uint64_t n);
+  const std::string& bytes_;
+  uint64_t pos_ = 0;
+};
+
+}  // namespace viewcells::cluster

@@ -1,0 +1,126 @@
+#include "viewcells/core/cluster.h"
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+
+#include "viewcells/core/error.h"
+
+#ifdef VIEWCELLS_MPI
+#include <mpi.h>
+#endif
+
+namespace viewcells::cluster {
+
+namespace {
+
+int g_rank = 0, g_size = 1;
+Traffic g_traffic;
+
+#ifdef VIEWCELLS_MPI
+bool g_mpi = false;
+
+/// Started by an MPI launcher? (Open MPI's mpirun, PMI/PMIx launchers such as Slurm's srun.)
+bool launched_by_mpi() {
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE", "PMIX_RANK", "SLURM_PROCID", "MPI_LOCALNRANKS"})
+    if (std::getenv(v)) return true;
+  return false;
+}
+
+void check(int rc, const char* what) {
+  if (rc != MPI_SUCCESS) throw Error(std::string("MPI: ") + what + " failed");
+}
+#endif
+
+}  // namespace
+
+Session::Session(int* argc, char*** argv) {
+#ifdef VIEWCELLS_MPI
+  if (!launched_by_mpi()) return;
+  int provided = 0;
+  // Only the main thread calls MPI (between parallel stages).
+  MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
+  g_mpi = true;
+  MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &g_size);
+#else
+  (void)argc, (void)argv;
+#endif
+}
+
+Session::~Session() {
+#ifdef VIEWCELLS_MPI
+  if (g_mpi) MPI_Finalize();
+#endif
+}
+
+int rank() { return g_rank; }
+int size() { return g_size; }
+bool built_with_mpi() {
+#ifdef VIEWCELLS_MPI
+  return true;
+#else
+  return false;
+#endif
+}
+
+const Traffic& traffic() { return g_traffic; }
+
+void share(std::vector<std::string>& items, uint64_t first) {
+  if (g_size == 1) return;
+#ifdef VIEWCELLS_MPI
+  const auto start = std::chrono::steady_clock::now();
+  // This rank's items, each as (length, bytes), in item order.
+  std::string mine_bytes;
+  for (uint64_t i = 0; i < items.size(); ++i) {
+    if (!mine(first + i)) continue;
+    const uint64_t n = items[i].size();
+    mine_bytes.append(reinterpret_cast<const char*>(&n), sizeof n);
+    mine_bytes += items[i];
+  }
+  if (mine_bytes.size() > static_cast<uint64_t>(INT32_MAX))
+    throw Error("MPI: a rank's share of one round exceeds 2 GB; use smaller batches");
+  const int len = static_cast<int>(mine_bytes.size());
+  std::vector<int> lens(g_size), offsets(g_size);
+  check(MPI_Allgather(&len, 1, MPI_INT, lens.data(), 1, MPI_INT, MPI_COMM_WORLD), "allgather of sizes");
+  uint64_t total = 0;
+  for (int r = 0; r < g_size; ++r) {
+    if (total > static_cast<uint64_t>(INT32_MAX)) throw Error("MPI: one round exceeds 2 GB; use smaller batches");
+    offsets[r] = static_cast<int>(total);
+    total += static_cast<uint64_t>(lens[r]);
+  }
+  if (total > static_cast<uint64_t>(INT32_MAX)) throw Error("MPI: one round exceeds 2 GB; use smaller batches");
+  std::string all(total, '\0');
+  check(MPI_Allgatherv(mine_bytes.data(), len, MPI_BYTE, all.data(), lens.data(), offsets.data(), MPI_BYTE,
+                       MPI_COMM_WORLD),
+        "allgatherv");
+  for (int r = 0; r < g_size; ++r) {
+    if (r == g_rank) continue;
+    uint64_t pos = static_cast<uint64_t>(offsets[r]);
+    const uint64_t end = pos + static_cast<uint64_t>(lens[r]);
+    const uint64_t size = static_cast<uint64_t>(g_size);
+    // The first item rank r owns: (first + i) mod size == r.
+    for (uint64_t i = (static_cast<uint64_t>(r) + size - first % size) % size; i < items.size(); i += size) {
+      uint64_t n = 0;
+      if (pos + sizeof n > end) throw Error("MPI: a rank sent fewer items than it owns");
+      std::memcpy(&n, all.data() + pos, sizeof n);
+      pos += sizeof n;
+      if (n > end - pos) throw Error("MPI: a rank's item runs past its data");
+      items[i].assign(all.data() + pos, n);
+      pos += n;
+    }
+  }
+  g_traffic.calls += 1;
+  g_traffic.bytes_sent += static_cast<uint64_t>(len);
+  g_traffic.bytes_received += total - static_cast<uint64_t>(len);
+  g_traffic.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+#endif
+}
+
+void Reader::read(void* dst, uint64_t n) {
+  if (n > bytes_.size() - pos_) throw Error("cluster: a shared item is shorter than its reader expects");
+  std::memcpy(dst, bytes_.data() + pos_, n);
+  pos_ += n;
+}
+
+}  // namespace viewcells::cluster
