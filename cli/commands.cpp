@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "options.h"
+#include "viewcells/core/cluster.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/isa.h"
 #include "viewcells/core/binary_file.h"
@@ -54,7 +55,9 @@ int run(int argc, char** argv) {
     int rc = 0;
     for (const Command& c : commands)
       if (*c.app) rc = c.run();
-    if (rc == 0) outputs.commit();
+    // On a cluster every rank computes the same files; rank 0 installs them, the others'
+    // staged copies go with their batch.
+    if (rc == 0 && cluster::writer()) outputs.commit();
     return rc;
   } catch (const Error& e) {
     std::cerr << "viewcells: error: " << e.what() << '\n';

@@ -62,6 +62,7 @@ struct PvsArgs {
   uint32_t measure_cameras = 0;
   uint32_t measure_size = 1024;
   std::string save, resume, edited_from;
+  double save_every = 0;
   std::vector<std::string> references;
   bool filter = false;
   double filter_k = 1.0;
@@ -92,6 +93,7 @@ int run_pvs(const PvsArgs& a, const Common& c) {
   config.measure_cameras = a.measure_cameras;
   config.measure_size = a.measure_size;
   config.save = a.save;
+  config.save_every = a.save_every;
   config.resume = a.resume;
   config.edited_from = a.edited_from;
   config.references = a.references;
@@ -118,7 +120,13 @@ void add_pvs_command(CLI::App& app, const Common& common, Commands& commands) {
                  "Also measure the pixel error: render this many random cameras by ray casting and count the "
                  "pixels whose object is missing from the PVS")
       ->check(whole(1, 1'000'000));
-  pv->add_option("--save", a->save, "Write the solver's state here at the end, to continue later with --resume");
+  auto* save = pv->add_option("--save", a->save,
+                               "Write the solver's state here at the end, to continue later with --resume");
+  pv->add_option("--save-every", a->save_every,
+                 "With --save: also write the state every this many seconds (a checkpoint a cut-off run resumes "
+                 "from, with any number of ranks)")
+      ->needs(save)
+      ->check(CLI::PositiveNumber);
   pv->add_option("--resume", a->resume,
                  "Continue from a state written by --save (same scene, cells, method, seed and batch); --samples "
                  "and --time count from the start of the computation, the saved part included");

@@ -21,6 +21,7 @@ packages=(
   libassimp-dev          # glTF, FBX and other scene-graph formats
   assimp-testmodels      # real models in those formats, for the tests
   chromium               # the web viewer's test, headless
+  libopenmpi-dev openmpi-bin   # several ranks (VIEWCELLS_MPI; the tests build with it)
   libgtest-dev libgmock-dev libbenchmark-dev   # tests and micro-benchmarks
   gnuplot-nox                                  # plots of comparisons and studies (scripts/plot-*.sh)
 )

@@ -5,7 +5,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-bash scripts/build.sh build RelWithDebInfo -DVIEWCELLS_BUILD_TESTS=ON
+# With MPI, so that the suite also runs sampling and AGVS on several ranks (tests/mpi/).
+bash scripts/build.sh build RelWithDebInfo -DVIEWCELLS_BUILD_TESTS=ON -DVIEWCELLS_MPI=ON
 # Real Quake 3 levels from Debian's archive (oa_dm2 is tested); the tests fail without them.
 bash scripts/fetch-maps.sh
 export VIEWCELLS_REQUIRE_MAPS=1

@@ -55,6 +55,11 @@ void AgvsSolver::set_limits(uint64_t max_samples, double max_seconds, double pix
   impl_->config.pixel_error = pixel_error;
 }
 
+void AgvsSolver::set_checkpoint(double seconds, std::function<void()> save) {
+  impl_->checkpoint_every = seconds;
+  impl_->checkpoint = std::move(save);
+}
+
 void AgvsSolver::run() {
   Impl& m = *impl_;
   const AgvsConfig& c = m.config;
@@ -76,6 +81,7 @@ void AgvsSolver::run() {
                             : by_time  ? static_cast<uint64_t>(std::max(0.0, c.max_seconds - before) * 1000)
                                        : 0);
   uint64_t shown_ms = start_ms;
+  auto last_checkpoint = start;
   while (true) {
     const double seconds = before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (c.max_samples && m.stats.samples >= c.max_samples) {
@@ -123,6 +129,12 @@ void AgvsSolver::run() {
                     m.stats.camera_rays, m.stats.wrong_camera_rays};
     for (size_t k = 0; k < m.references.size(); ++k) point.covered[k] = m.pvs.common_entries(m.references[k]);
     m.stats.curve.push_back(point);
+    if (m.checkpoint && m.checkpoint_every > 0 &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count() >=
+            m.checkpoint_every) {
+      m.checkpoint();
+      last_checkpoint = std::chrono::steady_clock::now();
+    }
   }
   if (show) progress->finish();
 }

@@ -1,4 +1,5 @@
 #pragma once
+#include <functional>
 // AGVS paper 4.6 (putting it all together): the solver's state, shared by the files that
 // implement its parts: distributions.cpp (4.3, 4.4), mixture.cpp (4.2), batch.cpp (4.1, one
 // batch of the sampling loop), estimator.cpp (4.5), filter.cpp (5), edit.cpp (6),
@@ -34,6 +35,8 @@ struct AgvsSolver::Impl {
   std::unique_ptr<SegmentCaster> caster_;
   GlobalPvs pvs;
   AgvsStats stats;
+  double checkpoint_every = 0;          ///< seconds between checkpoints (0: none)
+  std::function<void()> checkpoint;     ///< called between batches, at most every checkpoint_every
   // Surface sampling: rendered objects, and each one's triangles by cumulative area.
   std::vector<uint32_t> objects;
   std::vector<std::vector<std::pair<double, uint32_t>>> triangles_of;

@@ -43,10 +43,6 @@ void check_output_target(const std::string& path) {
 std::string temporary_for(const std::string& path) { return path + ".tmp." + std::to_string(getpid()); }
 
 void install_file(const std::string& tmp, const std::string& path) {
-  if (!cluster::writer()) {  // on a cluster, rank 0 writes; the others hold the same result
-    std::remove(tmp.c_str());
-    return;
-  }
   {
     std::lock_guard lock(g_batch_mutex);
     if (g_batch) {
@@ -59,6 +55,10 @@ void install_file(const std::string& tmp, const std::string& path) {
       g_batch->push_back({tmp, path});
       return;
     }
+  }
+  if (!cluster::writer()) {  // on a cluster, rank 0 writes; the others hold the same result
+    std::remove(tmp.c_str());
+    return;
   }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);

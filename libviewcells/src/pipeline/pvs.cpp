@@ -3,6 +3,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "viewcells/core/cluster.h"
 #include "viewcells/core/format.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
@@ -152,6 +153,16 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   std::optional<AgvsSolver> solver;
   make_solver(c, scenes, cells, pf, out.agvs, solver, out.edit, log);
   add_references(c, pf, *solver);
+  if (!c.save.empty() && c.save_every > 0) {
+    // Checkpoints: installed at once (a later failure must not take them back), written by
+    // rank 0 alone on a cluster (every rank holds the same state).
+    const uint64_t identity = pvs_state_identity(scenes.scene.fingerprint(), pf);
+    solver->set_checkpoint(c.save_every, [&, identity] {
+      if (!cluster::writer()) return;
+      UnbatchedWrites now;
+      solver->save(c.save, identity);
+    });
+  }
   solver->run();
   if (!c.save.empty()) {
     solver->save(c.save, pvs_state_identity(scenes.scene.fingerprint(), pf));

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "viewcells/core/cluster.h"
 #include "viewcells/core/format.h"
 #include "viewcells/core/isa.h"
 #include "viewcells/core/binary_file.h"
@@ -22,8 +23,19 @@ json number_or_null(double v) { return std::isnan(v) ? json(nullptr) : json(v); 
 json effect(bool enabled, const std::string& reason) { return {{"enabled", enabled}, {"reason", reason}}; }
 
 /// Reports say which Embree ISA cast their rays: results are bit-identical only for the same one.
+/// On several MPI ranks they also say how many, and what the ranks exchanged (rank 0's side).
 std::string text(json j) {
-  if (j.is_object()) j["embree_isa"] = embree_isa();
+  if (j.is_object()) {
+    j["embree_isa"] = embree_isa();
+    if (cluster::size() > 1) {
+      const cluster::Traffic& t = cluster::traffic();
+      j["cluster"] = {{"ranks", cluster::size()},
+                      {"exchanges", t.calls},
+                      {"bytes_sent", t.bytes_sent},
+                      {"bytes_received", t.bytes_received},
+                      {"exchange_seconds", t.seconds}};
+    }
+  }
   return j.dump(2) + "\n";
 }
 

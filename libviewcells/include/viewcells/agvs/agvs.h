@@ -17,6 +17,7 @@
 /// the sampling density) and dynamic edits (section 6: objects deleted and inserted, the
 /// solution repaired, sampling resumed).
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -152,6 +153,10 @@ class AgvsSolver {
   void run();
   /// Sets new termination criteria (totals, as in AgvsConfig; for resuming).
   void set_limits(uint64_t max_samples, double max_seconds, double pixel_error);
+  /// Between batches, when at least `seconds` have passed since the run started or the last
+  /// call, run() calls `save` (a checkpoint: typically save() to a file). What it sees is the
+  /// state an interrupted run resumes from; it must not change the solver.
+  void set_checkpoint(double seconds, std::function<void()> save);
   /// Writes the whole state (PVSs, sampling and mixture state, statistics) to a versioned,
   /// checksummed file; `identity` names the scene and view cells it belongs to.
   void save(const std::string& path, uint64_t identity) const;

@@ -24,6 +24,7 @@ struct PvsConfig {
   uint32_t measure_cameras = 0;
   uint32_t measure_size = 1024;
   std::string save, resume, edited_from;
+  double save_every = 0;  ///< with `save`: also write the state every this many seconds (a checkpoint)
   std::vector<std::string> references;
   std::string output;
 };

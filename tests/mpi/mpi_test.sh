@@ -1,0 +1,84 @@
+#!/usr/bin/env bash
+# viewcells on several MPI ranks (a VIEWCELLS_MPI build): `sample`, `pvs`, `bake` and `compare`
+# under mpirun with 1, 2 and 3 ranks (oversubscribed) write the same files, byte for byte, as one
+# process without mpirun, and the same report numbers (timings and the ranks' traffic aside).
+# Then a rank of a checkpointing `pvs` run is killed: the run ends with an error (no hang, no
+# output), and resuming from its last checkpoint on another number of ranks finishes with the
+# file an uninterrupted run writes.
+# Usage: mpi_test.sh VIEWCELLS_BINARY
+set -uo pipefail
+VC="$1"
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+export OMPI_MCA_btl_vader_single_copy_mechanism=none  # containers without ptrace permission
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+cd "$work" || exit 1
+passed=0 failed=0
+ok() { passed=$((passed + 1)); }
+bad() { echo "FAIL: $*"; failed=$((failed + 1)); }
+ranks() { local n=$1; shift; timeout 300 mpirun --oversubscribe -np "$n" "$VC" "$@"; }
+# A report without what may differ between runs: timings, rates, thread and rank counts.
+numbers() {
+  jq -S 'del(.cluster) | walk(if type == "object" then with_entries(select(.key | test("seconds|per_second|time|threads|^output$|^report$") | not)) else . end)' "$1"
+}
+same_files() {  # WHAT A B
+  if cmp -s "$2" "$3"; then ok; else bad "$1: $2 and $3 differ"; fi
+}
+same_numbers() {  # WHAT A B
+  if diff <(numbers "$2") <(numbers "$3") >/dev/null; then ok; else bad "$1: report numbers of $2 and $3 differ: $(diff <(numbers "$2") <(numbers "$3") | head -5)"; fi
+}
+
+"$VC" -q generate office --size 1 -o office.obj || exit 1
+"$VC" -q build office.obj --samples 30000 --max-cells 60 --merge-pvs samples -o office.vcells || exit 1
+
+# One process, no MPI launcher: the reference.
+"$VC" -q sample office.obj --samples 40000 -o s0.vseg --report s0.json || bad "sample"
+"$VC" -q pvs office.vcells --scene office.obj --cells 12 --samples 50000 --batch 5000 -o p0.pvs --report p0.json || bad "pvs"
+"$VC" -q bake office.obj --cells 8 --samples 20000 --max-cells 40 --merge-samples 20000 --agvs-samples 30000 \
+  -o b0.pvs --report b0.json || bad "bake"
+"$VC" -q compare office.obj --methods av-s,kd-casm --max-cells 24 --samples 20000 --eval-samples 30000 -o c0 \
+  || bad "compare"
+for n in 1 2 3; do
+  ranks "$n" -q sample office.obj --samples 40000 -o "s$n.vseg" --report "s$n.json" || bad "sample on $n ranks"
+  same_files "sample, $n ranks" s0.vseg "s$n.vseg"
+  same_numbers "sample, $n ranks" s0.json "s$n.json"
+  ranks "$n" -q pvs office.vcells --scene office.obj --cells 12 --samples 50000 --batch 5000 -o "p$n.pvs" \
+    --report "p$n.json" || bad "pvs on $n ranks"
+  same_files "pvs, $n ranks" p0.pvs "p$n.pvs"
+  same_numbers "pvs, $n ranks" p0.json "p$n.json"
+  ranks "$n" -q bake office.obj --cells 8 --samples 20000 --max-cells 40 --merge-samples 20000 --agvs-samples 30000 \
+    -o "b$n.pvs" --report "b$n.json" || bad "bake on $n ranks"
+  same_files "bake, $n ranks" b0.pvs "b$n.pvs"
+  ranks "$n" -q compare office.obj --methods av-s,kd-casm --max-cells 24 --samples 20000 --eval-samples 30000 \
+    -o "c$n" || bad "compare on $n ranks"
+  for f in c0/*.csv; do same_files "compare, $n ranks" "$f" "c$n/$(basename "$f")"; done
+done
+[ "$(jq -r .cluster.ranks s3.json)" = 3 ] && [ "$(jq -r .cluster.bytes_received s3.json)" -gt 0 ] && ok ||
+  bad "the report of 3 ranks does not say what they exchanged: $(jq -c .cluster s3.json)"
+
+# A rank killed in the middle of a checkpointing run.
+ranks 2 -q pvs office.vcells --scene office.obj --cells 12 --samples 3000000 --batch 5000 --save state.vagvs \
+  --save-every 0.2 -o killed.pvs >/dev/null 2>killed.err &
+run=$!
+for _ in $(seq 600); do [ -s state.vagvs ] && break; sleep 0.1; done
+[ -s state.vagvs ] && ok || bad "no checkpoint within 60 s"
+victim=$(pgrep -f "^$VC -q pvs .*killed.pvs" | tail -1)
+if [ -n "$victim" ]; then kill -9 "$victim"; else bad "no rank to kill (finished already?)"; fi
+wait "$run"
+rc=$?
+[ "$rc" -ne 0 ] && [ "$rc" -ne 124 ] && ok || bad "the run with a killed rank ended with $rc (124: it hung)"
+[ ! -e killed.pvs ] && ok || bad "the run with a killed rank wrote its output"
+grep -q "killed\|signal 9" killed.err && ok || bad "mpirun did not say a rank was killed: $(head -c 300 killed.err)"
+# The checkpoint was taken in the middle of the run.
+saved=$("$VC" pvs office.vcells --scene office.obj --cells 12 --samples 1 --batch 5000 \
+          --resume state.vagvs -o probe.pvs --report probe.json -q && jq -r .samples probe.json)
+[ "${saved:-0}" -gt 0 ] && [ "${saved:-0}" -lt 3000000 ] && ok || bad "the checkpoint holds ${saved:-?} samples"
+echo "mpi_test: killed a rank; the checkpoint held $saved of 3,000,000 samples"
+cp state.vagvs state-copy.vagvs
+ranks 3 -q pvs office.vcells --scene office.obj --cells 12 --samples 3000000 --batch 5000 --resume state-copy.vagvs \
+  -o resumed.pvs || bad "resume on 3 ranks"
+"$VC" -q pvs office.vcells --scene office.obj --cells 12 --samples 3000000 --batch 5000 -o full.pvs || bad "full run"
+same_files "resumed on 3 ranks after a kill" full.pvs resumed.pvs
+
+echo "mpi_test: $passed passed, $failed failed"
+[ "$failed" -eq 0 ]
