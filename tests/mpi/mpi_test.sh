@@ -53,6 +53,15 @@ for n in 1 2 3; do
     -o "c$n" || bad "compare on $n ranks"
   for f in c0/*.csv; do same_files "compare, $n ranks" "$f" "c$n/$(basename "$f")"; done
 done
+# REF and SGVS, and the visibility filter's densities (partitioned with the cells, then combined).
+for extra in "--method ref" "--method sgvs" "--filter"; do
+  # shellcheck disable=SC2086
+  "$VC" -q pvs office.vcells --scene office.obj --cells 12 --samples 30000 --batch 5000 $extra -o x0.pvs || bad "pvs $extra"
+  # shellcheck disable=SC2086
+  ranks 3 -q pvs office.vcells --scene office.obj --cells 12 --samples 30000 --batch 5000 $extra -o x3.pvs ||
+    bad "pvs $extra on 3 ranks"
+  same_files "pvs $extra, 3 ranks" x0.pvs x3.pvs
+done
 [ "$(jq -r .cluster.ranks s3.json)" = 3 ] && [ "$(jq -r .cluster.bytes_received s3.json)" -gt 0 ] && ok ||
   bad "the report of 3 ranks does not say what they exchanged: $(jq -c .cluster s3.json)"
 

@@ -82,13 +82,15 @@ void AgvsSolver::run() {
                                        : 0);
   uint64_t shown_ms = start_ms;
   auto last_checkpoint = start;
+  if (!m.partitioned) m.synced_entries = m.global_entries = m.pvs.entries();
   while (true) {
     const double seconds = before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (c.max_samples && m.stats.samples >= c.max_samples) {
       m.stats.stop_reason = "reached " + std::to_string(c.max_samples) + " samples";
       break;
     }
-    if (c.max_seconds > 0 && seconds >= c.max_seconds) {
+    // Clock decisions are rank 0's on a cluster (cluster::agree), so that all ranks stop together.
+    if (c.max_seconds > 0 && cluster::agree(seconds >= c.max_seconds)) {
       m.stats.stop_reason = "reached the time limit";
       break;
     }
@@ -127,16 +129,19 @@ void AgvsSolver::run() {
     m.stats.seconds = before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     AgvsPoint point{m.stats.seconds, m.stats.samples, m.stats.rays, m.mean_pvs(), m.error, m.error_bound,
                     m.stats.camera_rays, m.stats.wrong_camera_rays};
+    if (!m.references.empty()) m.sync();  // coverage needs the whole table
     for (size_t k = 0; k < m.references.size(); ++k) point.covered[k] = m.pvs.common_entries(m.references[k]);
     m.stats.curve.push_back(point);
     if (m.checkpoint && m.checkpoint_every > 0 &&
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count() >=
-            m.checkpoint_every) {
+        cluster::agree(std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count() >=
+                       m.checkpoint_every)) {
+      m.sync();  // the state of every rank's rows
       m.checkpoint();
       last_checkpoint = std::chrono::steady_clock::now();
     }
   }
   if (show) progress->finish();
+  m.sync();  // every rank holds the whole table when run() returns
 }
 
 void AgvsSolver::add_reference(GlobalPvs reference) {

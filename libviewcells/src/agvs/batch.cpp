@@ -7,6 +7,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <chrono>
 #include <span>
 #include <tuple>
 
@@ -257,14 +258,130 @@ void AgvsSolver::Impl::apply_segment(const BatchSamples& s, const BatchChunk& c,
   }
 }
 
+void AgvsSolver::Impl::apply_partitioned(const BatchSamples& s, const std::vector<BatchChunk>& chunks,
+                                         const std::vector<std::vector<int32_t>>& seg_cells,
+                                         std::vector<int32_t>& origin_cell, BatchCounts& counts) {
+  // Pass 1: this rank's cells. Which samples are the estimator's cameras follows the same
+  // rule as apply_segment (the first own segment of a view space-direction sample), which
+  // does not depend on the table, so every rank finds the same ones.
+  const size_t total = seg_cells.size();
+  std::vector<uint32_t> gains(total, 0);
+  std::vector<uint8_t> flags(total, 0);  // contributed a, b; at origin a, b
+  std::vector<uint8_t> camera(s.points.size(), 0);
+  std::vector<int32_t> owned;
+  auto on_segment = [&](const BatchChunk& c, size_t i, uint32_t sample) {
+    const Vec3 a = c.segs.a(i), ab = c.segs.b(i) - a;
+    const double t = dot(s.points[sample] - a, ab);
+    return t >= 0 && t <= dot(ab, ab);
+  };
+  for (const BatchChunk& c : chunks) {
+    for (size_t i = 0; i < c.segs.size(); ++i) {
+      const size_t k = c.seg_start + i;
+      const uint32_t sample = c.first + c.sample_of[i];
+      const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
+      if (config.method == AgvsMethod::kRef) {
+        if (camera[sample] != 0 || !on_segment(c, i, sample)) continue;
+        camera[sample] = 1;
+        const int32_t cell = s.ref_cell[sample];
+        if (!cluster::mine(static_cast<uint64_t>(cell))) continue;
+        if (config.filter_statistics) count_hits(cell, objs[1], kNoObject);
+        if (objs[1] != kNoObject && pvs.insert(static_cast<uint32_t>(cell), objs[1])) gains[k] = 1, flags[k] = 4;
+        continue;
+      }
+      const bool own = c.dist == kVsd && camera[sample] == 0 && on_segment(c, i, sample);
+      if (own && origin_cell[sample] == -2) origin_cell[sample] = cells.cell_at(s.points[sample]);
+      owned.clear();
+      for (int32_t cell : seg_cells[k])
+        if (cluster::mine(static_cast<uint64_t>(cell))) owned.push_back(cell);
+      bool contributed[2] = {false, false}, at_origin[2] = {false, false};
+      gains[k] = contribute(pvs, owned, objs[0], objs[1], contributed, own ? origin_cell[sample] : -1, at_origin);
+      flags[k] = static_cast<uint8_t>(contributed[0] | contributed[1] << 1 | at_origin[0] << 2 | at_origin[1] << 3);
+      if (config.filter_statistics)
+        for (int32_t cell : owned) count_hits(cell, objs[0], objs[1]);
+      if (own) camera[sample] = 2;
+    }
+  }
+  cluster::sum(gains);
+  cluster::bit_or(flags);
+  // Pass 2: what apply_segment does besides the table, with the gains and flags of all ranks.
+  for (const BatchChunk& c : chunks) {
+    counts.rays[c.dist] += c.rays;
+    for (size_t i = 0; i < c.segs.size(); ++i) {
+      const size_t k = c.seg_start + i;
+      const uint32_t sample = c.first + c.sample_of[i];
+      counts.has_segment[sample] = 1;
+      const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
+      if (config.method == AgvsMethod::kRef) {
+        if (counts.camera_rays[sample] == 0 && on_segment(c, i, sample)) {
+          counts.camera_rays[sample] = 1;
+          if (flags[k] & 4) counts.wrong_rays[sample] = 1;
+        }
+        counts.contribution[c.dist] += gains[k];
+        continue;
+      }
+      const bool own = c.dist == kVsd && counts.camera_rays[sample] == 0 && on_segment(c, i, sample);
+      if (own) {
+        counts.camera_rays[sample] = 2;
+        counts.wrong_rays[sample] = static_cast<uint8_t>(((flags[k] >> 2) & 1) + ((flags[k] >> 3) & 1));
+      }
+      counts.contribution[c.dist] += gains[k];
+      if (gains[k] > 0 && config.method == AgvsMethod::kAgvs) {
+        const Vec3 a = c.segs.a(i), b = c.segs.b(i);
+        for (int e = 0; e < 2; ++e) {
+          if (!((flags[k] >> e) & 1)) continue;
+          const Vec3& term = e ? b : a;
+          const Vec3& origin = e ? a : b;
+          add_candidate({origin, term, end_radius(objs[1 - e], origin), end_radius(objs[e], term), objs[e]});
+        }
+      }
+    }
+  }
+  // The table's size over all ranks' rows (for the mean PVS of the curve and the status).
+  partitioned = true;
+  std::vector<uint64_t> grown{pvs.entries() - synced_entries};
+  cluster::sum(grown);
+  global_entries = synced_entries + grown[0];
+}
+
+void AgvsSolver::Impl::sync() {
+  if (!partitioned) return;
+  // Each row from its owner: the others' copies of it are older subsets (bits) or must not be
+  // counted twice (the filter's densities), so they are cleared before the reduction.
+  const uint32_t n_cells = pvs.cell_count();
+  const size_t words = pvs.words_per_row(), objects = pvs.object_count();
+  std::vector<uint64_t>& bits = pvs.raw_bits();
+  for (uint32_t c = 0; c < n_cells; ++c)
+    if (!cluster::mine(c)) std::fill(bits.begin() + c * words, bits.begin() + (c + 1) * words, 0);
+  cluster::bit_or(bits);
+  pvs.recount();
+  if (config.filter_statistics) {
+    for (uint32_t c = 0; c < n_cells; ++c)
+      if (!cluster::mine(c)) {
+        cell_samples[c] = 0;
+        std::fill(hit_counts.begin() + c * objects, hit_counts.begin() + (c + 1) * objects, 0);
+      }
+    cluster::sum(cell_samples);
+    cluster::sum(hit_counts);
+  }
+  synced_entries = global_entries = pvs.entries();
+  partitioned = false;
+}
+
 void AgvsSolver::Impl::batch(uint64_t index, uint32_t n) {
   double share[kDists];
   shares(share);
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
+  auto t = Clock::now();
   BatchSamples s;
   draw_samples(index, n, share, s);
+  stats.draw_seconds += since(t);
+  t = Clock::now();
   const size_t count = s.points.size();
   std::vector<std::vector<int32_t>> seg_cells;
   const std::vector<BatchChunk> chunks = cast_samples(s, seg_cells);
+  stats.cast_seconds += since(t);
+  t = Clock::now();
   // Apply in sample order (serial: contributions depend on what came before).
   BatchCounts counts;
   counts.rays[kSil] += s.discovery_rays;
@@ -272,10 +389,16 @@ void AgvsSolver::Impl::batch(uint64_t index, uint32_t n) {
   counts.wrong_rays.assign(count, 0);
   counts.has_segment.assign(count, 0);
   std::vector<int32_t> origin_cell(count, -2);
-  for (const BatchChunk& c : chunks) {
-    counts.rays[c.dist] += c.rays;
-    for (size_t i = 0; i < c.segs.size(); ++i) apply_segment(s, c, i, seg_cells[c.seg_start + i], origin_cell, counts);
+  if (cluster::size() > 1) {
+    apply_partitioned(s, chunks, seg_cells, origin_cell, counts);
+  } else {
+    for (const BatchChunk& c : chunks) {
+      counts.rays[c.dist] += c.rays;
+      for (size_t i = 0; i < c.segs.size(); ++i) apply_segment(s, c, i, seg_cells[c.seg_start + i], origin_cell, counts);
+    }
   }
+  stats.segments += seg_cells.size();
+  for (const auto& p : seg_cells) stats.pierced_cells += p.size();
   // The estimator counts view space-direction samples (all of them for SGVS and REF).
   uint64_t vsd_rays = 0, vsd_contributing = 0;
   for (uint32_t k = s.first_of[kVsd]; k < s.end_of[kVsd]; ++k) {
@@ -294,6 +417,7 @@ void AgvsSolver::Impl::batch(uint64_t index, uint32_t n) {
   stats.camera_rays += vsd_rays;
   stats.wrong_camera_rays += vsd_contributing;
   update_estimate(vsd_rays, vsd_contributing);
+  stats.apply_seconds += since(t);
 }
 
 }  // namespace viewcells

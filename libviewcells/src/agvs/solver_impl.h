@@ -14,6 +14,7 @@
 #include "candidates.h"
 #include "halton.h"
 #include "viewcells/agvs/agvs.h"
+#include "viewcells/core/cluster.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/rng.h"
 #include "viewcells/sampling/sampler.h"
@@ -64,6 +65,14 @@ struct AgvsSolver::Impl {
   std::vector<uint64_t> cell_samples;
   std::vector<uint16_t> hit_counts;
   std::vector<GlobalPvs> references;  ///< for the curve's coverage only
+  // On several ranks (core/cluster.h) the cells are partitioned: rank r applies segments to
+  // the cells c with c mod ranks == r, so each rank's table is current in its own rows only
+  // (`partitioned` is then true) until sync() combines them. Everything else is the same on
+  // every rank: a segment's gain is summed and its flags or-ed over the ranks before they are
+  // used, in sample order.
+  bool partitioned = false;
+  uint64_t synced_entries = 0;  ///< entries of the table at the last sync()
+  uint64_t global_entries = 0;  ///< entries of all ranks' rows together (while partitioned)
 
   const Scene& scene() const { return *scene_; }
   const RayCaster& caster_ref() const { return *caster_ref_; }
@@ -147,6 +156,13 @@ struct AgvsSolver::Impl {
   std::vector<BatchChunk> cast_samples(const BatchSamples& s, std::vector<std::vector<int32_t>>& seg_cells);
   void apply_segment(const BatchSamples& s, const BatchChunk& c, size_t i, const std::vector<int32_t>& pierced,
                      std::vector<int32_t>& origin_cell, BatchCounts& counts);
+  /// apply_segment on several ranks: each rank's own cells first, then the reduced outcome.
+  void apply_partitioned(const BatchSamples& s, const std::vector<BatchChunk>& chunks,
+                         const std::vector<std::vector<int32_t>>& seg_cells, std::vector<int32_t>& origin_cell,
+                         BatchCounts& counts);
+  /// Combines the ranks' rows (and the filter's densities): afterwards every rank holds the
+  /// whole table. Collective. No-op in one process.
+  void sync();
   /// The mixture's weights after a batch (mixture.cpp), and the per-distribution statistics.
   void update_weights(const double share[kDists], const uint64_t samples[kDists], const uint64_t contribution[kDists],
                       const uint64_t rays[kDists]);
@@ -162,7 +178,9 @@ struct AgvsSolver::Impl {
   /// is no estimate, and error_bound gives the one-sided 90% Poisson upper bound over it.
   void evaluate_window();
 
-  double mean_pvs() const { return static_cast<double>(pvs.entries()) / cells.cell_count(); }
+  double mean_pvs() const {
+    return static_cast<double>(partitioned ? global_entries : pvs.entries()) / cells.cell_count();
+  }
 
   AgvsEditStats edit(const Scene& edited, const RayCaster& rc, const std::vector<uint32_t>& new_of_old);
 

@@ -409,6 +409,13 @@ std::string report_json(const PvsResult& r) {
                {"estimator_window_rays", st.window_rays},
                {"measured_pixel_error", measure_json(r.measured, c.measure_size)},
                {"stop_reason", st.stop_reason},
+               // Where this run's time went (resumed: this run's part only).
+               {"phases",
+                {{"draw_seconds", st.draw_seconds},
+                 {"cast_seconds", st.cast_seconds},
+                 {"apply_seconds", st.apply_seconds},
+                 {"segments", st.segments},
+                 {"pierced_cells", st.pierced_cells}}},
                {"distributions", agvs_distributions(st)},
                {"curve", agvs_curve(st, c.references.size())}});
 }

@@ -28,6 +28,16 @@ bool GlobalPvs::insert(uint32_t cell, uint32_t object) {
   return true;
 }
 
+void GlobalPvs::recount() {
+  entries_ = 0;
+  for (uint32_t c = 0; c < cells_; ++c) {
+    uint32_t n = 0;
+    for (size_t k = 0; k < words_; ++k) n += static_cast<uint32_t>(__builtin_popcountll(bits_[size_t(c) * words_ + k]));
+    sizes_[c] = n;
+    entries_ += n;
+  }
+}
+
 bool GlobalPvs::erase(uint32_t cell, uint32_t object) {
   uint64_t& w = bits_[size_t(cell) * words_ + object / 64];
   const uint64_t bit = uint64_t{1} << (object % 64);

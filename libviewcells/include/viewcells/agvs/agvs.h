@@ -138,6 +138,11 @@ struct AgvsStats {
   uint64_t window_rays = 0;
   uint64_t camera_rays = 0, wrong_camera_rays = 0;  ///< the estimator's rays since the start
   double seconds = 0;
+  /// Where this run's time went, batch by batch (not saved with the state): drawing the samples
+  /// (silhouette searches included), casting them and finding their cells (spread over the
+  /// ranks on a cluster; the exchange of results included), applying them in order (serial).
+  double draw_seconds = 0, cast_seconds = 0, apply_seconds = 0;
+  uint64_t segments = 0, pierced_cells = 0;  ///< segments applied, and cells they pierced in all
   std::string stop_reason;
   EmptySpaceDecision empty_space;
   std::vector<AgvsPoint> curve;

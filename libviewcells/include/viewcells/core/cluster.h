@@ -40,6 +40,17 @@ inline bool mine(uint64_t item) { return static_cast<int>(item % static_cast<uin
 /// every rank holds all of them. Collective: every rank calls it with the same arguments.
 void share(std::vector<std::string>& items, uint64_t first = 0);
 
+/// Element-wise sums and bitwise ors over all ranks, in place (every rank gets the result).
+/// Collective: every rank calls them with vectors of the same length.
+void sum(std::vector<uint16_t>& v);
+void sum(std::vector<uint32_t>& v);
+void sum(std::vector<uint64_t>& v);
+void bit_or(std::vector<uint8_t>& v);
+void bit_or(std::vector<uint64_t>& v);
+/// Rank 0's `value` on every rank: decisions that depend on a clock (stop after S seconds,
+/// write a checkpoint now) are rank 0's, so that every rank takes them at the same batch.
+bool agree(bool value);
+
 /// What the collective operations have cost this rank so far.
 struct Traffic {
   uint64_t calls = 0;

@@ -33,6 +33,11 @@ class GlobalPvs {
   uint64_t common_entries(const GlobalPvs& other) const;
   std::vector<uint32_t> list(uint32_t cell) const;  ///< sorted object ids
   bool operator==(const GlobalPvs& o) const { return cells_ == o.cells_ && objects_ == o.objects_ && bits_ == o.bits_; }
+  /// The bit rows (cell after cell, words_per_row() words each), for combining tables held by
+  /// several processes; after changing them, call recount().
+  std::vector<uint64_t>& raw_bits() { return bits_; }
+  size_t words_per_row() const { return words_; }
+  void recount();
   void save(ByteWriter& w) const;
   /// Reads what save() wrote; Error unless it has `cells` rows over `objects` objects.
   static GlobalPvs load(ByteReader& r, uint32_t cells, uint32_t objects);

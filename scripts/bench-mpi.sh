@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# MPI (issue: bakes that outgrow one machine): what the ranks exchange and where the time goes,
+# with 1, 2 and 4 ranks of one thread each on this machine (4 ranks oversubscribe its 2 cores:
+# their compute is not faster, their traffic is what it is), for AGVS (`pvs`, 1M samples in
+# batches of 20,000, seed 1) on the city of size 23 cut into 500 and 5,000 view cells, and for
+# segment sampling (`sample`, 2M samples). Then the strong-scaling model of docs/distributed.md
+# from those measurements. Prints JSON lines and Markdown tables.
+# Usage: scripts/bench-mpi.sh
+set -euo pipefail
+bench_cmake_args="-DVIEWCELLS_MPI=ON"
+source "$(dirname "$0")/bench-setup.sh"
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+scene=$(bench_scene city 23)
+out="$dir/mpi"
+mkdir -p "$out"
+[ -f "$out/city5000.vcells" ] || "$vc" -q build "$scene" --samples 1000000 --max-cells 5000 --merge-pvs samples --seed 1 \
+  -o "$out/city5000.vcells"
+lines="$out/runs.jsonl"
+: >"$lines"
+for n in 1 2 4; do
+  for cells in 500 5000; do
+    mpirun --oversubscribe -np "$n" "$vc" --threads 1 -q pvs "$out/city5000.vcells" --scene "$scene" --cells "$cells" \
+      --samples 1000000 --batch 20000 --seed 1 -o "$out/pvs-$cells-$n.pvs" --report "$out/pvs-$cells-$n.json"
+    jq -c --arg kind pvs --argjson cells "$cells" --argjson ranks "$n" '{kind: $kind, cells: $cells, ranks: $ranks,
+      samples: .samples, seconds: .seconds, phases: .phases, cluster: (.cluster // {exchanges: 0, bytes_sent: 0,
+      bytes_received: 0, exchange_seconds: 0})}' "$out/pvs-$cells-$n.json" | tee -a "$lines"
+  done
+  mpirun --oversubscribe -np "$n" "$vc" --threads 1 -q sample "$scene" --samples 2000000 --seed 1 \
+    -o "$out/s-$n.vseg" --report "$out/sample-$n.json"
+  jq -c --arg kind sample --argjson ranks "$n" '{kind: $kind, ranks: $ranks, samples: .counts.samples,
+    seconds: .timings.sampling_seconds, segments: .counts.valid_segments, cluster: (.cluster // {exchanges: 0, bytes_sent: 0, bytes_received: 0,
+    exchange_seconds: 0})}' "$out/sample-$n.json" | tee -a "$lines"
+done
+for n in 2 4; do
+  cmp -s "$out/s-1.vseg" "$out/s-$n.vseg" || { echo "bench-mpi: $n ranks sampled another file" >&2; exit 1; }
+  for cells in 500 5000; do
+    cmp -s "$out/pvs-$cells-1.pvs" "$out/pvs-$cells-$n.pvs" || { echo "bench-mpi: $n ranks: another .pvs" >&2; exit 1; }
+  done
+done
+python3 scripts/vctables.py mpi-model "$lines"
