@@ -689,7 +689,6 @@ def unpack_maps(*args):
                 os.replace(tmp, target)
 
 
-@command("FILE NAME COMMAND TABLE_FILE")
 @command("RUNS_JSONL")
 def mpi_model(*args):
     """MPI: measured exchange and phase times per rank count, and the strong-scaling model (docs/distributed.md)."""
@@ -769,6 +768,7 @@ def mpi_model(*args):
             print()
 
 
+@command("FILE NAME COMMAND TABLE_FILE")
 def replace_section(path, name, cmd, table_file):
     """Replaces the text between <!-- NAME:begin --> and <!-- NAME:end --> in a Markdown file by
     "Command: `COMMAND`", a blank line, and the contents of TABLE_FILE."""

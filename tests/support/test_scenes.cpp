@@ -39,6 +39,9 @@ Scene cube_grid(int n, double spacing, double size) {
 std::string temp_path(const std::string& name) {
   static const std::string dir = [] {
     auto d = std::filesystem::temp_directory_path() / ("viewcells_test_" + std::to_string(getpid()));
+    // A directory of this name is a dead process's (PIDs are reused): start empty.
+    std::error_code ec;
+    std::filesystem::remove_all(d, ec);
     std::filesystem::create_directories(d);
     std::atexit([] {
       std::error_code ec;

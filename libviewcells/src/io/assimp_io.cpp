@@ -422,6 +422,8 @@ RawMesh read_isolated(const std::string& name, F&& read) {
       answer = "M" + encode(read());
     } catch (const std::exception& e) {
       answer = std::string("E") + e.what();
+    } catch (...) {  // the child must never return into the caller's code
+      answer = "E" + name + ": the Assimp reader failed";
     }
     write_all(fds[1], answer);
     close(fds[1]);
