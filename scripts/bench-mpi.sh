@@ -37,4 +37,5 @@ for n in 2 4; do
     cmp -s "$out/pvs-$cells-1.pvs" "$out/pvs-$cells-$n.pvs" || { echo "bench-mpi: $n ranks: another .pvs" >&2; exit 1; }
   done
 done
-python3 scripts/vctables.py mpi-model "$lines"
+python3 scripts/vctables.py mpi-model "$lines" | tee "$out/tables.md"
+python3 scripts/vctables.py replace-section docs/distributed.md mpi "scripts/bench-mpi.sh" "$out/tables.md"

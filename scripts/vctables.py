@@ -692,7 +692,8 @@ def unpack_maps(*args):
 @command("RUNS_JSONL")
 def mpi_model(*args):
     """MPI: measured exchange and phase times per rank count, and the strong-scaling model (docs/distributed.md)."""
-    runs = [json.loads(line) for line in open(args[0]) if line.strip()]
+    with open(args[0]) as f:
+        runs = [json.loads(line) for line in f if line.strip()]
     print("| run | ranks | samples | seconds | draw / cast / apply s | exchanges | sent per exchange (rank 0) "
           "| received per exchange | exchange s | exchange share |")
     print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
@@ -707,14 +708,20 @@ def mpi_model(*args):
               f"| {c['bytes_sent'] / ex / 1e3:,.0f} kB | {c['bytes_received'] / ex / 1e3:,.0f} kB "
               f"| {c['exchange_seconds']:.2f} | {100 * c['exchange_seconds'] / r['seconds']:.1f}% |")
     print()
-    # Model inputs per sample, from one rank of one thread (compute) and from two ranks (bytes).
+    # Model inputs per sample: compute from one rank of one thread; the part of applying that
+    # the ranks divide (their own cells) from two ranks: a2 = p + q / 2, a1 = p + q; bytes from
+    # two ranks (what rank 0 sent and received is the whole batch's results).
     inputs = {}
     for cells in sorted({r["cells"] for r in runs if r["kind"] == "pvs"}):
         one = next(r for r in runs if r["kind"] == "pvs" and r["cells"] == cells and r["ranks"] == 1)
         two = next(r for r in runs if r["kind"] == "pvs" and r["cells"] == cells and r["ranks"] == 2)
         ph, n = one["phases"], one["samples"]
+        a1 = ph["apply_seconds"] / n
+        a2 = two["phases"]["apply_seconds"] / two["samples"]
+        divided = min(max(2 * (a1 - a2), 0.0), a1)
         inputs[cells] = {
-            "draw": ph["draw_seconds"] / n, "cast": ph["cast_seconds"] / n, "apply": ph["apply_seconds"] / n,
+            "draw": ph["draw_seconds"] / n, "cast": ph["cast_seconds"] / n, "apply": a1,
+            "serial_apply": a1 - divided, "divided_apply": divided,
             "bytes": (two["cluster"]["bytes_sent"] + two["cluster"]["bytes_received"]) / two["samples"],
             "pierced": ph["pierced_cells"] / max(ph["segments"], 1), "segments": ph["segments"] / n}
     if len(inputs) >= 2:
@@ -724,48 +731,46 @@ def mpi_model(*args):
         grow = (big / hi) ** k
         m = dict(inputs[hi])
         m["pierced"] = inputs[hi]["pierced"] * grow
-        m["apply"] = inputs[hi]["apply"] * grow
+        for key in ("apply", "serial_apply", "divided_apply"):
+            m[key] = inputs[hi][key] * grow
         m["bytes"] = inputs[hi]["bytes"] + 4 * inputs[hi]["segments"] * (m["pierced"] - inputs[hi]["pierced"])
         inputs[big] = m
         print(f"Pierced cells per segment grow as cells^{k:.2f} (measured at {lo:,} and {hi:,} cells); "
-              f"at {big:,} cells the model extrapolates {m['pierced']:.1f} per segment.")
+              f"at {big:,} cells the model extrapolates {m['pierced']:.1f} per segment, and applying in proportion.")
         print()
-    print("| cells | draw µs/sample | cast core-µs/sample | apply µs/sample | exchanged bytes/sample "
-          "| pierced cells/segment |")
+    print("| cells | draw µs/sample (serial) | cast core-µs/sample | apply µs/sample: serial + divided by the ranks "
+          "| exchanged bytes/sample | pierced cells/segment |")
     print("| --- | --- | --- | --- | --- | --- |")
     for cells, m in sorted(inputs.items()):
-        print(f"| {cells:,} | {1e6 * m['draw']:.2f} | {1e6 * m['cast']:.2f} | {1e6 * m['apply']:.2f} "
-              f"| {m['bytes']:.0f} | {m['pierced']:.1f} |")
+        print(f"| {cells:,} | {1e6 * m['draw']:.2f} | {1e6 * m['cast']:.2f} | {1e6 * m['serial_apply']:.2f} + "
+              f"{1e6 * m['divided_apply']:.2f} | {m['bytes']:.0f} | {m['pierced']:.1f} |")
     print()
-    cores, bandwidth, latency = 32, 10e9, 5e-6
+    cores, bandwidth, latency, batch = 32, 10e9, 5e-6, 20000
     nodes = [1, 2, 4, 8, 16, 32, 64]
 
-    def per_sample(m, n, batch, partitioned):
-        exchange = ((n - 1) / n) * m["bytes"] / bandwidth + (2 * math.ceil(math.log2(n)) * latency / batch
+    def per_sample(m, n, all_parallel):
+        # One exchange of the batch's results (ring allgather: (n - 1) / n of them reach each
+        # rank) and three small reductions per batch, each a few latencies.
+        exchange = ((n - 1) / n) * m["bytes"] / bandwidth + (4 * math.ceil(math.log2(n)) * latency / batch
                                                           if n > 1 else 0)
-        apply = m["apply"]
-        if partitioned and n > 1:
-            # Each rank applies the segments to the cells it owns; per segment, the gains are
-            # summed and the flags or-ed across ranks (8 bytes a segment, an allreduce).
-            apply /= n
-            exchange += 2 * ((n - 1) / n) * 8 * m["segments"] / bandwidth
-        return m["draw"] + apply + m["cast"] / (n * cores) + exchange
+        if all_parallel:
+            return (m["draw"] + m["apply"] + m["cast"]) / (n * cores) + exchange
+        return m["draw"] + m["serial_apply"] + m["divided_apply"] / n + m["cast"] / (n * cores) + exchange
 
-    for partitioned in (False, True):
-        for batch in (20000, 2000000):
-            what = ("cells partitioned over the ranks (designed, not built)" if partitioned
-                    else "every rank applies every segment (as built)")
-            print(f"{what}; batches of {batch:,} samples, {cores} cores per node, {bandwidth / 1e9:.0f} GB/s "
-                  f"and {latency * 1e6:.0f} µs between nodes: speed-up over one node (parallel efficiency)")
-            print()
-            print("| cells | " + " | ".join(f"{n} nodes" for n in nodes) + " |")
-            print("| --- | " + " | ".join("---" for _ in nodes) + " |")
-            for cells, m in sorted(inputs.items()):
-                base = per_sample(m, 1, batch, partitioned)
-                print(f"| {cells:,} | " + " | ".join(
-                    f"{base / per_sample(m, n, batch, partitioned):.1f} "
-                    f"({100 * base / per_sample(m, n, batch, partitioned) / n:.0f}%)" for n in nodes) + " |")
-            print()
+    for all_parallel in (False, True):
+        what = ("if drawing and applying were spread like casting (not built: the bound from the exchange alone)"
+                if all_parallel else "as built: drawing and the ordered part of applying on every rank")
+        print(f"{what}; batches of {batch:,} samples, {cores} cores per node, {bandwidth / 1e9:.0f} GB/s and "
+              f"{latency * 1e6:.0f} µs between nodes: speed-up over one node (parallel efficiency)")
+        print()
+        print("| cells | " + " | ".join(f"{n} nodes" for n in nodes) + " |")
+        print("| --- | " + " | ".join("---" for _ in nodes) + " |")
+        for cells, m in sorted(inputs.items()):
+            base = per_sample(m, 1, all_parallel)
+            print(f"| {cells:,} | " + " | ".join(
+                f"{base / per_sample(m, n, all_parallel):.1f} ({100 * base / per_sample(m, n, all_parallel) / n:.0f}%)"
+                for n in nodes) + " |")
+        print()
 
 
 @command("FILE NAME COMMAND TABLE_FILE")

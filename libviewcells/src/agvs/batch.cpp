@@ -348,7 +348,7 @@ void AgvsSolver::Impl::sync() {
   // Each row from its owner: the others' copies of it are older subsets (bits) or must not be
   // counted twice (the filter's densities), so they are cleared before the reduction.
   const uint32_t n_cells = pvs.cell_count();
-  const size_t words = pvs.words_per_row(), objects = pvs.object_count();
+  const size_t words = pvs.words_per_row(), n_objects = pvs.object_count();
   std::vector<uint64_t>& bits = pvs.raw_bits();
   for (uint32_t c = 0; c < n_cells; ++c)
     if (!cluster::mine(c)) std::fill(bits.begin() + c * words, bits.begin() + (c + 1) * words, 0);
@@ -358,7 +358,7 @@ void AgvsSolver::Impl::sync() {
     for (uint32_t c = 0; c < n_cells; ++c)
       if (!cluster::mine(c)) {
         cell_samples[c] = 0;
-        std::fill(hit_counts.begin() + c * objects, hit_counts.begin() + (c + 1) * objects, 0);
+        std::fill(hit_counts.begin() + c * n_objects, hit_counts.begin() + (c + 1) * n_objects, 0);
       }
     cluster::sum(cell_samples);
     cluster::sum(hit_counts);

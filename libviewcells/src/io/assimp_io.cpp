@@ -90,7 +90,10 @@ class Builder {
       throw Error(name_, 0, "the scene graph is deeper than " + std::to_string(kMaxNodeDepth) + " nodes (cyclic?)");
     const aiMatrix4x4 world = parent * node->mTransformation;
     std::string label = node->mName.length ? std::string(node->mName.C_Str()) : std::string();
-    if (label.empty()) label = parent_path.empty() ? "node" : parent_path + "/node";
+    if (label.empty()) {
+      label = parent_path;
+      label.append(parent_path.empty() ? "node" : "/node");
+    }
     const std::string node_name = unique(label);
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
       const unsigned mi = node->mMeshes[i];
