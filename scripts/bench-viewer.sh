@@ -4,7 +4,8 @@
 # (size 4): each is baked (500 view cells; 500,000 construction samples, 2,000 cells merged on
 # them, PVSs by 2M AGVS samples), written by `viewcells view`, opened at 1280x720 and turned about
 # its centre for SECONDS; on the city also from a street-level camera turning on the spot and
-# following its own cell, drawing everything and drawing only the cell's PVS. Also the time from a click to the lit PVS.
+# following its own cell, drawing everything and drawing only the cell's PVS; some at half
+# resolution (the panel's choice). Also the time from a click to the lit PVS.
 # Prints one JSON line per run and a Markdown table for BENCHMARKS.md.
 # Usage: scripts/bench-viewer.sh [SECONDS]
 set -euo pipefail
@@ -25,7 +26,8 @@ for spec in city:23 office:4; do
   # 60 m with 16 m streets), looking along it.
   street="camera=388,420,1.7&target=388,440,1.7&spin=eye"
   views=("cells=all")
-  [ "$kind" = city ] && views+=("$street&cells=none&follow=1&draw=all" "$street&cells=none&follow=1&draw=pvs")
+  [ "$kind" = city ] && views+=("cells=all&scale=0.5" "$street&cells=none&follow=1&draw=all"
+                                "$street&cells=none&follow=1&draw=pvs" "$street&cells=none&follow=1&draw=pvs&scale=0.5")
   for settings in "${views[@]}"; do
     line=$(node web/test/bench_viewer.mjs "$out/$kind$size-site/index.html" "$seconds" 1280x720 "$settings")
     echo "$line"
@@ -40,6 +42,7 @@ for r in "${rows[@]}"; do
   view="from above, all cells shown"
   [[ $settings == *draw=all* ]] && view="street level, following its cell, drawing everything"
   [[ $settings == *draw=pvs* ]] && view="street level, following its cell, drawing only its PVS"
+  [[ $settings == *scale=0.5* ]] && view="$view, half resolution"
   med=$(jq -r .frame_ms_median <<<"$line") p95=$(jq -r .frame_ms_p95 <<<"$line") click=$(jq -r .click_ms_median <<<"$line")
   printf '| %s | %s | %s | %s ms (%s ms) | %s ms |\n' "$name" "$tris" "$view" "$med" "$p95" "$click"
 done

@@ -216,7 +216,10 @@ function showSelectedCell(c) {
 // --- view ----------------------------------------------------------------------------------
 const container = document.getElementById('view');
 const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
-renderer.setPixelRatio(window.devicePixelRatio || 1);
+// The resolution is the panel's choice (#scale in the address): drawing half or a quarter of
+// the pixels is what keeps software WebGL (no GPU) moving on a large level.
+const pixelRatio = () => (window.devicePixelRatio || 1) * Number(document.getElementById('scale').value);
+renderer.setPixelRatio(pixelRatio());
 renderer.setSize(container.clientWidth, container.clientHeight);
 container.appendChild(renderer.domElement);
 const scene = new THREE.Scene();
@@ -377,11 +380,16 @@ document.getElementById('title').textContent = `viewcells: ${D.scene.split('/').
 document.getElementById('summary').textContent =
     `${fmt(cells.count)} view cells (${D.rule}) · ${fmt(objects.count)} objects · ${fmt(totalTriangles)} triangles`;
 // #cells=all|selected|none and #colour=cost|pvs in the address set the panel's choices.
-for (const [key, id] of [['cells', 'cells'], ['colour', 'colour'], ['draw', 'draw']]) {
+for (const [key, id] of [['cells', 'cells'], ['colour', 'colour'], ['draw', 'draw'], ['scale', 'scale']]) {
   const value = hash.get(key), el = document.getElementById(id);
   if (value && [...el.options].some((o) => o.value === value)) el.value = value;
 }
 cellMesh.visible = cellsMode() === 'all';
+renderer.setPixelRatio(pixelRatio());
+document.getElementById('scale').addEventListener('change', () => {
+  renderer.setPixelRatio(pixelRatio());
+  dirty = true;
+});
 if (hash.get('follow') === '1') follow.checked = state.follow = true;
 paintScene(null);
 paintCells(document.getElementById('colour').value);

@@ -60,6 +60,12 @@ try {
   if (drawnPvs !== pvsTriangles) fail(`drawing the PVS draws ${drawnPvs} triangles, its objects have ${pvsTriangles}`);
   if (drawnAll !== sceneInfo.triangles) fail(`the page draws ${drawnAll} triangles, the scene has ${sceneInfo.triangles}`);
   console.log(`draw only the PVS: ${drawnPvs} of ${drawnAll} triangles`);
+  // Half resolution draws half the pixels each way.
+  const fullWidth = await page.evaluate(() => document.querySelector('canvas').width);
+  await page.selectOption('#scale', '0.5');
+  const halfWidth = await page.evaluate(() => document.querySelector('canvas').width);
+  if (Math.abs(halfWidth - fullWidth / 2) > 1) fail(`half resolution: canvas ${halfWidth} wide, full ${fullWidth}`);
+  await page.selectOption('#scale', '1');
   await page.waitForTimeout(300);
   const shot = join(work, 'viewer.png');
   await page.screenshot({ path: shot });
