@@ -1,6 +1,7 @@
 #include "viewcells/core/cluster.h"
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <algorithm>
 #include <cstring>
@@ -46,6 +47,15 @@ Session::Session(int* argc, char*** argv) {
   MPI_Comm_size(MPI_COMM_WORLD, &g_size);
 #else
   (void)argc, (void)argv;
+  // Started by mpirun without MPI in this build: every process would run the whole command.
+  for (const char* v : {"OMPI_COMM_WORLD_SIZE", "PMI_SIZE"})
+    if (const char* n = std::getenv(v); n && std::atoi(n) > 1) {
+      std::fprintf(stderr,
+                   "viewcells: warning: started as one of %s MPI processes, but built without MPI "
+                   "(VIEWCELLS_MPI): each process runs the whole command\n",
+                   n);
+      break;
+    }
 #endif
 }
 
