@@ -83,9 +83,7 @@ struct ViewArgs {
 int run_view(const ViewArgs& a, const Common& c) {
   if (a.site.empty() && a.gltf.empty()) throw Error("view writes a web page (-o DIR) or glTF (--gltf FILE): give one");
   check_files({a.input, a.scene}, {a.gltf});
-  if (!a.site.empty() && !web_viewer_available())  // before any work
-    throw Error("this viewcells was built without the web viewer (web/node_modules was missing): run "
-                "scripts/install-deps.sh, then build again");
+  if (!a.site.empty()) require_web_viewer();  // before any work
   CostModel model;
   model.a = a.cost_a;
   model.b = a.cost_b;

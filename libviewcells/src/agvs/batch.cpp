@@ -11,6 +11,7 @@
 #include <span>
 #include <tuple>
 
+#include "viewcells/core/binary_file.h"
 #include "viewcells/core/cluster.h"
 
 namespace viewcells {
@@ -46,6 +47,7 @@ struct AgvsSolver::Impl::BatchChunk {
   int dist = 0;
   SegmentSet segs;
   std::vector<uint32_t> sample_of;
+  std::vector<std::vector<int32_t>> pierced;  ///< per segment: the cells it has length in (not for REF)
   uint64_t rays = 0;
   size_t seg_start = 0;  ///< index of its first segment among the batch's
 };
@@ -111,8 +113,7 @@ void AgvsSolver::Impl::draw_samples(uint64_t index, uint32_t n, const double sha
   }
 }
 
-std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const BatchSamples& s,
-                                                                          std::vector<std::vector<int32_t>>& seg_cells) {
+std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const BatchSamples& s) {
   // Cast in fixed chunks within each distribution, in parallel; outputs in sample order.
   constexpr uint32_t kChunk = 1024;
   std::vector<BatchChunk> chunks;
@@ -124,75 +125,51 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
       c.dist = d;
       chunks.push_back(std::move(c));
     }
-  auto cells_of = [&](const BatchChunk& c, std::vector<std::vector<int32_t>>& out) {
-    out.assign(c.segs.size(), {});
+  // A chunk: its samples cast, and the cells of each segment.
+  auto cast_chunk = [&](BatchChunk& c) {
+    c.rays = caster().cast(std::span<const Vec3>(s.points.data() + c.first, c.size),
+                           std::span<const Vec3>(s.dirs.data() + c.first, c.size), c.segs, c.sample_of);
+    c.pierced.assign(c.segs.size(), {});
     if (config.method == AgvsMethod::kRef) return;
     std::vector<std::tuple<int32_t, double, double>> stack;
     std::vector<int32_t> leaves;
-    for (size_t i = 0; i < c.segs.size(); ++i) cells.cells_of_segment(c.segs.a(i), c.segs.b(i), out[i], stack, leaves);
+    for (size_t i = 0; i < c.segs.size(); ++i)
+      cells.cells_of_segment(c.segs.a(i), c.segs.b(i), c.pierced[i], stack, leaves);
   };
   if (cluster::size() > 1) {
     // Several ranks: each casts the chunks it owns (numbered across batches, so that the work
-    // turns round the ranks) and finds their segments' cells; every rank receives all chunks,
-    // and applies them below in sample order, as one process does.
+    // turns round the ranks; a chunk's owner may differ between rank counts, its content does
+    // not), and every rank receives all chunks.
     std::vector<std::string> items(chunks.size());
     const uint64_t base = stats.batches * 4096;
     tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
       if (!cluster::mine(base + k)) return;
       BatchChunk& c = chunks[k];
-      c.rays = caster().cast(std::span<const Vec3>(s.points.data() + c.first, c.size),
-                             std::span<const Vec3>(s.dirs.data() + c.first, c.size), c.segs, c.sample_of);
-      std::vector<std::vector<int32_t>> pierced;
-      cells_of(c, pierced);
-      cluster::Writer w;
+      cast_chunk(c);
+      ByteWriter w;
       w.put(c.rays);
-      w.put_array(c.sample_of.data(), c.sample_of.size());
-      put_segments(w, c.segs, c.segs.size());
-      for (const auto& p : pierced) w.put_array(p.data(), p.size());
+      w.put_array(c.sample_of);
+      put_segments(w, c.segs);
+      for (const auto& p : c.pierced) w.put_array(p);
       items[k] = w.take();
     });
-    // Ownership rotates with `base`, which counts batches, not ranks: a chunk's owner may differ
-    // between rank counts, its content does not.
     cluster::share(items, base);
-    std::vector<std::string>& shared = items;
-    size_t total = 0;
-    std::vector<std::vector<std::vector<int32_t>>> pierced(chunks.size());
     for (size_t k = 0; k < chunks.size(); ++k) {
       BatchChunk& c = chunks[k];
-      cluster::Reader r(shared[k]);
+      ByteReader r(items[k], "a rank's casting results");
       c.rays = r.get<uint64_t>();
-      r.get_array(c.sample_of);
-      get_segments(r, c.segs);
-      pierced[k].resize(c.segs.size());
-      for (auto& p : pierced[k]) r.get_array(p);
-      c.seg_start = total;
-      total += c.segs.size();
+      r.get_array(c.sample_of, items[k].size());
+      get_segments(r, c.segs, items[k].size());
+      c.pierced.resize(c.segs.size());
+      for (auto& p : c.pierced) r.get_array(p, items[k].size());
     }
-    seg_cells.assign(total, {});
-    for (size_t k = 0; k < chunks.size(); ++k)
-      for (size_t i = 0; i < pierced[k].size(); ++i) seg_cells[chunks[k].seg_start + i] = std::move(pierced[k][i]);
-    return chunks;
+  } else {
+    tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) { cast_chunk(chunks[k]); });
   }
-  tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
-    BatchChunk& c = chunks[k];
-    c.rays = caster().cast(std::span<const Vec3>(s.points.data() + c.first, c.size),
-                           std::span<const Vec3>(s.dirs.data() + c.first, c.size), c.segs, c.sample_of);
-  });
-  // The cells of every segment, in parallel.
   size_t total = 0;
   for (BatchChunk& c : chunks) {
     c.seg_start = total;
     total += c.segs.size();
-  }
-  seg_cells.assign(total, {});
-  if (config.method != AgvsMethod::kRef) {
-    tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
-      std::vector<std::tuple<int32_t, double, double>> stack;
-      std::vector<int32_t> leaves;
-      const SegmentSet& segs = chunks[k].segs;
-      for (size_t i = 0; i < segs.size(); ++i)
-        cells.cells_of_segment(segs.a(i), segs.b(i), seg_cells[chunks[k].seg_start + i], stack, leaves);
-    });
   }
   return chunks;
 }
@@ -205,70 +182,23 @@ struct AgvsSolver::Impl::BatchCounts {
   std::vector<uint8_t> camera_rays, wrong_rays, has_segment;
 };
 
-void AgvsSolver::Impl::apply_segment(const BatchSamples& s, const BatchChunk& c, size_t i,
-                                     const std::vector<int32_t>& pierced, std::vector<int32_t>& origin_cell,
-                                     BatchCounts& counts) {
-  const uint32_t sample = c.first + c.sample_of[i];
-  counts.has_segment[sample] = 1;
-  const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
-  bool contributed[2] = {false, false};
-  uint64_t gain = 0;
+void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<BatchChunk>& chunks,
+                                      BatchCounts& counts) {
+  // Pass 1, in sample order: the table. On several ranks each inserts into its own cells (c
+  // mod ranks == rank); then each segment's gains are summed and its flags or-ed over the
+  // ranks (in one process, every cell is its own and the reductions do nothing). Which
+  // samples are the estimator's cameras (the first own segment of a view space-direction
+  // sample) does not depend on the table, so every rank finds the same ones.
+  size_t total = 0;
+  for (const BatchChunk& c : chunks) total += c.segs.size();
+  std::vector<uint32_t> gains(total, 0);
+  std::vector<uint8_t> flags(total, 0);  // contributed a, b; at origin a, b (REF: wrong ray)
+  std::vector<uint8_t> camera(s.points.size(), 0);
+  std::vector<int32_t> origin_cell(s.points.size(), -2);
+  std::vector<int32_t> owned;
+  const bool all_mine = cluster::size() == 1;
   // Whether the sample's point lies on this segment: its own segment (re-casts of points
   // inside solids start elsewhere; see-through companions are the first one's).
-  auto on_segment = [&] {
-    const Vec3 a = c.segs.a(i), ab = c.segs.b(i) - a;
-    const double t = dot(s.points[sample] - a, ab);
-    return t >= 0 && t <= dot(ab, ab);
-  };
-  if (config.method == AgvsMethod::kRef) {
-    // Per cell: the object hit forward from the sample's point, for its cell only; one
-    // camera ray, counted once per sample.
-    const uint32_t o = objs[1];
-    if (counts.camera_rays[sample] == 0 && on_segment()) {
-      counts.camera_rays[sample] = 1;
-      if (config.filter_statistics) count_hits(s.ref_cell[sample], o, kNoObject);
-      if (o != kNoObject && pvs.insert(static_cast<uint32_t>(s.ref_cell[sample]), o)) {
-        ++gain;
-        counts.wrong_rays[sample] = 1;
-      }
-    }
-  } else {
-    const bool own = c.dist == kVsd && counts.camera_rays[sample] == 0 && on_segment();
-    if (own && origin_cell[sample] == -2) origin_cell[sample] = cells.cell_at(s.points[sample]);
-    bool at_origin[2] = {false, false};
-    gain = contribute(pvs, pierced, objs[0], objs[1], contributed, own ? origin_cell[sample] : -1, at_origin);
-    if (config.filter_statistics)
-      for (int32_t cell : pierced) count_hits(cell, objs[0], objs[1]);
-    // The estimator's rays: a camera at the point sees along both rays of its segment.
-    if (own) {
-      counts.camera_rays[sample] = 2;
-      counts.wrong_rays[sample] = static_cast<uint8_t>(at_origin[0] + at_origin[1]);
-    }
-  }
-  counts.contribution[c.dist] += gain;
-  if (gain > 0 && config.method == AgvsMethod::kAgvs) {
-    // A mutation candidate per end whose object contributed.
-    const Vec3 a = c.segs.a(i), b = c.segs.b(i);
-    for (int e = 0; e < 2; ++e) {
-      if (!contributed[e]) continue;
-      const Vec3& term = e ? b : a;
-      const Vec3& origin = e ? a : b;
-      add_candidate({origin, term, end_radius(objs[1 - e], origin), end_radius(objs[e], term), objs[e]});
-    }
-  }
-}
-
-void AgvsSolver::Impl::apply_partitioned(const BatchSamples& s, const std::vector<BatchChunk>& chunks,
-                                         const std::vector<std::vector<int32_t>>& seg_cells,
-                                         std::vector<int32_t>& origin_cell, BatchCounts& counts) {
-  // Pass 1: this rank's cells. Which samples are the estimator's cameras follows the same
-  // rule as apply_segment (the first own segment of a view space-direction sample), which
-  // does not depend on the table, so every rank finds the same ones.
-  const size_t total = seg_cells.size();
-  std::vector<uint32_t> gains(total, 0);
-  std::vector<uint8_t> flags(total, 0);  // contributed a, b; at origin a, b
-  std::vector<uint8_t> camera(s.points.size(), 0);
-  std::vector<int32_t> owned;
   auto on_segment = [&](const BatchChunk& c, size_t i, uint32_t sample) {
     const Vec3 a = c.segs.a(i), ab = c.segs.b(i) - a;
     const double t = dot(s.points[sample] - a, ab);
@@ -280,6 +210,8 @@ void AgvsSolver::Impl::apply_partitioned(const BatchSamples& s, const std::vecto
       const uint32_t sample = c.first + c.sample_of[i];
       const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
       if (config.method == AgvsMethod::kRef) {
+        // Per cell: the object hit forward from the sample's point, for its cell only; one
+        // camera ray, counted once per sample.
         if (camera[sample] != 0 || !on_segment(c, i, sample)) continue;
         camera[sample] = 1;
         const int32_t cell = s.ref_cell[sample];
@@ -290,20 +222,24 @@ void AgvsSolver::Impl::apply_partitioned(const BatchSamples& s, const std::vecto
       }
       const bool own = c.dist == kVsd && camera[sample] == 0 && on_segment(c, i, sample);
       if (own && origin_cell[sample] == -2) origin_cell[sample] = cells.cell_at(s.points[sample]);
-      owned.clear();
-      for (int32_t cell : seg_cells[k])
-        if (cluster::mine(static_cast<uint64_t>(cell))) owned.push_back(cell);
+      const std::vector<int32_t>* mine = &c.pierced[i];
+      if (!all_mine) {
+        owned.clear();
+        for (int32_t cell : c.pierced[i])
+          if (cluster::mine(static_cast<uint64_t>(cell))) owned.push_back(cell);
+        mine = &owned;
+      }
       bool contributed[2] = {false, false}, at_origin[2] = {false, false};
-      gains[k] = contribute(pvs, owned, objs[0], objs[1], contributed, own ? origin_cell[sample] : -1, at_origin);
+      gains[k] = contribute(pvs, *mine, objs[0], objs[1], contributed, own ? origin_cell[sample] : -1, at_origin);
       flags[k] = static_cast<uint8_t>(contributed[0] | contributed[1] << 1 | at_origin[0] << 2 | at_origin[1] << 3);
       if (config.filter_statistics)
-        for (int32_t cell : owned) count_hits(cell, objs[0], objs[1]);
+        for (int32_t cell : *mine) count_hits(cell, objs[0], objs[1]);
       if (own) camera[sample] = 2;
     }
   }
   cluster::sum(gains);
   cluster::bit_or(flags);
-  // Pass 2: what apply_segment does besides the table, with the gains and flags of all ranks.
+  // Pass 2, in sample order: what follows from the segments besides the table.
   for (const BatchChunk& c : chunks) {
     counts.rays[c.dist] += c.rays;
     for (size_t i = 0; i < c.segs.size(); ++i) {
@@ -311,21 +247,21 @@ void AgvsSolver::Impl::apply_partitioned(const BatchSamples& s, const std::vecto
       const uint32_t sample = c.first + c.sample_of[i];
       counts.has_segment[sample] = 1;
       const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
+      counts.contribution[c.dist] += gains[k];
       if (config.method == AgvsMethod::kRef) {
         if (counts.camera_rays[sample] == 0 && on_segment(c, i, sample)) {
           counts.camera_rays[sample] = 1;
           if (flags[k] & 4) counts.wrong_rays[sample] = 1;
         }
-        counts.contribution[c.dist] += gains[k];
         continue;
       }
-      const bool own = c.dist == kVsd && counts.camera_rays[sample] == 0 && on_segment(c, i, sample);
-      if (own) {
+      // The estimator's rays: a camera at the point sees along both rays of its segment.
+      if (c.dist == kVsd && counts.camera_rays[sample] == 0 && on_segment(c, i, sample)) {
         counts.camera_rays[sample] = 2;
         counts.wrong_rays[sample] = static_cast<uint8_t>(((flags[k] >> 2) & 1) + ((flags[k] >> 3) & 1));
       }
-      counts.contribution[c.dist] += gains[k];
       if (gains[k] > 0 && config.method == AgvsMethod::kAgvs) {
+        // A mutation candidate per end whose object contributed.
         const Vec3 a = c.segs.a(i), b = c.segs.b(i);
         for (int e = 0; e < 2; ++e) {
           if (!((flags[k] >> e) & 1)) continue;
@@ -336,6 +272,7 @@ void AgvsSolver::Impl::apply_partitioned(const BatchSamples& s, const std::vecto
       }
     }
   }
+  if (all_mine) return;
   // The table's size over all ranks' rows (for the mean PVS of the curve and the status).
   partitioned = true;
   std::vector<uint64_t> grown{pvs.entries() - synced_entries};
@@ -378,27 +315,20 @@ void AgvsSolver::Impl::batch(uint64_t index, uint32_t n) {
   stats.draw_seconds += since(t);
   t = Clock::now();
   const size_t count = s.points.size();
-  std::vector<std::vector<int32_t>> seg_cells;
-  const std::vector<BatchChunk> chunks = cast_samples(s, seg_cells);
+  const std::vector<BatchChunk> chunks = cast_samples(s);
   stats.cast_seconds += since(t);
   t = Clock::now();
-  // Apply in sample order (serial: contributions depend on what came before).
+  // Apply in sample order (contributions depend on what came before).
   BatchCounts counts;
   counts.rays[kSil] += s.discovery_rays;
   counts.camera_rays.assign(count, 0);
   counts.wrong_rays.assign(count, 0);
   counts.has_segment.assign(count, 0);
-  std::vector<int32_t> origin_cell(count, -2);
-  if (cluster::size() > 1) {
-    apply_partitioned(s, chunks, seg_cells, origin_cell, counts);
-  } else {
-    for (const BatchChunk& c : chunks) {
-      counts.rays[c.dist] += c.rays;
-      for (size_t i = 0; i < c.segs.size(); ++i) apply_segment(s, c, i, seg_cells[c.seg_start + i], origin_cell, counts);
-    }
+  apply_segments(s, chunks, counts);
+  for (const BatchChunk& c : chunks) {
+    stats.segments += c.segs.size();
+    for (const auto& p : c.pierced) stats.pierced_cells += p.size();
   }
-  stats.segments += seg_cells.size();
-  for (const auto& p : seg_cells) stats.pierced_cells += p.size();
   // The estimator counts view space-direction samples (all of them for SGVS and REF).
   uint64_t vsd_rays = 0, vsd_contributing = 0;
   for (uint32_t k = s.first_of[kVsd]; k < s.end_of[kVsd]; ++k) {

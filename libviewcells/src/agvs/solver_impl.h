@@ -153,13 +153,11 @@ struct AgvsSolver::Impl {
   struct BatchChunk;
   struct BatchCounts;
   void draw_samples(uint64_t index, uint32_t n, const double share[kDists], BatchSamples& s);
-  std::vector<BatchChunk> cast_samples(const BatchSamples& s, std::vector<std::vector<int32_t>>& seg_cells);
-  void apply_segment(const BatchSamples& s, const BatchChunk& c, size_t i, const std::vector<int32_t>& pierced,
-                     std::vector<int32_t>& origin_cell, BatchCounts& counts);
-  /// apply_segment on several ranks: each rank's own cells first, then the reduced outcome.
-  void apply_partitioned(const BatchSamples& s, const std::vector<BatchChunk>& chunks,
-                         const std::vector<std::vector<int32_t>>& seg_cells, std::vector<int32_t>& origin_cell,
-                         BatchCounts& counts);
+  std::vector<BatchChunk> cast_samples(const BatchSamples& s);
+  /// Applies a batch's segments in sample order: the table (on several ranks, each rank's own
+  /// cells, then the gains and flags reduced over the ranks), then the counts and mutation
+  /// candidates that follow from them.
+  void apply_segments(const BatchSamples& s, const std::vector<BatchChunk>& chunks, BatchCounts& counts);
   /// Combines the ranks' rows (and the filter's densities): afterwards every rank holds the
   /// whole table. Collective. No-op in one process.
   void sync();

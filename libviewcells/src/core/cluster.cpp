@@ -171,10 +171,5 @@ void bit_or(std::vector<uint64_t>&) {}
 bool agree(bool value) { return value; }
 #endif
 
-void Reader::read(void* dst, uint64_t n) {
-  if (n > bytes_.size() - pos_) throw Error("cluster: a shared item is shorter than its reader expects");
-  std::memcpy(dst, bytes_.data() + pos_, n);
-  pos_ += n;
-}
 
 }  // namespace viewcells::cluster

@@ -455,11 +455,6 @@ RawMesh read_isolated(const std::string& name, F&& read) {
 
 bool is_gltf(const std::string& ext) { return ext == ".gltf" || ext == ".glb"; }
 
-std::string lower_ext(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  return ext;
-}
 
 constexpr unsigned kFlags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
                             aiProcess_ValidateDataStructure | aiProcess_FindInvalidData;
@@ -486,7 +481,7 @@ bool is_assimp_extension(const std::string& ext) {
 }
 
 static RawMesh read_assimp_here(const std::string& path, AssimpObjects mode) {
-  const std::string ext = lower_ext(path);
+  const std::string ext = lower_extension(path);
   if (is_gltf(ext)) {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path, 0, "cannot open file");

@@ -12,6 +12,7 @@
 
 #include <cmath>
 
+#include "viewcells/core/binary_file.h"
 #include "viewcells/core/cluster.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/progress.h"
@@ -432,18 +433,19 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
         BatchOutput out;
         samplers.local().run(config.seed, batch, std::min<uint64_t>(config.batch_size, limit - batch * config.batch_size),
                              scratch, out, nullptr);
-        cluster::Writer w;
+        ByteWriter w;
         w.put(out);
-        put_segments(w, scratch, out.valid);
+        scratch.resize(out.valid);
+        put_segments(w, scratch);
         items[i] = w.take();
       });
       cluster::share(items);
       for (uint64_t i = 0; i < n && !finished; ++i) {
         const uint64_t batch = first + i;
-        cluster::Reader r(items[i]);
+        ByteReader r(items[i], "a rank's sampling results");
         BatchOutput out = r.get<BatchOutput>();
         batch_segs.view_box = segs.view_box;
-        get_segments(r, batch_segs);
+        get_segments(r, batch_segs, items[i].size());
         consume(batch_segs, out, std::min<uint64_t>(config.batch_size, limit - batch * config.batch_size), nullptr);
       }
       next_batch = first + n;

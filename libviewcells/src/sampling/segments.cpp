@@ -86,11 +86,7 @@ void write_segments(const std::string& path, const SegmentSet& s, const SegmentF
   w.put<uint64_t>(h.scene_fingerprint);
   w.put<uint32_t>(h.object_count);
   w.put<uint8_t>(h.empty_space_detection ? 1 : 0);
-  for (const auto* v : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) w.put_array(*v);
-  w.put_array(s.object_a);
-  w.put_array(s.object_b);
-  w.put_array(s.triangle_a);
-  w.put_array(s.triangle_b);
+  put_segments(w, s);
   write_container(path, kMagic, kVersion, w.data());
 }
 
@@ -107,18 +103,9 @@ SegmentSet read_segments(const std::string& path, SegmentFileHeader* header) {
   h.scene_fingerprint = r.get<uint64_t>();
   h.object_count = r.get<uint32_t>();
   h.empty_space_detection = r.get<uint8_t>() != 0;
-  const uint64_t max_count = payload.size() / sizeof(uint32_t);
-  for (auto* v : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) r.get_array(*v, max_count);
-  r.get_array(s.object_a, max_count);
-  r.get_array(s.object_b, max_count);
-  r.get_array(s.triangle_a, max_count);
-  r.get_array(s.triangle_b, max_count);
+  get_segments(r, s, payload.size() / sizeof(uint32_t));
   if (!r.at_end()) r.fail("trailing bytes after the segment arrays");
-  const size_t n = s.ax.size();
-  for (const auto* v : {&s.ay, &s.az, &s.bx, &s.by, &s.bz})
-    if (v->size() != n) r.fail("segment arrays differ in length");
-  if (s.object_a.size() != n || s.object_b.size() != n || s.triangle_a.size() != n || s.triangle_b.size() != n)
-    r.fail("object or triangle arrays differ in length");
+  const size_t n = s.size();
   if (s.view_box.empty() || !is_finite(s.view_box.lo) || !is_finite(s.view_box.hi)) r.fail("invalid view box");
   for (size_t i = 0; i < n; ++i) {
     if (!s.view_box.contains(s.a(i)) || !s.view_box.contains(s.b(i)))
@@ -137,18 +124,19 @@ SegmentSet read_segments(const std::string& path, SegmentFileHeader* header) {
   return s;
 }
 
-void put_segments(cluster::Writer& w, const SegmentSet& s, size_t n) {
-  for (const auto* a : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) w.put_array(a->data(), n);
-  for (const auto* a : {&s.object_a, &s.object_b, &s.triangle_a, &s.triangle_b}) w.put_array(a->data(), n);
+void put_segments(ByteWriter& w, const SegmentSet& s) {
+  for (const auto* v : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) w.put_array(*v);
+  for (const auto* v : {&s.object_a, &s.object_b, &s.triangle_a, &s.triangle_b}) w.put_array(*v);
 }
 
-void get_segments(cluster::Reader& r, SegmentSet& s) {
-  for (auto* a : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) r.get_array(*a);
-  for (auto* a : {&s.object_a, &s.object_b, &s.triangle_a, &s.triangle_b}) r.get_array(*a);
+void get_segments(ByteReader& r, SegmentSet& s, uint64_t max_count) {
+  for (auto* v : {&s.ax, &s.ay, &s.az, &s.bx, &s.by, &s.bz}) r.get_array(*v, max_count);
+  for (auto* v : {&s.object_a, &s.object_b, &s.triangle_a, &s.triangle_b}) r.get_array(*v, max_count);
   const size_t n = s.ax.size();
-  for (const size_t m : {s.ay.size(), s.az.size(), s.bx.size(), s.by.size(), s.bz.size(), s.object_a.size(),
-                         s.object_b.size(), s.triangle_a.size(), s.triangle_b.size()})
-    if (m != n) throw Error("cluster: a shared segment set has arrays of different lengths");
+  for (const auto* v : {&s.ay, &s.az, &s.bx, &s.by, &s.bz})
+    if (v->size() != n) r.fail("segment arrays differ in length");
+  if (s.object_a.size() != n || s.object_b.size() != n || s.triangle_a.size() != n || s.triangle_b.size() != n)
+    r.fail("object or triangle arrays differ in length");
 }
 
 }  // namespace viewcells

@@ -280,13 +280,15 @@ void write_level_gltf(const std::string& path, const LevelView& view) {
   write_text_file(path, b.glb({scene_root, cell_root}, extras));
 }
 
-bool web_viewer_available() { return web_assets::available(); }
-
-void write_web_viewer(const std::string& dir, const LevelView& view) {
-  if (!web_viewer_available())
+void require_web_viewer() {
+  if (!web_assets::available())
     throw Error(
         "this viewcells was built without the web viewer (web/node_modules was missing): run "
         "scripts/install-deps.sh, then build again");
+}
+
+void write_web_viewer(const std::string& dir, const LevelView& view) {
+  require_web_viewer();
   std::error_code ec;
   if (std::filesystem::exists(dir, ec) && !std::filesystem::is_directory(dir, ec))
     throw Error(dir, 0, "exists and is not a directory");

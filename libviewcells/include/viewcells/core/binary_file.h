@@ -34,6 +34,8 @@ class ByteWriter {
     data_.append(s);
   }
   const std::string& data() const { return data_; }
+  /// The bytes, moved out (the writer is empty afterwards).
+  std::string take() { return std::move(data_); }
 
  private:
   std::string data_;

@@ -36,7 +36,7 @@ bool built_with_mpi();
 /// Item i of a fixed numbering belongs to rank i mod size().
 inline bool mine(uint64_t item) { return static_cast<int>(item % static_cast<uint64_t>(size())) == rank(); }
 
-/// items[i] holds the serialised result of item first + i where mine(first + i); afterwards
+/// items[i] holds the serialised result (core/binary_file.h's ByteWriter) of item first + i where mine(first + i); afterwards
 /// every rank holds all of them. Collective: every rank calls it with the same arguments.
 void share(std::vector<std::string>& items, uint64_t first = 0);
 
@@ -59,45 +59,5 @@ struct Traffic {
   double seconds = 0;           ///< waiting in collectives (imbalance included)
 };
 const Traffic& traffic();
-
-/// Appends and reads back plain values and arrays for share().
-class Writer {
- public:
-  template <class T>
-  void put(const T& v) {
-    bytes_.append(reinterpret_cast<const char*>(&v), sizeof v);
-  }
-  template <class T>
-  void put_array(const T* data, uint64_t n) {
-    put(n);
-    bytes_.append(reinterpret_cast<const char*>(data), n * sizeof(T));
-  }
-  std::string take() { return std::move(bytes_); }
-
- private:
-  std::string bytes_;
-};
-
-class Reader {
- public:
-  explicit Reader(const std::string& bytes) : bytes_(bytes) {}
-  template <class T>
-  T get() {
-    T v;
-    read(&v, sizeof v);
-    return v;
-  }
-  template <class V>
-  void get_array(V& out) {
-    const uint64_t n = get<uint64_t>();
-    out.resize(n);
-    read(out.data(), n * sizeof(out[0]));
-  }
-
- private:
-  void read(void* dst, uint64_t n);
-  const std::string& bytes_;
-  uint64_t pos_ = 0;
-};
 
 }  // namespace viewcells::cluster

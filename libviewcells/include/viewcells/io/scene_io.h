@@ -19,6 +19,9 @@ namespace viewcells {
 /// kNodes and kMeshes apply to the Assimp formats only (for them kAuto and kGroups mean kNodes).
 Scene load_scene(const std::string& path, ObjectGrouping grouping = ObjectGrouping::kAuto);
 
+/// The extension of `path` in lower case, with its dot ("" when it has none).
+std::string lower_extension(const std::string& path);
+
 /// What becomes an object of a scene read through Assimp.
 enum class AssimpObjects {
   kNodes,   ///< each node instance of the scene graph with meshes (its see-through meshes apart)

@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/binary_file.h"
 #include "viewcells/core/default_init.h"
 #include "viewcells/core/vec3.h"
 #include "viewcells/scene/scene.h"
@@ -45,10 +45,11 @@ struct SegmentSet {
 };
 
 /// What a segment file records besides the segments.
-/// Segments [0, n) of `s` into a message between ranks (core/cluster.h), and back: get_segments
-/// replaces the segments of `s` (its view box stays).
-void put_segments(cluster::Writer& w, const SegmentSet& s, size_t n);
-void get_segments(cluster::Reader& r, SegmentSet& s);
+/// The segment arrays of `s`, as a .vseg file and a message between ranks (core/cluster.h)
+/// hold them, and back: get_segments replaces the segments of `s` (its view box stays) and
+/// fails (ByteReader::fail) on arrays of different lengths or more than max_count elements.
+void put_segments(ByteWriter& w, const SegmentSet& s);
+void get_segments(ByteReader& r, SegmentSet& s, uint64_t max_count);
 
 struct SegmentFileHeader {
   uint64_t seed = 0;

@@ -52,9 +52,10 @@ void write_level_gltf(const std::string& path, const LevelView& view);
 /// Writes the static web viewer into directory `dir` (created when missing): index.html,
 /// viewer.js (three.js and the viewer, bundled when viewcells was built) and data.js (the
 /// level). It opens from the file system without a server. Throws Error when this build has
-/// no viewer bundle (see web_viewer_available()).
+/// no viewer bundle (see require_web_viewer()).
 void write_web_viewer(const std::string& dir, const LevelView& view);
-/// False when viewcells was built without the web viewer (no web/node_modules at build time).
-bool web_viewer_available();
+/// Throws Error, saying what to do, when viewcells was built without the web viewer (no
+/// web/node_modules at build time).
+void require_web_viewer();
 
 }  // namespace viewcells
