@@ -21,6 +21,7 @@ struct CompareArgs {
   double cost_a = 100, cost_b = 1;
   bool no_ga = false;
   uint32_t axis_candidates = 200;
+  bool exact_candidates = false;
   uint32_t ga_candidates = 150;
   MergeOptions merge;
   std::string output;
@@ -39,6 +40,7 @@ int run_compare(const CompareArgs& a, const Common& c) {
   config.model.a = a.cost_a;
   config.model.b = a.cost_b;
   config.subdivision.max_axis_candidates = a.axis_candidates;
+  config.subdivision.exact_candidates = a.exact_candidates;
   config.subdivision.ga_candidates = a.ga_candidates;
   config.geometry_aligned_off = a.no_ga;
   config.merge_agvs = a.merge.agvs(c, config.construction.seed, config.construction.samples);
@@ -56,7 +58,7 @@ void add_compare_command(CLI::App& app, const Common& common, Commands& commands
                                 "independent evaluation samples (paper, section 6)");
   add_sampling_options(cm, a->sampling);
   cm->add_option("--methods", a->methods,
-                 "Comma-separated: av-m (AV-S's cells merged; see --merge-pvs), av-m-samples (greedy merging on the construction samples' PVSs alone, the paper's AV-M), av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp, and q3-clusters (the clusters "
+                 "Comma-separated: av-m (AV-S's cells merged; see --merge-pvs), av-m-samples (greedy merging on the construction samples' PVSs alone, the paper's AV-M), av-s, av-s-exact (AV-S with --exact-candidates, to compare the two in one run), kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp, and q3-clusters (the clusters "
                  "q3map2 compiled into a Quake 3 map; the default on a .bsp with visibility data, with av-m,av-s,kd-casm)")
       ->capture_default_str()
       ->each([a](const std::string&) { a->methods_given = true; });
@@ -74,6 +76,7 @@ void add_compare_command(CLI::App& app, const Common& common, Commands& commands
   cm->add_option("--axis-candidates", a->axis_candidates, "AV-S/AV-M: axis-aligned positions per axis and cell")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  cm->add_flag("--exact-candidates", a->exact_candidates, std::string("AV-S/AV-M: ") + kExactCandidatesHelp);
   cm->add_option("--ga-candidates", a->ga_candidates, "AV-S/AV-M: geometry-aligned planes per cell")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

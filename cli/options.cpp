@@ -209,6 +209,7 @@ SubdivisionConfig CellOptions::subdivision(const Common& c, uint64_t seed) const
   config.geometry_aligned = no_ga ? GeometryAlignedMode::kOff : (ga ? GeometryAlignedMode::kOn : GeometryAlignedMode::kAuto);
   config.ga_candidates = ga_candidates;
   config.max_axis_candidates = axis_candidates;
+  config.exact_candidates = exact_candidates;
   config.min_reduction = min_reduction;
   config.density = parse_density_band(density_band);
   config.seed = seed;
@@ -258,6 +259,7 @@ void add_cell_options(CLI::App* cmd, CellOptions& a, const std::string& max_cell
   cmd->add_option("--axis-candidates", a.axis_candidates, "Axis-aligned positions tried per axis and cell at most")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  cmd->add_flag("--exact-candidates", a.exact_candidates, kExactCandidatesHelp);
   cmd->add_option("--min-reduction", a.min_reduction,
                   "Stop when splits reduce the cost by less than this share of the initial cost for 50 splits running")
       ->capture_default_str();

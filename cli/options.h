@@ -21,6 +21,11 @@ namespace viewcells::cli {
 
 constexpr uint64_t kMaxSamples = uint64_t{1} << 40;  // a trillion rays: beyond any one machine's memory
 constexpr uint64_t kMaxCells = 10'000'000;
+/// --exact-candidates, shared by build, bake and compare.
+constexpr const char* kExactCandidatesHelp =
+    "Axis-aligned positions as the paper draws them: a uniform random subset of the distinct segment-end coordinates "
+    "of each cell, which needs them sorted (about 3x slower subdivision). Default: --axis-candidates random segment "
+    "ends, so that coordinates where many segments end (walls) are likelier; both evaluate their positions exactly";
 
 /// Global options.
 struct Common {
@@ -86,6 +91,7 @@ struct CellOptions {
   bool no_ga = false, ga = false;
   uint32_t ga_candidates = 150;
   uint32_t axis_candidates = 200;
+  bool exact_candidates = false;
   double min_reduction = 1e-6;
   double cost_a = 100, cost_b = 1, cost_c = 0;
   std::string screen = "1024x768";

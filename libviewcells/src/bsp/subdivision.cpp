@@ -8,11 +8,13 @@
 // axis-aligned planes the sweep applies it through the segments' coordinate extents.
 #include "viewcells/bsp/subdivision.h"
 
+#include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <map>
@@ -231,6 +233,48 @@ struct Marks {
     if (o == kNoObject || stamp[o] == epoch) return 0.0;
     stamp[o] = epoch;
     return r[o];
+  }
+};
+
+/// A segment part's extent along one axis, with the objects at its segment's ends (so the
+/// sweep reads one array in order instead of the segment set by id).
+struct AxisExtent {
+  double lo, hi;
+  uint32_t object_a, object_b;
+};
+
+/// Per object: the first candidate position index at which it is on the negative side of the
+/// plane and the last at which it is on the positive side (see Builder::side_costs), with the
+/// objects touched so far; reset in O(1) by bumping an epoch.
+struct SideMarks {
+  std::vector<uint32_t> stamp;
+  std::vector<int32_t> first, last;
+  std::vector<uint32_t> touched;
+  std::vector<double> padded;  ///< scratch: the positions padded to a power of two
+  uint32_t epoch = 0;
+  void reset(size_t n) {
+    if (stamp.size() < n) {
+      stamp.assign(n, 0);
+      first.resize(n);
+      last.resize(n);
+    }
+    touched.clear();
+    if (++epoch == 0) {
+      std::fill(stamp.begin(), stamp.end(), 0);
+      epoch = 1;
+    }
+  }
+  void touch(uint32_t o, int32_t jl, int32_t jr) {
+    if (o == kNoObject) return;
+    if (stamp[o] != epoch) {
+      stamp[o] = epoch;
+      first[o] = jl;
+      last[o] = jr;
+      touched.push_back(o);
+      return;
+    }
+    first[o] = std::min(first[o], jl);
+    last[o] = std::max(last[o], jr);
   }
 };
 
@@ -485,10 +529,11 @@ class Builder {
     if (refs.empty() || out_.nodes[node].pvs_cost == 0) return ev;
     RawVector<double> storage;
     const double* r = candidate_costs(node, storage);
+    const std::array<std::vector<AxisExtent>, 3> ext = axis_extents(refs);
     Candidate results[4];
     tbb::parallel_for(0, 4, [&](int task) {
       if (task < 3) {
-        results[task] = best_axis_candidate(node, task, ev, r);
+        results[task] = best_axis_candidate(node, task, ext[task], ev, r);
       } else if (ga_) {
         results[3] = best_geometry_candidate(node, ev, r);
       }
@@ -559,79 +604,132 @@ class Builder {
     return best;
   }
 
-  /// The sweep: r(PVS) of both sides at every candidate position of one axis in O(n log n).
-  Candidate best_axis_candidate(int32_t node, int axis, Evaluation& ev, const double* r) {
-    const std::vector<SegRef>& refs = refs_[node];
+  /// The axis-aligned positions tried in `node` along `axis` (sorted, distinct, strictly inside
+  /// the cell's bounds): all segment ends when there are at most max_axis_candidates, else a
+  /// random choice, reproducible per node and axis (SubdivisionConfig::exact_candidates).
+  std::vector<double> axis_positions(int32_t node, int axis, const std::vector<AxisExtent>& ext, double lo_b,
+                                     double hi_b) const {
+    const size_t k = config_.max_axis_candidates;
+    Rng rng(config_.seed, (static_cast<uint64_t>(node) << 2) | static_cast<uint64_t>(axis));
+    std::vector<double> positions;
+    const size_t ends = 2 * ext.size();
+    if (!config_.exact_candidates && ends > 2 * k) {
+      // k random segment ends (rejecting those on the cell's bounds), then sorted: O(k log k).
+      positions.reserve(k);
+      for (size_t tries = 0; positions.size() < k && tries < 4 * k; ++tries) {
+        const size_t i = rng.below(ends);
+        const double c = (i & 1) ? ext[i >> 1].hi : ext[i >> 1].lo;
+        if (c > lo_b && c < hi_b) positions.push_back(c);
+      }
+      std::sort(positions.begin(), positions.end());
+      positions.erase(std::unique(positions.begin(), positions.end()), positions.end());
+      return positions;
+    }
+    positions.reserve(ends);
+    for (const AxisExtent& e : ext)
+      for (double c : {e.lo, e.hi})
+        if (c > lo_b && c < hi_b) positions.push_back(c);
+    std::sort(positions.begin(), positions.end());
+    positions.erase(std::unique(positions.begin(), positions.end()), positions.end());
+    if (positions.size() > k) {
+      // A uniform random subset of the distinct positions (paper, section 4.2).
+      for (size_t i = 0; i < k; ++i) std::swap(positions[i], positions[i + rng.below(positions.size() - i)]);
+      positions.resize(k);
+      std::sort(positions.begin(), positions.end());
+    }
+    return positions;
+  }
+
+  /// r(PVS) of both sides of the planes at the sorted positions x[0..k-1], in one pass. A
+  /// segment part [lo, hi] is on the negative side at x when lo < x (or it lies in the plane,
+  /// lo == hi == x), on the positive side when hi > x (or lies in it): from the first position
+  /// index jl on, up to the last index jr. An object is on the negative side from the smallest
+  /// jl of its segments on, on the positive side up to the largest jr; a histogram of those
+  /// indices and prefix sums give both sides' costs at every position in O(n log k + k).
+  void side_costs(const std::vector<AxisExtent>& ext, const std::vector<double>& x, const double* r,
+                  std::vector<double>& left, std::vector<double>& right) {
+    const size_t k = x.size();
+    SideMarks& m = side_marks_.local();
+    m.reset(r_.size());
+    // Branch-free binary searches over x padded with +inf to a power of two: the count of
+    // positions below v (lower bound) or at most v (upper bound).
+    size_t p = 1;
+    while (p < k + 1) p *= 2;
+    std::vector<double>& xs = m.padded;
+    xs.assign(p, INFINITY);
+    std::copy(x.begin(), x.end(), xs.begin());
+    const double* xp = xs.data();
+    auto below = [xp, p](double v) {
+      size_t i = 0;
+      for (size_t step = p / 2; step > 0; step /= 2) i += xp[i + step - 1] < v ? step : 0;
+      return static_cast<int32_t>(i);
+    };
+    auto at_most = [xp, p](double v) {
+      size_t i = 0;
+      for (size_t step = p / 2; step > 0; step /= 2) i += xp[i + step - 1] <= v ? step : 0;
+      return static_cast<int32_t>(i);
+    };
+    for (const AxisExtent& e : ext) {
+      // A part along the axis is on the negative side from the first x above lo, on the positive
+      // side up to the last x below hi; a point (lo == hi) also at x == lo, in the plane.
+      const bool point = e.lo == e.hi;
+      const int32_t jl = point ? below(e.lo) : at_most(e.lo);
+      const int32_t jr = (point ? at_most(e.hi) : below(e.hi)) - 1;
+      m.touch(e.object_a, jl, jr);
+      m.touch(e.object_b, jl, jr);
+    }
+    std::vector<double> from(k + 1, 0.0), upto(k + 1, 0.0);
+    for (uint32_t o : m.touched) {
+      from[m.first[o]] += r[o];                                  // index k: never on the negative side
+      upto[static_cast<size_t>(m.last[o] + 1)] += r[o];          // index 0: never on the positive side
+    }
+    left.assign(k, 0.0);
+    right.assign(k, 0.0);
+    double cost = 0;
+    for (size_t j = 0; j < k; ++j) left[j] = cost += from[j];
+    cost = 0;
+    for (size_t j = k; j-- > 0;) right[j] = cost += upto[j + 1];
+  }
+
+  /// The extents of the node's segment parts along x, y and z: one pass over the segment set
+  /// (in parallel for large nodes; each entry is computed alone, so the result is the same).
+  std::array<std::vector<AxisExtent>, 3> axis_extents(const std::vector<SegRef>& refs) const {
+    std::array<std::vector<AxisExtent>, 3> ext;
+    for (auto& e : ext) e.resize(refs.size());
+    const RawVector<double>* a[3] = {&segs_.ax, &segs_.ay, &segs_.az};
+    const RawVector<double>* b[3] = {&segs_.bx, &segs_.by, &segs_.bz};
+    auto fill = [&](size_t begin, size_t end) {
+      for (size_t i = begin; i < end; ++i) {
+        const SegRef& s = refs[i];
+        const uint32_t oa = segs_.object_a[s.id], ob = segs_.object_b[s.id];
+        for (int axis = 0; axis < 3; ++axis) {
+          const double sa = (*a[axis])[s.id], sb = (*b[axis])[s.id];  // as point_at, one coordinate
+          const double c0 = sa * (1.0 - s.t0) + sb * s.t0, c1 = sa * (1.0 - s.t1) + sb * s.t1;
+          ext[axis][i] = {std::min(c0, c1), std::max(c0, c1), oa, ob};
+        }
+      }
+    };
+    constexpr size_t kGrain = 1 << 15;
+    if (refs.size() <= kGrain) {
+      fill(0, refs.size());
+    } else {
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, refs.size(), kGrain),
+                        [&](const tbb::blocked_range<size_t>& range) { fill(range.begin(), range.end()); });
+    }
+    return ext;
+  }
+
+  /// The best axis-aligned split of `node` along `axis` among its candidate positions.
+  Candidate best_axis_candidate(int32_t node, int axis, const std::vector<AxisExtent>& ext, Evaluation& ev,
+                                const double* r) {
     const ConvexPolyhedron& cell = out_.cells[node];
     const Box3 bounds = cell.bounds();
     const double lo_b = bounds.lo[axis], hi_b = bounds.hi[axis];
-    struct Extent {
-      double lo, hi;
-      uint32_t id;
-    };
-    std::vector<Extent> ext(refs.size());
-    std::vector<double> positions;
-    positions.reserve(2 * refs.size());
-    for (size_t i = 0; i < refs.size(); ++i) {
-      const double c0 = point_at(segs_, refs[i].id, refs[i].t0)[axis];
-      const double c1 = point_at(segs_, refs[i].id, refs[i].t1)[axis];
-      ext[i] = {std::min(c0, c1), std::max(c0, c1), refs[i].id};
-      for (double c : {c0, c1})
-        if (c > lo_b && c < hi_b) positions.push_back(c);
-    }
-    std::sort(positions.begin(), positions.end());
-    positions.erase(std::unique(positions.begin(), positions.end()), positions.end());
+    const std::vector<double> positions = axis_positions(node, axis, ext, lo_b, hi_b);
     if (positions.empty()) return {};
-    if (positions.size() > config_.max_axis_candidates) {
-      // A random subset (paper, section 4.2), reproducible per node and axis.
-      Rng rng(config_.seed, (static_cast<uint64_t>(node) << 2) | static_cast<uint64_t>(axis));
-      for (size_t i = 0; i < config_.max_axis_candidates; ++i)
-        std::swap(positions[i], positions[i + rng.below(positions.size() - i)]);
-      positions.resize(config_.max_axis_candidates);
-      std::sort(positions.begin(), positions.end());
-    }
     const size_t k = positions.size();
-    std::vector<double> left(k), right(k);
-    Marks& m = marks_.local();
-    // Negative side at x: lo < x, or lying in the plane (lo == hi == x). Sorted by lo, parts
-    // lying in a plane first among equal lo, so they are in when x reaches them.
-    std::vector<uint32_t> order(ext.size());
-    for (uint32_t i = 0; i < order.size(); ++i) order[i] = i;
-    std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
-      const bool fx = ext[x].lo == ext[x].hi, fy = ext[y].lo == ext[y].hi;
-      return ext[x].lo < ext[y].lo || (ext[x].lo == ext[y].lo && fx && !fy);
-    });
-    m.reset(r_.size());
-    double cost = 0;
-    size_t next = 0;
-    for (size_t j = 0; j < k; ++j) {
-      const double x = positions[j];
-      while (next < order.size() &&
-             (ext[order[next]].lo < x || (ext[order[next]].lo == x && ext[order[next]].hi == x))) {
-        const uint32_t id = ext[order[next]].id;
-        cost += m.add(segs_.object_a[id], r) + m.add(segs_.object_b[id], r);
-        ++next;
-      }
-      left[j] = cost;
-    }
-    // Positive side at x: hi > x, or lying in the plane.
-    std::sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) {
-      const bool fx = ext[x].lo == ext[x].hi, fy = ext[y].lo == ext[y].hi;
-      return ext[x].hi > ext[y].hi || (ext[x].hi == ext[y].hi && fx && !fy);
-    });
-    m.reset(r_.size());
-    cost = 0;
-    next = 0;
-    for (size_t j = k; j-- > 0;) {
-      const double x = positions[j];
-      while (next < order.size() &&
-             (ext[order[next]].hi > x || (ext[order[next]].hi == x && ext[order[next]].lo == x))) {
-        const uint32_t id = ext[order[next]].id;
-        cost += m.add(segs_.object_a[id], r) + m.add(segs_.object_b[id], r);
-        ++next;
-      }
-      right[j] = cost;
-    }
+    std::vector<double> left, right;
+    side_costs(ext, positions, r, left, right);
     const double own = node_cost(node);
     const double volume = out_.nodes[node].volume, weight = out_.nodes[node].weight;
     const HeightBandDensity& density = config_.density;
@@ -738,6 +836,7 @@ class Builder {
   std::vector<Candidate> best_;
   std::atomic<uint64_t> axis_evaluated_{0}, geometry_evaluated_{0};
   tbb::enumerable_thread_specific<Marks> marks_;
+  tbb::enumerable_thread_specific<SideMarks> side_marks_;
 };
 
 }  // namespace

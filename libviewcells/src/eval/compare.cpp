@@ -32,7 +32,7 @@ double seconds_since(std::chrono::steady_clock::time_point t) {
 void check_methods(const std::vector<std::string>& methods) {
   if (methods.empty()) throw Error("no methods to compare");
   for (const std::string& m : methods)
-    if (m != "av-m" && m != "av-m-samples") parse_split_strategy(m);
+    if (m != "av-m" && m != "av-m-samples" && m != "av-s-exact") parse_split_strategy(m);
 }
 
 Comparison compare_methods(const Scene& scene, const RayCaster& caster, const CompareConfig& config) {
@@ -51,7 +51,8 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
   auto build = [&](const std::string& method) {
     SubdivisionConfig sc = config.subdivision;
     sc.max_cells = config.max_cells;
-    sc.strategy = parse_split_strategy(method);
+    if (method == "av-s-exact") sc.exact_candidates = true;  // the paper's candidate choice beside the default
+    sc.strategy = parse_split_strategy(method == "av-s-exact" ? "av-s" : method);
     sc.show_progress = config.show_progress;
     const auto t = std::chrono::steady_clock::now();
     Subdivision s = subdivide(scene, built.segments, config.model, sc);

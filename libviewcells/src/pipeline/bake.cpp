@@ -27,14 +27,14 @@ std::string hierarchy_key(const BakeConfig& c, uint32_t max_cells) {
   const SubdivisionConfig& d = c.subdivision;
   std::ostringstream k;
   k.precision(17);
-  k << "viewcells bake hierarchy v2\nscene " << c.scene.path << " grouping " << to_string(c.scene.grouping)
+  k << "viewcells bake hierarchy v3\nscene " << c.scene.path << " grouping " << to_string(c.scene.grouping)
     << " robust " << c.scene.robust << "\nsamples " << s.samples << " segments " << s.target_segments << " seed "
     << s.seed << " recasts " << s.max_recasts << " empty " << static_cast<int>(s.empty_space) << "\nview box "
     << s.view_box.lo.x << ' ' << s.view_box.lo.y << ' ' << s.view_box.lo.z << ' ' << s.view_box.hi.x << ' '
     << s.view_box.hi.y << ' ' << s.view_box.hi.z << "\ncost " << c.model.a << ' ' << c.model.b << ' ' << c.model.c
     << ' ' << c.model.screen_width << ' ' << c.model.screen_height << ' ' << c.model.fov_degrees << "\ncells "
     << max_cells << " ga " << static_cast<int>(d.geometry_aligned) << ' ' << d.ga_candidates << ' '
-    << d.max_axis_candidates << " min reduction " << d.min_reduction << " density " << d.density.enabled << ' '
+    << d.max_axis_candidates << (d.exact_candidates ? " exact" : " fast") << " min reduction " << d.min_reduction << " density " << d.density.enabled << ' '
     << d.density.lo << ' ' << d.density.hi << ' ' << d.density.outside << '\n';
   if (c.merge_agvs)
     k << "merge agvs " << c.merge_agvs->seed << ' ' << c.merge_agvs->max_samples << ' ' << c.merge_agvs->pixel_error << ' '

@@ -230,6 +230,7 @@ std::string report_json(const BuildResult& r) {
   json& settings = report["settings"];
   settings["max_cells"] = r.subdivision_config.max_cells;
   settings["axis_candidates_per_axis"] = r.subdivision_config.max_axis_candidates;
+  settings["axis_candidates_choice"] = r.subdivision_config.exact_candidates ? "exact" : "fast";
   settings["ga_candidates"] = r.subdivision_config.ga_candidates;
   settings["min_reduction"] = r.subdivision_config.min_reduction;
   settings["cost_model"] = {{"a", model.a}, {"b", model.b}, {"c", model.c}};
@@ -489,6 +490,7 @@ std::string report_json(const CompareRunResult& r) {
         {"histogram_cells", config.histogram_cells ? config.histogram_cells : config.max_cells},
         {"cost_model", {{"a", config.model.a}, {"b", config.model.b}, {"c", 0}}},
         {"axis_candidates", config.subdivision.max_axis_candidates},
+        {"axis_candidates_choice", config.subdivision.exact_candidates ? "exact" : "fast"},
         {"ga_candidates", config.subdivision.ga_candidates},
         {"geometry_aligned", r.config.geometry_aligned_off ? "off" : "auto"},
         {"robust_ray_casting", r.config.scene.robust},

@@ -2,8 +2,9 @@
 /// Adaptive view space subdivision, AV-S (view-cell-construction paper, section 4.2): a BSP of
 /// the view space refined greedily, always splitting the leaf whose best plane reduces the
 /// expected render cost c(S) the most (priority: reduction + 1% of the leaf's own cost).
-/// Axis-aligned candidates lie at the clipped segment endpoints and are evaluated by a sweep
-/// with per-object first-seen marks (O(n log n) per node); geometry-aligned candidates are
+/// Axis-aligned candidates lie at the clipped segment endpoints; both sides' r(PVS) at all k
+/// positions of an axis come from one pass over the node's segments (each object's first and
+/// last position on each side, then prefix sums: O(n log k) per node); geometry-aligned candidates are
 /// planes of scene triangles hit inside the node, a random subset of at most ga_candidates.
 /// Deterministic: the same inputs and seed give the same tree for any number of threads.
 #include <cstdint>
@@ -66,6 +67,12 @@ struct SubdivisionConfig {
   uint32_t polygon_candidates = 50;  ///< BSP: polygon planes tried per cell at most
   uint32_t max_cells = 1000;           ///< stop at this many leaves
   uint32_t max_axis_candidates = 200;  ///< positions per axis (a random subset of segment ends beyond)
+  /// How the axis-aligned positions of a cell are drawn when it has more segment ends than
+  /// max_axis_candidates. Exact (the paper's): a uniform random subset of the distinct end
+  /// coordinates, which needs them sorted (O(n log n) per cell and axis). Fast (the default):
+  /// max_axis_candidates random segment ends (so coordinates where many segments end, walls,
+  /// are likelier), O(k log k). Either way the chosen positions are then evaluated exactly.
+  bool exact_candidates = false;
   GeometryAlignedMode geometry_aligned = GeometryAlignedMode::kAuto;
   uint32_t ga_candidates = 150;       ///< geometry-aligned planes per node at most (paper: 150)
   /// kAuto enables geometry-aligned candidates when at least this share of the surface area

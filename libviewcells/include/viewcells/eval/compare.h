@@ -16,7 +16,8 @@
 namespace viewcells {
 
 struct CompareConfig {
-  /// av-m, av-m-samples, av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp
+  /// av-m, av-m-samples, av-s, av-s-exact (AV-S with SubdivisionConfig::exact_candidates),
+  /// kd-casm, kd-lasm, kd-vt, kd-vt-star, bsp
   std::vector<std::string> methods = {"av-m", "av-m-samples", "av-s", "kd-casm", "kd-lasm", "kd-vt", "kd-vt-star", "bsp"};
   uint32_t max_cells = 1000;
   SamplerConfig construction;  ///< samples for building
