@@ -197,12 +197,20 @@ namespace {
 /// Smallest part of a cell a split may cut off, relative to the cell's volume.
 constexpr double kMinPart = 1e-9;
 
+inline Vec3 point_at(const SegmentSet& s, uint32_t i, double t) { return s.a(i) * (1.0 - t) + s.b(i) * t; }
+
+/// The part of segment `id` in a node: a + t (b - a), t in [t0, t1]. Its end points (computed
+/// once, by point_at) and the objects at the segment's ends are kept inline, so that the
+/// subdivision reads a node's parts in order rather than the segment set by id.
 struct SegRef {
-  uint32_t id;
+  uint32_t id, object_a, object_b;
   double t0, t1;
+  Vec3 p0, p1;
 };
 
-inline Vec3 point_at(const SegmentSet& s, uint32_t i, double t) { return s.a(i) * (1.0 - t) + s.b(i) * t; }
+inline SegRef make_ref(const SegmentSet& s, uint32_t id, double t0, double t1) {
+  return {id, s.object_a[id], s.object_b[id], t0, t1, point_at(s, id, t0), point_at(s, id, t1)};
+}
 
 /// Which children a segment part goes to, from the exact sides of its two ends:
 /// bit 0 negative, bit 1 positive.
@@ -319,7 +327,10 @@ class Builder {
     // Box faces: -x, +x, -y, +y, -z, +z match planes 0..5.
     ConvexPolyhedron root = ConvexPolyhedron::box(b, 0);
     std::vector<SegRef> refs(segs_.size());
-    for (uint32_t i = 0; i < segs_.size(); ++i) refs[i] = {i, 0.0, 1.0};
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, static_cast<uint32_t>(segs_.size()), 1 << 14),
+                      [&](const tbb::blocked_range<uint32_t>& range) {
+                        for (uint32_t i = range.begin(); i < range.end(); ++i) refs[i] = make_ref(segs_, i, 0.0, 1.0);
+                      });
     if (config_.strategy == SplitStrategy::kPolygonBsp) {
       // The polygons that reach into the view space.
       std::vector<uint32_t> inside;
@@ -413,7 +424,7 @@ class Builder {
     Marks& m = marks_.local();
     m.reset(r_.size());
     double c = 0;
-    for (const SegRef& s : refs) c += m.add(segs_.object_a[s.id], r_.data()) + m.add(segs_.object_b[s.id], r_.data());
+    for (const SegRef& s : refs) c += m.add(s.object_a, r_.data()) + m.add(s.object_b, r_.data());
     return c;
   }
 
@@ -425,7 +436,7 @@ class Builder {
     Marks& m = marks_.local();
     m.reset(r_.size());
     for (const SegRef& s : refs)
-      for (uint32_t o : {segs_.object_a[s.id], segs_.object_b[s.id]})
+      for (uint32_t o : {s.object_a, s.object_b})
         if (m.first(o)) f(o, cell_object_cost(scene_.objects[o], r_[o], points, model_));
   }
 
@@ -439,12 +450,23 @@ class Builder {
     return storage.data();
   }
 
-  int32_t add_node(int32_t parent, ConvexPolyhedron cell, std::vector<SegRef> refs) {
+  /// A node's volume, weight and r(PVS) (thread-safe: the two children are measured at once).
+  BspNode measure_node(int32_t parent, const ConvexPolyhedron& cell, const std::vector<SegRef>& refs) {
     BspNode node;
     node.parent = parent;
     node.volume = cell.volume();
     node.weight = config_.density.weight(cell);
     node.pvs_cost = pvs_cost(cell, refs);
+    return node;
+  }
+
+  int32_t add_node(int32_t parent, ConvexPolyhedron cell, std::vector<SegRef> refs) {
+    const BspNode node = measure_node(parent, cell, refs);
+    return add_node(node, std::move(cell), std::move(refs));
+  }
+
+  int32_t add_node(const BspNode& node, ConvexPolyhedron cell, std::vector<SegRef> refs) {
+    const int32_t parent = node.parent;
     depth_.push_back(parent < 0 ? 0 : depth_[parent] + 1);
     out_.nodes.push_back(node);
     out_.cells.push_back(std::move(cell));
@@ -467,16 +489,19 @@ class Builder {
     out_.planes.push_back(plane);
     std::vector<SegRef> side[2];
     for (const SegRef& s : refs_[node]) {
-      const Vec3 p0 = point_at(segs_, s.id, s.t0), p1 = point_at(segs_, s.id, s.t1);
-      const int s0 = plane.side(p0), s1 = plane.side(p1);
+      const int s0 = plane.side(s.p0), s1 = plane.side(s.p1);
       const int to = classify(s0, s1);
       if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) {
         // Crosses: each side gets its part (the cut point is rounded; sides stay exact).
-        const double d0 = plane.distance(p0), d1 = plane.distance(p1);
+        const double d0 = plane.distance(s.p0), d1 = plane.distance(s.p1);
         double t = s.t0 + (s.t1 - s.t0) * (d0 / (d0 - d1));
         t = std::clamp(t, s.t0, s.t1);
-        side[s0 < 0 ? 0 : 1].push_back({s.id, s.t0, t});
-        side[s0 < 0 ? 1 : 0].push_back({s.id, t, s.t1});
+        const Vec3 cut = point_at(segs_, s.id, t);
+        SegRef first = s, second = s;
+        first.t1 = t, first.p1 = cut;
+        second.t0 = t, second.p0 = cut;
+        side[s0 < 0 ? 0 : 1].push_back(first);
+        side[s0 < 0 ? 1 : 0].push_back(second);
         continue;
       }
       if (to & 1) side[0].push_back(s);
@@ -504,8 +529,11 @@ class Builder {
     }
     out_.cells[node] = ConvexPolyhedron();
     out_.nodes[node].plane = plane_id;
-    const int32_t a = add_node(node, std::move(halves->first), std::move(side[0]));
-    const int32_t b = add_node(node, std::move(halves->second), std::move(side[1]));
+    BspNode measured[2];
+    tbb::parallel_invoke([&] { measured[0] = measure_node(node, halves->first, side[0]); },
+                         [&] { measured[1] = measure_node(node, halves->second, side[1]); });
+    const int32_t a = add_node(measured[0], std::move(halves->first), std::move(side[0]));
+    const int32_t b = add_node(measured[1], std::move(halves->second), std::move(side[1]));
     out_.nodes[node].child[0] = a;
     out_.nodes[node].child[1] = b;
     return true;
@@ -691,21 +719,17 @@ class Builder {
     for (size_t j = k; j-- > 0;) right[j] = cost += upto[j + 1];
   }
 
-  /// The extents of the node's segment parts along x, y and z: one pass over the segment set
+  /// The extents of the node's segment parts along x, y and z: one pass over its parts
   /// (in parallel for large nodes; each entry is computed alone, so the result is the same).
   std::array<std::vector<AxisExtent>, 3> axis_extents(const std::vector<SegRef>& refs) const {
     std::array<std::vector<AxisExtent>, 3> ext;
     for (auto& e : ext) e.resize(refs.size());
-    const RawVector<double>* a[3] = {&segs_.ax, &segs_.ay, &segs_.az};
-    const RawVector<double>* b[3] = {&segs_.bx, &segs_.by, &segs_.bz};
     auto fill = [&](size_t begin, size_t end) {
       for (size_t i = begin; i < end; ++i) {
         const SegRef& s = refs[i];
-        const uint32_t oa = segs_.object_a[s.id], ob = segs_.object_b[s.id];
         for (int axis = 0; axis < 3; ++axis) {
-          const double sa = (*a[axis])[s.id], sb = (*b[axis])[s.id];  // as point_at, one coordinate
-          const double c0 = sa * (1.0 - s.t0) + sb * s.t0, c1 = sa * (1.0 - s.t1) + sb * s.t1;
-          ext[axis][i] = {std::min(c0, c1), std::max(c0, c1), oa, ob};
+          const double c0 = s.p0[axis], c1 = s.p1[axis];
+          ext[axis][i] = {std::min(c0, c1), std::max(c0, c1), s.object_a, s.object_b};
         }
       }
     };
@@ -807,9 +831,9 @@ class Builder {
       pos.reset(r_.size());
       double cl = 0, cr = 0;
       for (const SegRef& s : refs) {
-        const int to = classify(plane.side(point_at(segs_, s.id, s.t0)), plane.side(point_at(segs_, s.id, s.t1)));
-        if (to & 1) cl += neg.add(segs_.object_a[s.id], r) + neg.add(segs_.object_b[s.id], r);
-        if (to & 2) cr += pos.add(segs_.object_a[s.id], r) + pos.add(segs_.object_b[s.id], r);
+        const int to = classify(plane.side(s.p0), plane.side(s.p1));
+        if (to & 1) cl += neg.add(s.object_a, r) + neg.add(s.object_b, r);
+        if (to & 2) cr += pos.add(s.object_a, r) + pos.add(s.object_b, r);
       }
       const double wl = config_.density.enabled ? config_.density.weight_below(cell, part, plane) : vl;
       const double reduction = own - (wl * cl + (weight - wl) * cr) / total_weight_;
