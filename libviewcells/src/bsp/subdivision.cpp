@@ -197,20 +197,21 @@ namespace {
 /// Smallest part of a cell a split may cut off, relative to the cell's volume.
 constexpr double kMinPart = 1e-9;
 
-inline Vec3 point_at(const SegmentSet& s, uint32_t i, double t) { return s.a(i) * (1.0 - t) + s.b(i) * t; }
-
-/// The part of segment `id` in a node: a + t (b - a), t in [t0, t1]. Its end points (computed
-/// once, by point_at) and the objects at the segment's ends are kept inline, so that the
-/// subdivision reads a node's parts in order rather than the segment set by id.
+/// The part of segment `id` in a node: a + t (b - a), t in [t0, t1].
 struct SegRef {
-  uint32_t id, object_a, object_b;
+  uint32_t id;
   double t0, t1;
-  Vec3 p0, p1;
 };
 
-inline SegRef make_ref(const SegmentSet& s, uint32_t id, double t0, double t1) {
-  return {id, s.object_a[id], s.object_b[id], t0, t1, point_at(s, id, t0), point_at(s, id, t1)};
-}
+/// One segment's end points and objects in one cache line: the subdivision reads a segment by
+/// id once per node it lies in (tens of millions of parts at 50k cells), and the segment
+/// set's eight separate arrays would cost eight cache misses each time.
+struct alignas(64) SegEnds {
+  Vec3 a, b;
+  uint32_t object_a, object_b;
+  /// The point a + t (b - a), rounded the same way wherever the subdivision needs it.
+  Vec3 at(double t) const { return a * (1.0 - t) + b * t; }
+};
 
 /// Which children a segment part goes to, from the exact sides of its two ends:
 /// bit 0 negative, bit 1 positive.
@@ -326,10 +327,14 @@ class Builder {
     }
     // Box faces: -x, +x, -y, +y, -z, +z match planes 0..5.
     ConvexPolyhedron root = ConvexPolyhedron::box(b, 0);
+    ends_.resize(segs_.size());
     std::vector<SegRef> refs(segs_.size());
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, static_cast<uint32_t>(segs_.size()), 1 << 14),
                       [&](const tbb::blocked_range<uint32_t>& range) {
-                        for (uint32_t i = range.begin(); i < range.end(); ++i) refs[i] = make_ref(segs_, i, 0.0, 1.0);
+                        for (uint32_t i = range.begin(); i < range.end(); ++i) {
+                          ends_[i] = {segs_.a(i), segs_.b(i), segs_.object_a[i], segs_.object_b[i]};
+                          refs[i] = {i, 0.0, 1.0};
+                        }
                       });
     if (config_.strategy == SplitStrategy::kPolygonBsp) {
       // The polygons that reach into the view space.
@@ -424,7 +429,10 @@ class Builder {
     Marks& m = marks_.local();
     m.reset(r_.size());
     double c = 0;
-    for (const SegRef& s : refs) c += m.add(s.object_a, r_.data()) + m.add(s.object_b, r_.data());
+    for (const SegRef& s : refs) {
+      const SegEnds& e = ends_[s.id];
+      c += m.add(e.object_a, r_.data()) + m.add(e.object_b, r_.data());
+    }
     return c;
   }
 
@@ -436,7 +444,7 @@ class Builder {
     Marks& m = marks_.local();
     m.reset(r_.size());
     for (const SegRef& s : refs)
-      for (uint32_t o : {s.object_a, s.object_b})
+      for (uint32_t o : {ends_[s.id].object_a, ends_[s.id].object_b})
         if (m.first(o)) f(o, cell_object_cost(scene_.objects[o], r_[o], points, model_));
   }
 
@@ -487,25 +495,40 @@ class Builder {
       return false;
     }
     out_.planes.push_back(plane);
+    // Sides first (bit 0 negative, bit 1 positive, bit 2: crosses, the negative part first,
+    // bit 3: crosses, the positive part first), so that both children are allocated once.
+    const std::vector<SegRef>& refs = refs_[node];
+    std::vector<uint8_t> code(refs.size());
+    size_t count[2] = {0, 0};
+    for (size_t i = 0; i < refs.size(); ++i) {
+      const SegRef& s = refs[i];
+      const SegEnds& e = ends_[s.id];
+      const int s0 = plane.side(e.at(s.t0)), s1 = plane.side(e.at(s.t1));
+      int to = classify(s0, s1);
+      if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) to |= s0 < 0 ? 4 : 8;
+      code[i] = static_cast<uint8_t>(to);
+      count[0] += to & 1;
+      count[1] += (to >> 1) & 1;
+    }
     std::vector<SegRef> side[2];
-    for (const SegRef& s : refs_[node]) {
-      const int s0 = plane.side(s.p0), s1 = plane.side(s.p1);
-      const int to = classify(s0, s1);
-      if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) {
+    side[0].reserve(count[0]);
+    side[1].reserve(count[1]);
+    for (size_t i = 0; i < refs.size(); ++i) {
+      const SegRef& s = refs[i];
+      if (code[i] & 12) {
         // Crosses: each side gets its part (the cut point is rounded; sides stay exact).
-        const double d0 = plane.distance(s.p0), d1 = plane.distance(s.p1);
+        const SegEnds& e = ends_[s.id];
+        const Vec3 p0 = e.at(s.t0), p1 = e.at(s.t1);
+        const double d0 = plane.distance(p0), d1 = plane.distance(p1);
         double t = s.t0 + (s.t1 - s.t0) * (d0 / (d0 - d1));
         t = std::clamp(t, s.t0, s.t1);
-        const Vec3 cut = point_at(segs_, s.id, t);
-        SegRef first = s, second = s;
-        first.t1 = t, first.p1 = cut;
-        second.t0 = t, second.p0 = cut;
-        side[s0 < 0 ? 0 : 1].push_back(first);
-        side[s0 < 0 ? 1 : 0].push_back(second);
+        const bool negative_first = code[i] & 4;
+        side[negative_first ? 0 : 1].push_back({s.id, s.t0, t});
+        side[negative_first ? 1 : 0].push_back({s.id, t, s.t1});
         continue;
       }
-      if (to & 1) side[0].push_back(s);
-      if (to & 2) side[1].push_back(s);
+      if (code[i] & 1) side[0].push_back(s);
+      if (code[i] & 2) side[1].push_back(s);
     }
     refs_[node].clear();
     refs_[node].shrink_to_fit();
@@ -727,9 +750,11 @@ class Builder {
     auto fill = [&](size_t begin, size_t end) {
       for (size_t i = begin; i < end; ++i) {
         const SegRef& s = refs[i];
+        const SegEnds& e = ends_[s.id];
+        const Vec3 p0 = e.at(s.t0), p1 = e.at(s.t1);
         for (int axis = 0; axis < 3; ++axis) {
-          const double c0 = s.p0[axis], c1 = s.p1[axis];
-          ext[axis][i] = {std::min(c0, c1), std::max(c0, c1), s.object_a, s.object_b};
+          const double c0 = p0[axis], c1 = p1[axis];
+          ext[axis][i] = {std::min(c0, c1), std::max(c0, c1), e.object_a, e.object_b};
         }
       }
     };
@@ -831,9 +856,10 @@ class Builder {
       pos.reset(r_.size());
       double cl = 0, cr = 0;
       for (const SegRef& s : refs) {
-        const int to = classify(plane.side(s.p0), plane.side(s.p1));
-        if (to & 1) cl += neg.add(s.object_a, r) + neg.add(s.object_b, r);
-        if (to & 2) cr += pos.add(s.object_a, r) + pos.add(s.object_b, r);
+        const SegEnds& e = ends_[s.id];
+        const int to = classify(plane.side(e.at(s.t0)), plane.side(e.at(s.t1)));
+        if (to & 1) cl += neg.add(e.object_a, r) + neg.add(e.object_b, r);
+        if (to & 2) cr += pos.add(e.object_a, r) + pos.add(e.object_b, r);
       }
       const double wl = config_.density.enabled ? config_.density.weight_below(cell, part, plane) : vl;
       const double reduction = own - (wl * cl + (weight - wl) * cr) / total_weight_;
@@ -853,6 +879,7 @@ class Builder {
   double total_weight_ = 0;
   bool ga_ = false;
   std::vector<std::vector<SegRef>> refs_;
+  std::vector<SegEnds> ends_;  ///< per segment, as segs_
   std::vector<uint32_t> depth_;              ///< per node
   std::vector<std::vector<uint32_t>> tris_;  ///< BSP baseline: per node, the polygons in it
   double pvs_budget_ = 0;
