@@ -33,8 +33,7 @@ Plane Plane::through(const Vec3& a, const Vec3& b, const Vec3& c) {
   return p;
 }
 
-int Plane::side(const Vec3& p) const {
-  if (axis >= 0) return p[axis] > offset ? 1 : (p[axis] < offset ? -1 : 0);
+int Plane::side_of_geometry_plane(const Vec3& p) const {
   switch (CGAL::orientation(to_cgal(points[0]), to_cgal(points[1]), to_cgal(points[2]), to_cgal(p))) {
     case CGAL::POSITIVE: return 1;
     case CGAL::NEGATIVE: return -1;

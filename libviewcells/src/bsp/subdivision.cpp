@@ -496,40 +496,57 @@ class Builder {
     }
     out_.planes.push_back(plane);
     // Sides first (bit 0 negative, bit 1 positive, bit 2: crosses, the negative part first,
-    // bit 3: crosses, the positive part first), so that both children are allocated once.
+    // bit 3: crosses, the positive part first), then both children written at once, chunk by
+    // chunk in parallel for large cells (each chunk at its own offset: the order is the same).
     const std::vector<SegRef>& refs = refs_[node];
-    std::vector<uint8_t> code(refs.size());
-    size_t count[2] = {0, 0};
-    for (size_t i = 0; i < refs.size(); ++i) {
-      const SegRef& s = refs[i];
-      const SegEnds& e = ends_[s.id];
-      const int s0 = plane.side(e.at(s.t0)), s1 = plane.side(e.at(s.t1));
-      int to = classify(s0, s1);
-      if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) to |= s0 < 0 ? 4 : 8;
-      code[i] = static_cast<uint8_t>(to);
-      count[0] += to & 1;
-      count[1] += (to >> 1) & 1;
-    }
-    std::vector<SegRef> side[2];
-    side[0].reserve(count[0]);
-    side[1].reserve(count[1]);
-    for (size_t i = 0; i < refs.size(); ++i) {
-      const SegRef& s = refs[i];
-      if (code[i] & 12) {
-        // Crosses: each side gets its part (the cut point is rounded; sides stay exact).
+    const size_t n = refs.size();
+    constexpr size_t kGrain = 1 << 15;
+    const size_t chunks = std::max<size_t>(1, (n + kGrain - 1) / kGrain);
+    std::vector<uint8_t> code(n);
+    std::vector<std::array<size_t, 2>> at(chunks + 1, {0, 0});  // per chunk: its first index in each child
+    auto for_chunks = [&](auto&& f) {
+      if (chunks == 1) return f(size_t{0});
+      tbb::parallel_for(size_t{0}, chunks, [&](size_t c) { f(c); });
+    };
+    for_chunks([&](size_t c) {
+      size_t count[2] = {0, 0};
+      for (size_t i = c * kGrain; i < std::min(n, (c + 1) * kGrain); ++i) {
+        const SegRef& s = refs[i];
         const SegEnds& e = ends_[s.id];
-        const Vec3 p0 = e.at(s.t0), p1 = e.at(s.t1);
-        const double d0 = plane.distance(p0), d1 = plane.distance(p1);
-        double t = s.t0 + (s.t1 - s.t0) * (d0 / (d0 - d1));
-        t = std::clamp(t, s.t0, s.t1);
-        const bool negative_first = code[i] & 4;
-        side[negative_first ? 0 : 1].push_back({s.id, s.t0, t});
-        side[negative_first ? 1 : 0].push_back({s.id, t, s.t1});
-        continue;
+        const int s0 = plane.side(e.at(s.t0)), s1 = plane.side(e.at(s.t1));
+        int to = classify(s0, s1);
+        if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) to |= s0 < 0 ? 4 : 8;
+        code[i] = static_cast<uint8_t>(to);
+        count[0] += to & 1;
+        count[1] += (to >> 1) & 1;
       }
-      if (code[i] & 1) side[0].push_back(s);
-      if (code[i] & 2) side[1].push_back(s);
-    }
+      at[c + 1] = {count[0], count[1]};
+    });
+    for (size_t c = 0; c < chunks; ++c)
+      for (int k = 0; k < 2; ++k) at[c + 1][k] += at[c][k];
+    std::vector<SegRef> side[2];
+    side[0].resize(at[chunks][0]);
+    side[1].resize(at[chunks][1]);
+    for_chunks([&](size_t c) {
+      size_t next[2] = {at[c][0], at[c][1]};
+      for (size_t i = c * kGrain; i < std::min(n, (c + 1) * kGrain); ++i) {
+        const SegRef& s = refs[i];
+        if (code[i] & 12) {
+          // Crosses: each side gets its part (the cut point is rounded; sides stay exact).
+          const SegEnds& e = ends_[s.id];
+          const Vec3 p0 = e.at(s.t0), p1 = e.at(s.t1);
+          const double d0 = plane.distance(p0), d1 = plane.distance(p1);
+          double t = s.t0 + (s.t1 - s.t0) * (d0 / (d0 - d1));
+          t = std::clamp(t, s.t0, s.t1);
+          const int first = (code[i] & 4) ? 0 : 1;
+          side[first][next[first]++] = {s.id, s.t0, t};
+          side[1 - first][next[1 - first]++] = {s.id, t, s.t1};
+          continue;
+        }
+        if (code[i] & 1) side[0][next[0]++] = s;
+        if (code[i] & 2) side[1][next[1]++] = s;
+      }
+    });
     refs_[node].clear();
     refs_[node].shrink_to_fit();
     if (config_.strategy == SplitStrategy::kPolygonBsp) {

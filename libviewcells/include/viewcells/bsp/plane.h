@@ -24,9 +24,15 @@ struct Plane {
 
   bool is_axis_aligned() const { return axis >= 0; }
   /// -1, 0 or +1: the exact side of p (0 only when p lies exactly on the plane).
-  int side(const Vec3& p) const;
+  int side(const Vec3& p) const {
+    if (axis >= 0) return p[axis] > offset ? 1 : (p[axis] < offset ? -1 : 0);
+    return side_of_geometry_plane(p);
+  }
   /// normal . p - offset (rounded; for interpolation and volumes, never for topology).
   double distance(const Vec3& p) const { return dot(normal, p) - offset; }
+
+ private:
+  int side_of_geometry_plane(const Vec3& p) const;  ///< CGAL's exact orientation
 };
 
 }  // namespace viewcells
