@@ -107,6 +107,9 @@ struct SplitRecord {
 struct SubdivisionStats {
   uint64_t axis_candidates = 0;      ///< candidate planes evaluated, by kind
   uint64_t geometry_candidates = 0;
+  /// Segment parts read by candidate evaluation, summed over the cells evaluated (a segment
+  /// lies in every cell it crosses, so this grows faster than the segments).
+  uint64_t parts_evaluated = 0;
   uint64_t slivers_refused = 0;      ///< chosen splits left undone: a part would be a sliver
   bool geometry_aligned = false;
   std::string geometry_aligned_reason;
