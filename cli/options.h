@@ -24,8 +24,9 @@ constexpr uint64_t kMaxCells = 10'000'000;
 /// --exact-candidates, shared by build, bake and compare.
 constexpr const char* kExactCandidatesHelp =
     "Axis-aligned positions as the paper draws them: a uniform random subset of the distinct segment-end coordinates "
-    "of each cell, which needs them sorted (about 3x slower subdivision). Default: --axis-candidates random segment "
-    "ends, so that coordinates where many segments end (walls) are likelier; both evaluate their positions exactly";
+    "of each cell, which needs them all sorted (about 3x slower subdivision on large scenes). Default: random segment "
+    "ends until --axis-candidates distinct ones, so that coordinates where many segments end (walls) are likelier; "
+    "both evaluate their positions exactly";
 
 /// Global options.
 struct Common {

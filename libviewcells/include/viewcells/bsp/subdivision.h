@@ -69,9 +69,11 @@ struct SubdivisionConfig {
   uint32_t max_axis_candidates = 200;  ///< positions per axis (a random subset of segment ends beyond)
   /// How the axis-aligned positions of a cell are drawn when it has more segment ends than
   /// max_axis_candidates. Exact (the paper's): a uniform random subset of the distinct end
-  /// coordinates, which needs them sorted (O(n log n) per cell and axis). Fast (the default):
-  /// max_axis_candidates random segment ends (so coordinates where many segments end, walls,
-  /// are likelier), O(k log k). Either way the chosen positions are then evaluated exactly.
+  /// coordinates, which needs them all sorted (O(n log n) per cell and axis). Fast (the
+  /// default, once a cell has more than 4 x max_axis_candidates ends): random segment ends
+  /// until max_axis_candidates distinct ones (or 4 x as many draws), so coordinates where many
+  /// segments end (walls) are likelier: O(k log k). Either way every chosen position is
+  /// evaluated exactly.
   bool exact_candidates = false;
   GeometryAlignedMode geometry_aligned = GeometryAlignedMode::kAuto;
   uint32_t ga_candidates = 150;       ///< geometry-aligned planes per node at most (paper: 150)
