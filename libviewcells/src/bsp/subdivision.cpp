@@ -328,6 +328,40 @@ class DrawnSet {
   uint32_t epoch_ = 0;
 };
 
+/// The exact side of points against a geometry-aligned plane through p, q, r, decided as
+/// Plane::side (CGAL's orientation predicate) decides it, but mostly without the call: the
+/// determinant of (q - p, r - p, s - p) in double, evaluated as CGAL's determinant() does
+/// with s - p in the last column (so the 2x2 minors of q - p and r - p are computed once per
+/// plane), against twice the error bound of CGAL's semi-static filter for it; Plane::side
+/// where that bound does not decide.
+class FilteredSide {
+ public:
+  explicit FilteredSide(const Plane& plane) : plane_(plane), p_(plane.points[0]) {
+    const Vec3 pq = plane.points[1] - p_, pr = plane.points[2] - p_;
+    m01_ = pq.x * pr.y - pq.y * pr.x;
+    m02_ = pq.x * pr.z - pq.z * pr.x;
+    m12_ = pq.y * pr.z - pq.z * pr.y;
+    for (int k = 0; k < 3; ++k) max_[k] = std::max(std::abs(pq[k]), std::abs(pr[k]));
+  }
+  int operator()(const Vec3& s) const {
+    const double sx = s.x - p_.x, sy = s.y - p_.y, sz = s.z - p_.z;
+    const double det = m01_ * sz - m02_ * sy + m12_ * sx;
+    const double eps = 2 * 5.1107127829973299e-15 * std::max(max_[0], std::abs(sx)) *
+                       std::max(max_[1], std::abs(sy)) * std::max(max_[2], std::abs(sz));
+    if (eps > 1e-280 && eps < 1e280) {  // no underflow or overflow in the bound
+      if (det > eps) return 1;
+      if (det < -eps) return -1;
+    }
+    return plane_.side(s);
+  }
+
+ private:
+  const Plane& plane_;
+  Vec3 p_;
+  double m01_, m02_, m12_;
+  double max_[3];
+};
+
 struct Candidate {
   bool valid = false;
   Plane plane;
@@ -917,27 +951,70 @@ class Builder {
     const double volume = out_.nodes[node].volume, weight = out_.nodes[node].weight;
     const ConvexPolyhedron& cell = out_.cells[node];
     const ConvexPolyhedron part = config_.density.enabled ? config_.density.band_part(cell) : ConvexPolyhedron();
-    Marks& neg = marks_.local();
-    Marks pos;  // a second set of marks for the positive side
-    Candidate best;
-    for (uint32_t t : planes) {
-      const auto& tri = scene_.triangles[t];
-      const Plane plane = Plane::through(scene_.vertices[tri[0]], scene_.vertices[tri[1]], scene_.vertices[tri[2]]);
-      const double vl = cell.volume_below(plane), vr = volume - vl;
-      if (!(vl > kMinPart * volume && vr > kMinPart * volume)) continue;
+    // The parts' end points and objects once, in order, for all the planes.
+    struct PartEnds {
+      Vec3 p0, p1;
+      uint32_t object_a, object_b;
+    };
+    std::vector<PartEnds> parts(refs.size());
+    for (size_t i = 0; i < refs.size(); ++i) {
+      prefetch_ends(refs, i);
+      const SegEnds& e = ends_[refs[i].id];
+      parts[i] = {e.at(refs[i].t0), e.at(refs[i].t1), e.object_a, e.object_b};
+    }
+    // A plane's reduction from every `stride`-th part (1: exact).
+    auto reduction_of = [&](const Plane& plane, double vl, size_t stride) {
+      const FilteredSide side(plane);
+      auto& [neg, pos] = side_pair_marks_.local();
       neg.reset(r_.size());
       pos.reset(r_.size());
       double cl = 0, cr = 0;
-      for (const SegRef& s : refs) {
-        const SegEnds& e = ends_[s.id];
-        const int to = classify(plane.side(e.at(s.t0)), plane.side(e.at(s.t1)));
+      for (size_t i = 0; i < parts.size(); i += stride) {
+        const PartEnds& e = parts[i];
+        const int to = classify(side(e.p0), side(e.p1));
         if (to & 1) cl += neg.add(e.object_a, r) + neg.add(e.object_b, r);
         if (to & 2) cr += pos.add(e.object_a, r) + pos.add(e.object_b, r);
       }
       const double wl = config_.density.enabled ? config_.density.weight_below(cell, part, plane) : vl;
-      const double reduction = own - (wl * cl + (weight - wl) * cr) / total_weight_;
-      if (!best.valid || reduction > best.reduction) best = {true, plane, reduction};
+      return own - (wl * cl + (weight - wl) * cr) / total_weight_;
+    };
+    // Each plane costs O(n). In a large cell the fast mode ranks the planes on about
+    // kGaSampleParts evenly spaced parts and evaluates only the kGaKeep best of them on all
+    // parts; --exact-candidates evaluates every plane on every part.
+    constexpr size_t kGaSampleParts = 8192, kGaKeep = 8;
+    const bool ranked = !config_.exact_candidates && parts.size() > 2 * kGaSampleParts && planes.size() > kGaKeep;
+    const size_t stride = ranked ? (parts.size() + kGaSampleParts - 1) / kGaSampleParts : 1;
+    // The planes in parallel, the best chosen in their order: ties keep the first.
+    std::vector<Candidate> results(planes.size());
+    tbb::parallel_for(size_t{0}, planes.size(), [&](size_t j) {
+      const auto& tri = scene_.triangles[planes[j]];
+      const Plane plane = Plane::through(scene_.vertices[tri[0]], scene_.vertices[tri[1]], scene_.vertices[tri[2]]);
+      const double vl = cell.volume_below(plane), vr = volume - vl;
+      if (!(vl > kMinPart * volume && vr > kMinPart * volume)) return;
+      results[j] = {true, plane, reduction_of(plane, vl, stride)};
+    });
+    if (ranked) {
+      std::vector<size_t> order;
+      for (size_t j = 0; j < results.size(); ++j)
+        if (results[j].valid) order.push_back(j);
+      const size_t keep = std::min(kGaKeep, order.size());
+      std::partial_sort(order.begin(), order.begin() + keep, order.end(), [&](size_t a, size_t b) {
+        return results[a].reduction > results[b].reduction || (results[a].reduction == results[b].reduction && a < b);
+      });
+      std::vector<char> kept(results.size(), 0);
+      for (size_t i = 0; i < keep; ++i) kept[order[i]] = 1;
+      tbb::parallel_for(size_t{0}, results.size(), [&](size_t j) {
+        if (!kept[j]) {
+          results[j].valid = false;
+          return;
+        }
+        const Plane& plane = results[j].plane;
+        results[j].reduction = reduction_of(plane, cell.volume_below(plane), 1);
+      });
     }
+    Candidate best;
+    for (const Candidate& c : results)
+      if (c.valid && (!best.valid || c.reduction > best.reduction)) best = c;
     __atomic_add_fetch(&ev.geometry, planes.size(), __ATOMIC_RELAXED);
     return best;
   }
@@ -961,6 +1038,7 @@ class Builder {
   std::atomic<uint64_t> axis_evaluated_{0}, geometry_evaluated_{0}, parts_evaluated_{0};
   tbb::enumerable_thread_specific<Marks> marks_;
   tbb::enumerable_thread_specific<SideMarks> side_marks_;
+  tbb::enumerable_thread_specific<std::pair<Marks, Marks>> side_pair_marks_;  ///< geometry-aligned: both sides
   mutable tbb::enumerable_thread_specific<DrawnSet> drawn_;
 };
 
