@@ -22,6 +22,7 @@ struct CompareArgs {
   bool no_ga = false;
   uint32_t axis_candidates = 200;
   bool exact_candidates = false;
+  double min_reduction = 1e-6;
   uint32_t ga_candidates = 150;
   MergeOptions merge;
   std::string output;
@@ -41,6 +42,7 @@ int run_compare(const CompareArgs& a, const Common& c) {
   config.model.b = a.cost_b;
   config.subdivision.max_axis_candidates = a.axis_candidates;
   config.subdivision.exact_candidates = a.exact_candidates;
+  config.subdivision.min_reduction = a.min_reduction;
   config.subdivision.ga_candidates = a.ga_candidates;
   config.geometry_aligned_off = a.no_ga;
   config.merge_agvs = a.merge.agvs(c, config.construction.seed, config.construction.samples);
@@ -77,6 +79,11 @@ void add_compare_command(CLI::App& app, const Common& common, Commands& commands
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   cm->add_flag("--exact-candidates", a->exact_candidates, std::string("AV-S/AV-M: ") + kExactCandidatesHelp);
+  cm->add_option("--min-reduction", a->min_reduction,
+                 "AV-S/AV-M: stop when splits reduce the cost by less than this share of the initial cost for 50 "
+                 "splits running (0: always reach --max-cells)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   cm->add_option("--ga-candidates", a->ga_candidates, "AV-S/AV-M: geometry-aligned planes per cell")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
-# Subdivision benchmark (issue: AV-S): the generated city (>= 1M triangles), segments to 50k
-# cells, time per phase; and how the subdivision time grows with 0.5M, 1M, 1.5M, 2M segments.
+# Subdivision benchmark: the generated city (>= 1M triangles), segments to 50k cells, time per
+# phase, with the default (fast) candidate positions and with --exact-candidates (the paper's
+# choice), each size run with both in turn so that their ratio is measured in one run; how the
+# subdivision time grows with 0.5M, 1M, 1.5M, 2M segments; and one compare at 1.5M segments
+# that scores both subdivisions on independent evaluation samples at 1k, 10k and 50k cells.
 # The stagnation stop is switched off (--min-reduction 0) so that every run reaches CELLS.
 # Rewrites the subdivision section of BENCHMARKS.md. Usage: scripts/bench-subdivision.sh [SIZE] [CELLS]
 set -euo pipefail
@@ -8,9 +11,20 @@ size="${1:-23}"
 cells="${2:-50000}"
 source "$(dirname "$0")/bench-setup.sh"
 scene=$(bench_scene city "$size")
+# peak KB FILE COMMAND...: runs COMMAND, writing its peak resident memory (KB) to FILE when
+# GNU time is there.
+peak() {
+  local file="$1"; shift
+  if [ -x /usr/bin/time ]; then /usr/bin/time -f %M -o "$file" "$@"; else rm -f "$file"; "$@"; fi
+}
 for n in 500000 1000000 1500000 2000000; do
-  "$vc" build "$scene" --segments "$n" --max-cells "$cells" --min-reduction 0 --seed 1 -q --report "$dir/build-$n.json"
+  peak "$dir/build-$n.kb" "$vc" build "$scene" --segments "$n" --max-cells "$cells" --min-reduction 0 --seed 1 -q \
+    --no-merge --report "$dir/build-$n.json"
+  peak "$dir/build-exact-$n.kb" "$vc" build "$scene" --segments "$n" --max-cells "$cells" --min-reduction 0 --seed 1 \
+    -q --no-merge --exact-candidates --report "$dir/build-exact-$n.json"
 done
+"$vc" compare "$scene" --segments 1500000 --max-cells "$cells" --min-reduction 0 --methods av-s,av-s-exact --seed 1 -q \
+  -o "$dir/compare-candidates"
 python3 scripts/vctables.py subdivision "$dir" "$size" "$cells" > "$dir/subdivision-table.md"
 python3 scripts/vctables.py replace-section BENCHMARKS.md subdivision "scripts/bench-subdivision.sh $size $cells" "$dir/subdivision-table.md"
 cat "$dir/subdivision-table.md"

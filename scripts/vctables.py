@@ -59,21 +59,47 @@ def sampling(*args):
 
 @command("DIR SIZE CELLS")
 def subdivision(*args):
-    """BENCHMARKS.md, subdivision: time per phase at 0.5M-2M segments, and the growth per doubling."""
+    """BENCHMARKS.md, subdivision: fast and exact candidates at 0.5M-2M segments, growth per doubling, evaluated costs."""
     argv = ["vctables"] + list(args)
     d, size, cells = argv[1], argv[2], argv[3]
-    print(f"City size {size} (seed 1), {int(cells):,} cells, default view box, no stagnation stop, threads = 2.\n")
-    print("| segments | load s | BVH s | sampling s | subdivision s | write s | cells | initial cost | final cost | axis candidates | GA candidates |")
-    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
-    base = None
-    for n in [500000, 1000000, 1500000, 2000000]:
-        r = json.load(open(f"{d}/build-{n}.json")); t = r["timings"]; s = r["subdivision"]
-        print(f"| {n:,} | {t['load_seconds']:.2f} | {t['bvh_build_seconds']:.2f} | {t['sampling_seconds']:.2f} | "
-              f"{t['subdivision_seconds']:.1f} | {t['write_seconds']:.2f} | {s['cells']:,} | {s['initial_cost']:,.0f} | "
-              f"{s['final_cost']:,.0f} | {s['axis_candidates_evaluated']:,} | {s['geometry_candidates_evaluated']:,} |")
-    ts = {n: json.load(open(f"{d}/build-{n}.json"))["timings"]["subdivision_seconds"] for n in [500000, 1000000, 2000000]}
-    print(f"\nSubdivision time ratios: 1M / 0.5M = {ts[1000000] / ts[500000]:.2f}, 2M / 1M = {ts[2000000] / ts[1000000]:.2f} "
-          "(2.0 would be linear in the number of segments).")
+    print(f"City size {size} (seed 1), {int(cells):,} cells, default view box, no stagnation stop, no merge, threads = 2. "
+          "Fast: the default candidate positions; exact: `--exact-candidates`, the paper's. Each size ran fast, then "
+          "exact, in one run of the script.\n")
+    print("| segments | sampling s | subdivision s, fast | subdivision s, exact | exact / fast | final cost, fast | "
+          "final cost, exact | axis candidates, fast | segment parts evaluated, fast | peak GB, fast / exact |")
+    print("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    sizes = [500000, 1000000, 1500000, 2000000]
+    fast, exact = {}, {}
+    for n in sizes:
+        f = json.load(open(f"{d}/build-{n}.json")); e = json.load(open(f"{d}/build-exact-{n}.json"))
+        fast[n], exact[n] = f["timings"]["subdivision_seconds"], e["timings"]["subdivision_seconds"]
+        sf, se = f["subdivision"], e["subdivision"]
+        def peak(name):
+            path = f"{d}/{name}-{n}.kb"
+            return f"{int(open(path).read().split()[-1]) / 1e6:.2f}" if os.path.exists(path) else "-"
+        print(f"| {n:,} | {f['timings']['sampling_seconds']:.2f} | {fast[n]:.1f} | {exact[n]:.1f} | "
+              f"{exact[n] / fast[n]:.2f} | {sf['final_cost']:,.0f} | {se['final_cost']:,.0f} | "
+              f"{sf['axis_candidates_evaluated']:,} | {sf.get('segment_parts_evaluated', 0):,} | "
+              f"{peak('build')} / {peak('build-exact')} |")
+    print(f"\nSubdivision time per doubling of segments, fast: 1M / 0.5M = {fast[1000000] / fast[500000]:.2f}, "
+          f"2M / 1M = {fast[2000000] / fast[1000000]:.2f}; exact: {exact[1000000] / exact[500000]:.2f} and "
+          f"{exact[2000000] / exact[1000000]:.2f} (2.0 would be linear in the number of segments).")
+    path = f"{d}/compare-candidates/curves.csv"
+    if os.path.exists(path):
+        rows = list(csv.DictReader(open(path)))
+        cost = {m: {int(r["cells"]): float(r["cost"]) for r in rows if r["method"] == m} for m in ("av-s", "av-s-exact")}
+        summary = json.load(open(f"{d}/compare-candidates/summary.json"))
+        secs = {m["method"]: m["build_seconds"] for m in summary["methods"]}
+        common = sorted(set(cost["av-s"]) & set(cost["av-s-exact"]))
+        print(f"\nEvaluated on independent samples (`compare --segments 1500000 --methods av-s,av-s-exact`, 4M evaluation "
+              f"samples; subdivision {secs['av-s']:.1f} s fast, {secs['av-s-exact']:.1f} s exact in that run):\n")
+        print("| cells | evaluated cost, fast | evaluated cost, exact | fast / exact |")
+        print("| ---: | ---: | ---: | ---: |")
+        for want in (1000, 10000, int(cells)):
+            c = min(common, key=lambda x: abs(x - want))
+            print(f"| {c:,} | {cost['av-s'][c]:,.0f} | {cost['av-s-exact'][c]:,.0f} | {cost['av-s'][c] / cost['av-s-exact'][c]:.4f} |")
+        ratios = [cost["av-s"][c] / cost["av-s-exact"][c] for c in common if c >= 16]
+        print(f"\nOver all {len(ratios)} reported counts from 16 cells: fast / exact from {min(ratios):.4f} to {max(ratios):.4f}.")
 
 
 @command("DIR SIZE CELLS")

@@ -82,14 +82,31 @@ class Tables(unittest.TestCase):
 
     def test_subdivision_growth_per_doubling(self):
         for n, s in [(500000, 10.0), (1000000, 21.0), (1500000, 33.0), (2000000, 44.1)]:
-            dump(f"{self.d}/build-{n}.json", {
-                "timings": {"load_seconds": 1, "bvh_build_seconds": 1, "sampling_seconds": 1, "subdivision_seconds": s,
-                            "write_seconds": 0.1},
-                "subdivision": {"cells": 50000, "initial_cost": 10, "final_cost": 5, "axis_candidates_evaluated": 7,
-                                "geometry_candidates_evaluated": 0}})
+            for name, secs in [("build", s), ("build-exact", 3 * s)]:
+                dump(f"{self.d}/{name}-{n}.json", {
+                    "timings": {"load_seconds": 1, "bvh_build_seconds": 1, "sampling_seconds": 1,
+                                "subdivision_seconds": secs, "write_seconds": 0.1},
+                    "subdivision": {"cells": 50000, "initial_cost": 10, "final_cost": 5, "axis_candidates_evaluated": 7,
+                                    "geometry_candidates_evaluated": 0, "segment_parts_evaluated": 9}})
+            with open(f"{self.d}/build-{n}.kb", "w") as f:
+                f.write("1500000\n")
+        os.makedirs(f"{self.d}/compare-candidates")
+        with open(f"{self.d}/compare-candidates/curves.csv", "w") as f:
+            f.write("method,cells,cost,ratio_to_av_m,constructed_cost\n")
+            for cells, cost in [(16, 100.0), (1000, 50.0), (10000, 20.0), (50000, 10.0)]:
+                f.write(f"av-s,{cells},{cost},,\n")
+                f.write(f"av-s-exact,{cells},{cost * 1.01},,\n")
+        dump(f"{self.d}/compare-candidates/summary.json",
+             {"methods": [{"method": "av-s", "build_seconds": 30.0}, {"method": "av-s-exact", "build_seconds": 90.0}]})
         t = run("subdivision", self.d, 23, 50000)
-        self.assertIn("1M / 0.5M = 2.10, 2M / 1M = 2.10", t)
-        self.assertEqual(row(t, "1,500,000")[4], "33.0")
+        self.assertIn("fast: 1M / 0.5M = 2.10, 2M / 1M = 2.10; exact: 2.10 and 2.10", t)
+        r = row(t, "1,500,000")
+        self.assertEqual(r[2], "33.0")
+        self.assertEqual(r[3], "99.0")
+        self.assertEqual(r[4], "3.00")
+        self.assertEqual(r[9], "1.50 / -")
+        self.assertEqual(row(t, "10,000")[3], "0.9901")
+        self.assertIn("subdivision 30.0 s fast, 90.0 s exact", t)
 
     def test_ab_medians_and_ratio(self):
         tsv = f"{self.d}/ab.tsv"
