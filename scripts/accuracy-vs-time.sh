@@ -5,6 +5,8 @@
 #  3. candidate limits (axis positions per axis, geometry-aligned planes per cell);
 #  4. Embree robust against fast mode: speed, and rays leaking through edges and vertices
 #     counted against the watertight brute-force caster.
+# Sections 5 (merging) and 6 (subdivision candidates) come from scripts/merge-vs-time.sh and
+# scripts/candidates-vs-time.sh; this script keeps what they last wrote.
 # Writes docs/accuracy-vs-time.md and its plots in docs/accuracy/.
 # Usage: scripts/accuracy-vs-time.sh [CELLS] [CITY_SIZE]
 set -euo pipefail
@@ -56,6 +58,12 @@ printf '\n## 5. Merging: what the validated merge costs and gains\n\n<!-- merge:
 if [ -f docs/accuracy/merge.md ] && [ -f docs/accuracy/merge.command ]; then
   python3 scripts/vctables.py replace-section docs/accuracy-vs-time.md merge "$(cat docs/accuracy/merge.command)" \
     docs/accuracy/merge.md
+fi
+# Section 6 is scripts/candidates-vs-time.sh's; likewise.
+printf '\n## 6. Subdivision candidates: fast against exact, and positions per axis\n\n<!-- candidates:begin -->\nNot generated yet: run scripts/candidates-vs-time.sh.\n<!-- candidates:end -->\n' >> docs/accuracy-vs-time.md
+if [ -f docs/accuracy/candidates.md ] && [ -f docs/accuracy/candidates.command ]; then
+  python3 scripts/vctables.py replace-section docs/accuracy-vs-time.md candidates "$(cat docs/accuracy/candidates.command)" \
+    docs/accuracy/candidates.md
 fi
 
 # Plots: evaluated cost against cells per construction sample count; AA / AA+GA ratio.

@@ -547,6 +547,75 @@ def results(*args):
           "calls it not scalable; its final set, where it stops, is what such tools ship.")
 
 
+def _candidate_runs(d):
+    """scripts/candidates-vs-time.sh's runs: {(scene, k): summary, curves}."""
+    runs = {}
+    for path in sorted(glob.glob(f"{d}/*-*/summary.json")):
+        name = os.path.basename(os.path.dirname(path))
+        scene, k = name.rsplit("-", 1)
+        rows = list(csv.DictReader(open(f"{os.path.dirname(path)}/curves.csv")))
+        curves = {m: {int(r["cells"]): float(r["cost"]) for r in rows if r["method"] == m} for m in ("av-s", "av-s-exact")}
+        secs = {m["method"]: m["build_seconds"] for m in json.load(open(path))["methods"]}
+        runs[(scene, int(k))] = (secs, curves)
+    return runs
+
+
+CANDIDATE_SCENES = ["office", "rotated-office", "city", "oa_dm2"]
+
+
+@command("DIR SAMPLES CELLS")
+def candidates(d, samples, cells):
+    """The candidates section of docs/accuracy-vs-time.md from scripts/candidates-vs-time.sh's runs."""
+    runs = _candidate_runs(d)
+    cells = int(cells)
+    print(f"AV-S from {int(samples):,} construction samples to {cells:,} cells, scored on 4x as many independent evaluation "
+          "samples (seed 99). Fast: the default candidate positions (random segment ends until k distinct ones, and in "
+          "a large cell the geometry-aligned planes ranked on 8k of its segment parts); exact: `--exact-candidates`, "
+          "the paper's choice (a uniform subset of the distinct end coordinates; every plane on every part). Both "
+          "ways ran in the same compare, from the same samples; k is `--axis-candidates`. Cost ratios compare with "
+          "the exact choice at the default k = 200. Office and rotated office of size 4, the city of the subdivision "
+          "benchmark, and the OpenArena map oa_dm2 (geometry-aligned candidates on for the rotated office only: the "
+          "others are axis-aligned to within 5% of their surface).\n")
+    print("| scene | k | subdivision s, fast | exact | exact / fast | cost at about 100, fast / exact (200) | "
+          f"at {cells:,}, fast / exact (200) | at about 100, exact / exact (200) | at {cells:,}, exact / exact (200) |")
+    print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    for scene in CANDIDATE_SCENES:
+        if (scene, 200) not in runs:
+            continue
+        ref = runs[(scene, 200)][1]["av-s-exact"]
+        near = min(ref, key=lambda c: abs(c - 100))
+        for k in sorted(k for s, k in runs if s == scene):
+            secs, curves = runs[(scene, k)]
+            f, e = curves["av-s"], curves["av-s-exact"]
+            last = max(c for c in ref if c in f and c in e and c <= cells)
+            print(f"| {scene} | {k} | {secs['av-s']:.1f} | {secs['av-s-exact']:.1f} | "
+                  f"{secs['av-s-exact'] / secs['av-s']:.2f} | {f[near] / ref[near]:.3f} | {f[last] / ref[last]:.3f} | "
+                  f"{e[near] / ref[near]:.3f} | {e[last] / ref[last]:.3f} |")
+    worst = []
+    for (scene, k), (secs, curves) in runs.items():
+        if k != 200:
+            continue
+        f, e = curves["av-s"], curves["av-s-exact"]
+        ratios = [f[c] / e[c] for c in f if c in e and c >= 16]
+        worst.append(f"{scene} {min(ratios):.3f}-{max(ratios):.3f}")
+    print("\nAt k = 200, fast / exact over every reported count from 16 cells: " + ", ".join(sorted(worst)) + ".\n")
+    print("![candidates](accuracy/candidates.png)")
+
+
+@command("DIR")
+def candidates_dat(d):
+    """Plot data of the candidates section: scene, k, fast s, exact s, fast cost / exact (200) at the largest count."""
+    runs = _candidate_runs(d)
+    print("scene k fast_s exact_s fast_cost_ratio")
+    for (scene, k), (secs, curves) in sorted(runs.items()):
+        if (scene, 200) not in runs:
+            continue
+        ref = runs[(scene, 200)][1]["av-s-exact"]
+        f = curves["av-s"]
+        last = max(c for c in ref if c in f)
+        print(scene, k, f"{secs['av-s']:.3f}", f"{secs['av-s-exact']:.3f}", f"{f[last] / ref[last]:.4f}")
+
+
 @command("OUT SAMPLES CELLS")
 def merge_vs_time(*args):
     """The merge section of docs/accuracy-vs-time.md from scripts/merge-vs-time.sh's runs."""

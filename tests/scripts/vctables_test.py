@@ -108,6 +108,25 @@ class Tables(unittest.TestCase):
         self.assertEqual(row(t, "10,000")[3], "0.9901")
         self.assertIn("subdivision 30.0 s fast, 90.0 s exact", t)
 
+    def test_candidates_ratios_to_exact_at_200(self):
+        for k, fast_cost, exact_cost, fast_s in [(50, 12.0, 11.0, 1.0), (200, 10.5, 10.0, 2.0)]:
+            run_dir = f"{self.d}/city-{k}"
+            dump(f"{run_dir}/summary.json", {"methods": [{"method": "av-s", "build_seconds": fast_s},
+                                                          {"method": "av-s-exact", "build_seconds": 3 * fast_s}]})
+            with open(f"{run_dir}/curves.csv", "w") as f:
+                f.write("method,cells,cost,ratio_to_av_m,constructed_cost\n")
+                for cells, scale in [(16, 4.0), (99, 2.0), (2000, 1.0)]:
+                    f.write(f"av-s,{cells},{fast_cost * scale},,\n")
+                    f.write(f"av-s-exact,{cells},{exact_cost * scale},,\n")
+        t = run("candidates", self.d, 1000000, 2000)
+        rows = [line for line in t.splitlines() if line.startswith("| city |")]
+        self.assertEqual(len(rows), 2)
+        r50 = [c.strip() for c in rows[0].strip("|").split("|")]
+        self.assertEqual(r50[1:], ["50", "1.0", "3.0", "3.00", "1.200", "1.200", "1.100", "1.100"])
+        self.assertIn("city 1.050-1.050", t)
+        dat = run("candidates-dat", self.d).splitlines()
+        self.assertEqual(dat[1], "city 50 1.000 3.000 1.2000")
+
     def test_ab_medians_and_ratio(self):
         tsv = f"{self.d}/ab.tsv"
         with open(tsv, "w") as f:
