@@ -3,7 +3,8 @@
 # phase, with the default (fast) candidate positions and with --exact-candidates (the paper's
 # choice), each size run with both in turn so that their ratio is measured in one run; how the
 # subdivision time grows with 0.5M, 1M, 1.5M, 2M segments; and one compare at 1.5M segments
-# that scores both subdivisions on independent evaluation samples at 1k, 10k and 50k cells.
+# that scores both subdivisions on independent evaluation samples at 1k, 10k and 50k cells; and
+# the glass city (see-through surfaces) at 1.5M segments both ways.
 # The stagnation stop is switched off (--min-reduction 0) so that every run reaches CELLS.
 # Rewrites the subdivision section of BENCHMARKS.md. Usage: scripts/bench-subdivision.sh [SIZE] [CELLS]
 set -euo pipefail
@@ -23,6 +24,13 @@ for n in 500000 1000000 1500000 2000000; do
   peak "$dir/build-exact-$n.kb" "$vc" build "$scene" --segments "$n" --max-cells "$cells" --min-reduction 0 --seed 1 \
     -q --no-merge --exact-candidates --report "$dir/build-exact-$n.json"
 done
+# The see-through path: the glass city (curtain walls, pools of water), whose crossings add a
+# segment each, at 1.5M segments, both ways.
+glass=$(bench_scene glass-city "$size")
+peak "$dir/build-glass.kb" "$vc" build "$glass" --segments 1500000 --max-cells "$cells" --min-reduction 0 --seed 1 -q \
+  --no-merge --report "$dir/build-glass.json"
+peak "$dir/build-glass-exact.kb" "$vc" build "$glass" --segments 1500000 --max-cells "$cells" --min-reduction 0 \
+  --seed 1 -q --no-merge --exact-candidates --report "$dir/build-glass-exact.json"
 "$vc" compare "$scene" --segments 1500000 --max-cells "$cells" --min-reduction 0 --methods av-s,av-s-exact --seed 1 -q \
   -o "$dir/compare-candidates"
 python3 scripts/vctables.py subdivision "$dir" "$size" "$cells" > "$dir/subdivision-table.md"

@@ -84,6 +84,26 @@ def subdivision(*args):
     print(f"\nSubdivision time per doubling of segments, fast: 1M / 0.5M = {fast[1000000] / fast[500000]:.2f}, "
           f"2M / 1M = {fast[2000000] / fast[1000000]:.2f}; exact: {exact[1000000] / exact[500000]:.2f} and "
           f"{exact[2000000] / exact[1000000]:.2f} (2.0 would be linear in the number of segments).")
+    glass = f"{d}/build-glass.json"
+    if os.path.exists(glass) and os.path.exists(f"{d}/build-glass-exact.json"):
+        def per_candidate(r):
+            s = r["subdivision"]
+            return 1e6 * r["timings"]["subdivision_seconds"] / max(1, s["axis_candidates_evaluated"] + s["geometry_candidates_evaluated"])
+        g, ge = json.load(open(glass)), json.load(open(f"{d}/build-glass-exact.json"))
+        c15, c15e = json.load(open(f"{d}/build-1500000.json")), json.load(open(f"{d}/build-exact-1500000.json"))
+        gs, ges = g["timings"]["subdivision_seconds"], ge["timings"]["subdivision_seconds"]
+        print(f"\nThe see-through path: the glass city of size {size} (the city with glass curtain walls around two "
+              f"buildings in five and pools of water in a third of the streets: {g['counts']['see_through_objects']:,} "
+              f"see-through objects), 1.5M segments of which {g['counts']['see_through_segments']:,} are see-through "
+              f"crossings, to {int(cells):,} cells:\n")
+        print("| scene | subdivision s, fast | exact | exact / fast | µs per candidate, fast | exact | segment parts evaluated, fast |")
+        print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+        for name, f, e in [("city", c15, c15e), ("glass city", g, ge)]:
+            print(f"| {name} | {f['timings']['subdivision_seconds']:.1f} | {e['timings']['subdivision_seconds']:.1f} | "
+                  f"{e['timings']['subdivision_seconds'] / f['timings']['subdivision_seconds']:.2f} | "
+                  f"{per_candidate(f):.2f} | {per_candidate(e):.2f} | {f['subdivision'].get('segment_parts_evaluated', 0):,} |")
+        print(f"\nTime per candidate, glass city / city: {per_candidate(g) / per_candidate(c15):.2f} fast, "
+              f"{per_candidate(ge) / per_candidate(c15e):.2f} exact.")
     path = f"{d}/compare-candidates/curves.csv"
     if os.path.exists(path):
         rows = list(csv.DictReader(open(path)))

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cstring>
+#include <map>
+#include <filesystem>
 #include <sstream>
 
 #include "support/test_scenes.h"
@@ -332,6 +334,53 @@ TEST(ObjWriter, RoundTripsExactly) {
   EXPECT_EQ(r.vertices, s.vertices) << "coordinates survive the text round trip bit for bit";
   EXPECT_EQ(r.fingerprint(), s.fingerprint());
   for (size_t i = 0; i < s.object_count(); ++i) EXPECT_EQ(r.objects[i].name, s.objects[i].name);
+}
+
+TEST(ObjReader, SeeThroughMaterialsFromTheMaterialLibrary) {
+  // Two quads per group; "pane" is all glass, "wall" mixes: its glass faces are split off.
+  const std::string dir = test::temp_path("mtl");
+  std::filesystem::create_directories(dir);
+  test::write_file(dir + "/m.mtl",
+                   "newmtl stone\nKd 0.5 0.5 0.5\nd 1\nnewmtl glass\nd 0.25\nnewmtl tinted\nTr 0.4\n"
+                   "newmtl clear\nillum 7\nnewmtl halo\nd -halo 1.0\n");
+  const std::string quads = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n";
+  test::write_file(dir + "/s.obj", "mtllib m.mtl\n" + quads +
+                                       "o pane\nusemtl glass\nf 1 2 3 4\n"
+                                       "o wall\nusemtl stone\nf 5 6 7 8\nusemtl tinted\nf 1 5 8 4\n"
+                                       "o lens\nusemtl clear\nf 2 6 7 3\no solid\nusemtl halo\nf 1 2 6 5\n");
+  const Scene s = load_scene(dir + "/s.obj");
+  std::map<std::string, bool> occludes;
+  for (const ObjectInfo& o : s.objects) occludes[o.name] = o.occluder;
+  EXPECT_EQ(occludes, (std::map<std::string, bool>{
+                          {"pane", false}, {"wall", true}, {"wall (see-through)", false}, {"lens", false}, {"solid", true}}));
+  // Without its library the materials are unknown: an error naming the OBJ's line, not opaque glass.
+  test::write_file(dir + "/missing.obj", quads + "mtllib nowhere.mtl\no pane\nusemtl glass\nf 1 2 3 4\n");
+  expect_load_error(dir + "/missing.obj", {"missing.obj:9:", "nowhere.mtl"});
+  test::write_file(dir + "/bad.mtl", "newmtl glass\nd 0.x\n");
+  test::write_file(dir + "/bad.obj", "mtllib bad.mtl\n" + quads);
+  expect_load_error(dir + "/bad.obj", {"bad.obj:1:", "bad.mtl:2:", "malformed transparency"});
+  test::write_file(dir + "/orphan.mtl", "d 0.5\n");
+  test::write_file(dir + "/orphan.obj", "mtllib orphan.mtl\n" + quads);
+  expect_load_error(dir + "/orphan.obj", {"orphan.mtl:1:", "before any newmtl"});
+  // From a stream (no files to read): materials are ignored.
+  std::istringstream in("mtllib m.mtl\n" + quads + "o pane\nusemtl glass\nf 1 2 3 4\n");
+  EXPECT_TRUE(read_obj(in, "x.obj").group_occluder.empty());
+}
+
+TEST(ObjWriter, SeeThroughObjectsRoundTripThroughAMaterialLibrary) {
+  const Scene s = generate_scene({GeneratorKind::kGlassCity, 3, 1});
+  const size_t glass = std::count_if(s.objects.begin(), s.objects.end(), [](const ObjectInfo& o) { return !o.occluder; });
+  ASSERT_GT(glass, 0u);
+  const std::string path = test::temp_path("glass.obj");
+  write_obj(s, path);
+  EXPECT_TRUE(std::filesystem::exists(test::temp_path("glass.mtl")));
+  const Scene r = load_scene(path);
+  ASSERT_EQ(r.object_count(), s.object_count());
+  EXPECT_EQ(r.fingerprint(), s.fingerprint());
+  for (size_t i = 0; i < s.object_count(); ++i) {
+    EXPECT_EQ(r.objects[i].name, s.objects[i].name);
+    EXPECT_EQ(r.objects[i].occluder, s.objects[i].occluder) << s.objects[i].name;
+  }
 }
 
 }  // namespace

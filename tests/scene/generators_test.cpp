@@ -105,6 +105,26 @@ TEST(Generators, TownHasTurnedStreetsSquaresAndTowers) {
   EXPECT_GT(heights[heights.size() * 9 / 10], 2 * heights[heights.size() / 10]);
 }
 
+TEST(Generators, GlassCityIsTheCityWithSeeThroughSurfaces) {
+  const Scene city = generate_scene({GeneratorKind::kCity, 2, 4});
+  const Scene glass = generate_scene({GeneratorKind::kGlassCity, 2, 4});
+  size_t curtains = 0, pools = 0, plain = 0;
+  for (const ObjectInfo& o : glass.objects) {
+    if (o.occluder) {
+      ++plain;
+      continue;
+    }
+    EXPECT_TRUE(o.solid()) << o.name;  // closed boxes, like everything generated
+    curtains += o.name.ends_with("_glass");
+    pools += o.name.ends_with("_water");
+  }
+  EXPECT_EQ(plain, city.object_count()) << "the glass is added to the city, which stays as it was";
+  EXPECT_GT(curtains, 4u);
+  EXPECT_GT(pools, 2u);
+  EXPECT_NE(std::string(glass.source).find("glass-city"), std::string::npos);
+  EXPECT_EQ(parse_generator_kind("glass-city"), GeneratorKind::kGlassCity);
+}
+
 TEST(Generators, RejectsBadParameters) {
   EXPECT_THROW(generate_scene({GeneratorKind::kCity, 1, 0}), Error);
   EXPECT_THROW(parse_generator_kind("castle"), Error);

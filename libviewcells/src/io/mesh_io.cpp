@@ -475,7 +475,14 @@ Scene load_scene(const std::string& path, ObjectGrouping grouping) {
   } else if (ext == ".obj") {
     std::ifstream in(path, std::ios::binary);
     if (!in) throw Error(path, 0, "cannot open file");
-    mesh = read_obj(in, path);
+    mesh = read_obj(in, path, [&](const std::string& file) {
+      const std::filesystem::path mtl = std::filesystem::path(path).parent_path() / file;
+      std::ifstream m(mtl, std::ios::binary);
+      if (!m) throw Error("cannot open " + mtl.string() + " (without it, see-through materials are unknown)");
+      std::string text((std::istreambuf_iterator<char>(m)), std::istreambuf_iterator<char>());
+      if (m.bad()) throw Error("read error in " + mtl.string());
+      return text;
+    });
   } else if (ext == ".ply") {
     mesh = read_ply(read_all(), path);
   } else if (ext == ".off") {

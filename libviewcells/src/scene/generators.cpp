@@ -16,6 +16,7 @@ GeneratorKind parse_generator_kind(const std::string& name) {
   if (name == "city") return GeneratorKind::kCity;
   if (name == "rotated-office") return GeneratorKind::kRotatedOffice;
   if (name == "town") return GeneratorKind::kTown;
+  if (name == "glass-city") return GeneratorKind::kGlassCity;
   throw Error("unknown scene kind '" + name + "' (expected office, city, rotated-office or town)");
 }
 
@@ -25,6 +26,7 @@ const char* to_string(GeneratorKind kind) {
     case GeneratorKind::kCity: return "city";
     case GeneratorKind::kRotatedOffice: return "rotated-office";
     case GeneratorKind::kTown: return "town";
+    case GeneratorKind::kGlassCity: return "glass-city";
   }
   return "?";
 }
@@ -38,10 +40,12 @@ class MeshBuilder {
  public:
   explicit MeshBuilder(Scene& scene) : scene_(scene) {}
 
-  void begin_object(std::string name) {
+  /// Starts an object; `occluder` false for a see-through one (glass, water).
+  void begin_object(std::string name, bool occluder = true) {
     current_ = static_cast<uint32_t>(scene_.objects.size());
     ObjectInfo info;
     info.name = std::move(name);
+    info.occluder = occluder;
     scene_.objects.push_back(std::move(info));
   }
 
@@ -250,10 +254,11 @@ Scene generate_office(uint64_t seed, int size) {
 
 // ------------------------------------------------------------------------------------ city
 
-Scene generate_city(uint64_t seed, int size) {
+Scene generate_city(uint64_t seed, int size, bool glass) {
   Scene scene;
   MeshBuilder mb(scene);
   Rng rng(seed, 0xc17);
+  Rng glass_rng(seed, 0x91a55);
   constexpr double kBlock = 60.0, kStreet = 16.0, kPitch = kBlock + kStreet;
   const int blocks = size;
   const double extent = blocks * kPitch + kStreet;
@@ -283,14 +288,27 @@ Scene generate_city(uint64_t seed, int size) {
           mb.begin_object(bp + "_building_" + std::to_string(building++));
           mb.add_box({x0, y0, 0}, {x1, y1, h}, static_cast<int>((x1 - x0) / 5) + 1,
                      static_cast<int>((y1 - y0) / 5) + 1, floors);
+          double top = h;
           if (rng.uniform() < 0.3) {  // setback on the roof
             const double s = 0.25;
             const double sx0 = x0 + s * (x1 - x0), sx1 = x1 - s * (x1 - x0);
             const double sy0 = y0 + s * (y1 - y0), sy1 = y1 - s * (y1 - y0);
             const double sh = h * rng.uniform(0.2, 0.6);
             mb.add_box({sx0, sy0, h}, {sx1, sy1, h + sh}, 2, 2, std::max(1, static_cast<int>(sh / 3.5)));
+            top = h + sh;
+          }
+          // Glass city: a curtain wall 0.8 m outside the building, up to above its top (its own
+          // random stream, so the city's other draws stay those of the plain city).
+          if (glass && glass_rng.uniform() < 0.4) {
+            mb.begin_object(bp + "_building_" + std::to_string(building - 1) + "_glass", false);
+            mb.add_box({x0 - 0.8, y0 - 0.8, 0}, {x1 + 0.8, y1 + 0.8, top + 1.0}, 2, 2, std::max(1, floors / 4));
           }
         }
+      }
+      // Glass city: a pool of water along the middle of the street south of the block.
+      if (glass && glass_rng.uniform() < 1.0 / 3) {
+        mb.begin_object(bp + "_water", false);
+        mb.add_box({bx + 2.0, by - kStreet + 5.0, 0.0}, {bx + kBlock - 2.0, by - 5.0, 0.4}, 6, 2, 1);
       }
       // Street furniture along the block's south and west edges: lamps, trees, benches.
       int item = 0;
@@ -324,7 +342,8 @@ Scene generate_city(uint64_t seed, int size) {
   mb.add_box({extent - kStreet, 0 - 0.0, -1.0}, {extent, extent - kStreet, 0.0}, 1, blocks, 1);
   mb.begin_object("ground_border_north");
   mb.add_box({0, extent - kStreet, -1.0}, {extent, extent, 0.0}, blocks, 1, 1);
-  scene.source = std::string("generated city (size ") + std::to_string(size) + ", seed " + std::to_string(seed) + ")";
+  scene.source = std::string(glass ? "generated glass-city (size " : "generated city (size ") + std::to_string(size) +
+                 ", seed " + std::to_string(seed) + ")";
   return scene;
 }
 
@@ -453,7 +472,8 @@ Scene generate_scene(const GeneratorConfig& config) {
   switch (config.kind) {
     case GeneratorKind::kOffice:
     case GeneratorKind::kRotatedOffice: scene = generate_office(config.seed, config.size); break;
-    case GeneratorKind::kCity: scene = generate_city(config.seed, config.size); break;
+    case GeneratorKind::kCity: scene = generate_city(config.seed, config.size, false); break;
+    case GeneratorKind::kGlassCity: scene = generate_city(config.seed, config.size, true); break;
     case GeneratorKind::kTown: scene = generate_town(config.seed, config.size); break;
   }
   scene.grouping = ObjectGrouping::kGroups;

@@ -6,6 +6,7 @@
 /// error, never a shorter or invented mesh. glTF 2.0 (.gltf, .glb), FBX and a few more formats
 /// of the tools artists use are read through Assimp, with the scene graph's nodes as objects.
 #include <istream>
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -42,8 +43,17 @@ RawMesh read_assimp_bytes(std::string_view bytes, const std::string& extension, 
 /// Largest coordinate magnitude a scene may hold: Embree's rays stop working beyond about 1.8e18.
 inline constexpr double kMaxCoordinate = 1e18;
 
-/// Parses OBJ text; `name` is used in error messages. Polygons are fan-triangulated.
-RawMesh read_obj(std::istream& in, const std::string& name);
+/// Returns the text of the material library `file` named by an OBJ's `mtllib` (relative to the
+/// OBJ), or throws Error.
+using MaterialLibraryReader = std::function<std::string(const std::string& file)>;
+/// Parses OBJ text; `name` is used in error messages. Polygons are fan-triangulated. With
+/// `read_mtl`, the `mtllib` files are read and faces whose `usemtl` material is see-through
+/// (MTL dissolve `d` below 1, transparency `Tr` above 0, or a glass/refraction `illum` 4, 6, 7
+/// or 9) form the group "NAME (see-through)", which does not occlude (RawMesh::group_occluder);
+/// without it, materials are ignored.
+RawMesh read_obj(std::istream& in, const std::string& name, const MaterialLibraryReader& read_mtl = {});
+/// The names of the see-through materials (as read_obj decides) in MTL text.
+std::vector<std::string> see_through_materials(std::string_view mtl, const std::string& name);
 /// Parses the bytes of a PLY, OFF or STL file; `name` is used in error messages.
 RawMesh read_ply(std::string_view bytes, const std::string& name);
 RawMesh read_off(std::string_view bytes, const std::string& name);

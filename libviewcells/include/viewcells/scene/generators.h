@@ -17,9 +17,13 @@ enum class GeneratorKind {
   /// A city that is not a grid: districts (Voronoi cells) with streets at their own angles and
   /// blocks of their own sizes, taller in the middle, open squares with trees, landmark towers
   kTown,
+  /// The city with see-through surfaces (ObjectInfo::occluder false): a glass curtain wall
+  /// around two buildings in five, and a pool of water in a third of the streets; for the
+  /// see-through path of sampling and subdivision (every crossing adds a segment)
+  kGlassCity,
 };
 
-/// Parses "office", "city", "rotated-office", "town"; throws Error otherwise.
+/// Parses "office", "city", "rotated-office", "town", "glass-city"; throws Error otherwise.
 GeneratorKind parse_generator_kind(const std::string& name);
 const char* to_string(GeneratorKind kind);
 
