@@ -31,6 +31,15 @@ peak "$dir/build-glass.kb" "$vc" build "$glass" --segments 1500000 --max-cells "
   --no-merge --report "$dir/build-glass.json"
 peak "$dir/build-glass-exact.kb" "$vc" build "$glass" --segments 1500000 --max-cells "$cells" --min-reduction 0 \
   --seed 1 -q --no-merge --exact-candidates --report "$dir/build-glass-exact.json"
+# A Quake 3 map with much water and glass whose walls are not axis-aligned (geometry-aligned
+# candidates on): the path that was slowest per candidate, both ways.
+map=data/maps/bsp/oa_shouse.bsp
+if [ -f "$map" ]; then
+  peak "$dir/build-map.kb" "$vc" build "$map" --samples 300000 --max-cells 1500 --seed 1 -q --no-merge \
+    --report "$dir/build-map.json"
+  peak "$dir/build-map-exact.kb" "$vc" build "$map" --samples 300000 --max-cells 1500 --seed 1 -q --no-merge \
+    --exact-candidates --report "$dir/build-map-exact.json"
+fi
 "$vc" compare "$scene" --segments 1500000 --max-cells "$cells" --min-reduction 0 --methods av-s,av-s-exact --seed 1 -q \
   -o "$dir/compare-candidates"
 python3 scripts/vctables.py subdivision "$dir" "$size" "$cells" > "$dir/subdivision-table.md"

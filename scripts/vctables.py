@@ -98,12 +98,22 @@ def subdivision(*args):
               f"crossings, to {int(cells):,} cells:\n")
         print("| scene | subdivision s, fast | exact | exact / fast | µs per candidate, fast | exact | segment parts evaluated, fast |")
         print("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
-        for name, f, e in [("city", c15, c15e), ("glass city", g, ge)]:
+        rows = [("city", c15, c15e), ("glass city", g, ge)]
+        if os.path.exists(f"{d}/build-map.json") and os.path.exists(f"{d}/build-map-exact.json"):
+            m, me = json.load(open(f"{d}/build-map.json")), json.load(open(f"{d}/build-map-exact.json"))
+            rows.append(("oa_shouse (300k samples, 1,500 cells, GA on)", m, me))
+        for name, f, e in rows:
             print(f"| {name} | {f['timings']['subdivision_seconds']:.1f} | {e['timings']['subdivision_seconds']:.1f} | "
                   f"{e['timings']['subdivision_seconds'] / f['timings']['subdivision_seconds']:.2f} | "
                   f"{per_candidate(f):.2f} | {per_candidate(e):.2f} | {f['subdivision'].get('segment_parts_evaluated', 0):,} |")
         print(f"\nTime per candidate, glass city / city: {per_candidate(g) / per_candidate(c15):.2f} fast, "
               f"{per_candidate(ge) / per_candidate(c15e):.2f} exact.")
+        if len(rows) > 2:
+            m, me = rows[2][1], rows[2][2]
+            print(f"oa_shouse / city: {per_candidate(m) / per_candidate(c15):.2f} fast, "
+                  f"{per_candidate(me) / per_candidate(c15e):.2f} exact ({m['counts']['see_through_segments']:,} see-through "
+                  f"segments; a geometry-aligned candidate costs a pass over the cell's parts, an axis-aligned one a "
+                  f"share of one pass).")
     path = f"{d}/compare-candidates/curves.csv"
     if os.path.exists(path):
         rows = list(csv.DictReader(open(path)))
