@@ -78,8 +78,14 @@ AgvsFixture& agvs_fixture() {
 
 void entry_obj(const uint8_t* data, size_t size) {
   expecting_errors([&] {
-    std::istringstream in{std::string(bytes_of(data, size))};
-    scene_of(read_obj(in, "fuzz.obj"), "fuzz.obj");
+    // Input after a line "%%MTL" is the text of every material library the OBJ names, so the
+    // MTL parser and the see-through grouping are fuzzed too.
+    const std::string_view bytes = bytes_of(data, size);
+    const size_t split = bytes.find("\n%%MTL\n");
+    const std::string obj(bytes.substr(0, split));
+    const std::string mtl = split == std::string_view::npos ? std::string() : std::string(bytes.substr(split + 7));
+    std::istringstream in{obj};
+    scene_of(read_obj(in, "fuzz.obj", [&](const std::string&) { return mtl; }), "fuzz.obj");
   });
 }
 void entry_ply(const uint8_t* data, size_t size) {
