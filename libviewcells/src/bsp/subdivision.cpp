@@ -978,12 +978,14 @@ class Builder {
       const double wl = config_.density.enabled ? config_.density.weight_below(cell, part, plane) : vl;
       return own - (wl * cl + (weight - wl) * cr) / total_weight_;
     };
-    // Each plane costs O(n). In a large cell the fast mode ranks the planes on about
-    // kGaSampleParts evenly spaced parts and evaluates only the kGaKeep best of them on all
-    // parts; --exact-candidates evaluates every plane on every part.
-    constexpr size_t kGaSampleParts = 8192, kGaKeep = 8;
-    const bool ranked = !config_.exact_candidates && parts.size() > 2 * kGaSampleParts && planes.size() > kGaKeep;
-    const size_t stride = ranked ? (parts.size() + kGaSampleParts - 1) / kGaSampleParts : 1;
+    // Each plane costs O(n). In a large cell, every plane is first measured on about
+    // kGaSampleParts evenly spaced parts: they see a subset of what all parts see, so each side's
+    // r(PVS) can only grow and that reduction bounds the plane's true one from above. Planes are
+    // then evaluated on all parts in the order of their bounds until the next bound is below the
+    // best exact reduction (with a margin for rounding): the same choice as evaluating them all.
+    constexpr size_t kGaSampleParts = 4096;
+    const bool bounded = parts.size() > 4 * kGaSampleParts && planes.size() > 1;
+    const size_t stride = bounded ? (parts.size() + kGaSampleParts - 1) / kGaSampleParts : 1;
     // The planes in parallel, the best chosen in their order: ties keep the first.
     std::vector<Candidate> results(planes.size());
     tbb::parallel_for(size_t{0}, planes.size(), [&](size_t j) {
@@ -993,24 +995,31 @@ class Builder {
       if (!(vl > kMinPart * volume && vr > kMinPart * volume)) return;
       results[j] = {true, plane, reduction_of(plane, vl, stride)};
     });
-    if (ranked) {
+    if (bounded) {
       std::vector<size_t> order;
       for (size_t j = 0; j < results.size(); ++j)
         if (results[j].valid) order.push_back(j);
-      const size_t keep = std::min(kGaKeep, order.size());
-      std::partial_sort(order.begin(), order.begin() + keep, order.end(), [&](size_t a, size_t b) {
+      std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
         return results[a].reduction > results[b].reduction || (results[a].reduction == results[b].reduction && a < b);
       });
-      std::vector<char> kept(results.size(), 0);
-      for (size_t i = 0; i < keep; ++i) kept[order[i]] = 1;
-      tbb::parallel_for(size_t{0}, results.size(), [&](size_t j) {
-        if (!kept[j]) {
-          results[j].valid = false;
-          return;
+      const double margin = 1e-9 * std::abs(own) + 1e-300;
+      std::vector<char> exact(results.size(), 0);
+      double best_exact = -INFINITY;
+      for (size_t next = 0; next < order.size();) {
+        if (results[order[next]].reduction < best_exact - margin) break;  // no later plane can win
+        // A batch of planes with the highest bounds, evaluated on all parts in parallel.
+        const size_t batch = std::min(order.size(), next + 4);
+        tbb::parallel_for(next, batch, [&](size_t i) {
+          Candidate& c = results[order[i]];
+          c.reduction = reduction_of(c.plane, cell.volume_below(c.plane), 1);
+        });
+        for (; next < batch; ++next) {
+          exact[order[next]] = 1;
+          best_exact = std::max(best_exact, results[order[next]].reduction);
         }
-        const Plane& plane = results[j].plane;
-        results[j].reduction = reduction_of(plane, cell.volume_below(plane), 1);
-      });
+      }
+      for (size_t j = 0; j < results.size(); ++j)
+        if (!exact[j]) results[j].valid = false;  // bounded below the best: cannot be chosen
     }
     Candidate best;
     for (const Candidate& c : results)
