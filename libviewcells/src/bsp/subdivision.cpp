@@ -837,8 +837,8 @@ class Builder {
     }
     std::vector<double> from(k + 1, 0.0), upto(k + 1, 0.0);
     for (uint32_t o : m.touched) {
-      from[m.first[o]] += r[o];                                  // index k: never on the negative side
-      upto[static_cast<size_t>(m.last[o] + 1)] += r[o];          // index 0: never on the positive side
+      from[m.first[o]] += r[o];                          // index k: never on the negative side
+      upto[static_cast<size_t>(m.last[o] + 1)] += r[o];  // index 0: never on the positive side
     }
     left.assign(k, 0.0);
     right.assign(k, 0.0);
