@@ -164,17 +164,16 @@ TEST(Subdivision, GeometryAlignedPlanesHelpTheRotatedOffice) {
   expect_invariants(scene, segs, ga);
 }
 
-TEST(Subdivision, IdenticalForOneAndTwoThreads) {
-  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 3, 1});
-  const SegmentSet segs = sample(scene, 15000);
+/// Builds `cells` cells with one and with two threads; both trees must be the same.
+void expect_same_for_one_and_two_threads(const Scene& scene, const SegmentSet& segs, uint32_t cells) {
   Subdivision one, two;
   {
     ThreadLimit t(1);
-    one = build(scene, segs, 80);
+    one = build(scene, segs, cells);
   }
   {
     ThreadLimit t(2);
-    two = build(scene, segs, 80);
+    two = build(scene, segs, cells);
   }
   ASSERT_EQ(one.splits.size(), two.splits.size());
   for (size_t k = 0; k < one.splits.size(); ++k) {
@@ -182,6 +181,12 @@ TEST(Subdivision, IdenticalForOneAndTwoThreads) {
     EXPECT_EQ(one.splits[k].cost_after, two.splits[k].cost_after);
   }
   for (size_t p = 0; p < one.planes.size(); ++p) EXPECT_EQ(one.planes[p].offset, two.planes[p].offset);
+  for (int32_t leaf : one.leaves()) EXPECT_EQ(one.segments[leaf], two.segments[leaf]);
+}
+
+TEST(Subdivision, IdenticalForOneAndTwoThreads) {
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 3, 1});
+  expect_same_for_one_and_two_threads(scene, sample(scene, 15000), 80);
 }
 
 TEST(Subdivision, ViewpointDensityConcentratesCellsInTheBand) {
@@ -391,22 +396,7 @@ TEST(Subdivision, IdenticalForOneAndTwoThreadsWithLargeCells) {
   const Scene scene = generate_scene({GeneratorKind::kCity, 2, 3});
   const SegmentSet segs = sample(scene, 120000);
   ASSERT_GT(segs.size(), 70000u);
-  Subdivision one, two;
-  {
-    ThreadLimit t(1);
-    one = build(scene, segs, 60);
-  }
-  {
-    ThreadLimit t(2);
-    two = build(scene, segs, 60);
-  }
-  ASSERT_EQ(one.splits.size(), two.splits.size());
-  for (size_t k = 0; k < one.splits.size(); ++k) {
-    EXPECT_EQ(one.splits[k].node, two.splits[k].node);
-    EXPECT_EQ(one.splits[k].cost_after, two.splits[k].cost_after);
-  }
-  for (size_t p = 0; p < one.planes.size(); ++p) EXPECT_EQ(one.planes[p].offset, two.planes[p].offset);
-  for (int32_t leaf : one.leaves()) EXPECT_EQ(one.segments[leaf], two.segments[leaf]);
+  expect_same_for_one_and_two_threads(scene, segs, 60);
 }
 
 /// Neighbours share faces of positive area; on every split plane, the shared areas add up to

@@ -35,6 +35,28 @@ std::string_view trim(std::string_view s) {
   return s;
 }
 
+/// Calls f(line_no, line) for every line of `text` with its comment removed, after checking
+/// that it holds no binary data (an error naming `name`, the line and `kind`, "OBJ" or "MTL").
+template <typename F>
+void for_each_line(std::string_view text, const std::string& name, const char* kind, F&& f) {
+  long line_no = 0;
+  size_t pos = 0;
+  while (pos < text.size()) {
+    size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    std::string_view line = text.substr(pos, end - pos);
+    pos = end + 1;
+    ++line_no;
+    if (auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
+    for (const char ch : line) {
+      const auto c = static_cast<unsigned char>(ch);
+      if ((c < 0x20 && c != '\t' && c != '\r' && c != '\f' && c != '\v') || c == 0x7f)
+        throw Error(name, line_no, std::string("binary data: this is not a text ") + kind + " file");
+    }
+    f(line_no, line);
+  }
+}
+
 /// Parses a number of an MTL statement.
 double mtl_number(std::string_view& rest, const std::string& name, long line_no, std::string_view what) {
   const std::string_view tok = next_token(rest);
@@ -56,20 +78,7 @@ std::vector<std::string> see_through_materials(std::string_view mtl, const std::
   auto close = [&] {
     if (!current.empty() && current_see_through) out.push_back(current);
   };
-  long line_no = 0;
-  size_t pos = 0;
-  while (pos < mtl.size()) {
-    size_t end = mtl.find('\n', pos);
-    if (end == std::string_view::npos) end = mtl.size();
-    std::string_view line = mtl.substr(pos, end - pos);
-    pos = end + 1;
-    ++line_no;
-    if (auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-    for (const char ch : line) {
-      const auto c = static_cast<unsigned char>(ch);
-      if ((c < 0x20 && c != '\t' && c != '\r' && c != '\f' && c != '\v') || c == 0x7f)
-        throw Error(name, line_no, "binary data: this is not a text MTL file");
-    }
+  for_each_line(mtl, name, "MTL", [&](long line_no, std::string_view line) {
     std::string_view rest = line;
     const std::string_view kw = next_token(rest);
     if (kw == "newmtl") {
@@ -86,7 +95,7 @@ std::vector<std::string> see_through_materials(std::string_view mtl, const std::
       if (kw == "Tr") current_see_through |= v > 0;
       if (kw == "illum") current_see_through |= v == 4 || v == 6 || v == 7 || v == 9;
     }
-  }
+  });
   close();
   return out;
 }
@@ -121,23 +130,10 @@ RawMesh read_obj(std::istream& in, const std::string& name, const MaterialLibrar
     current_group = group_name.empty() && !in_see_through ? kUngrouped : group_id(group_name, in_see_through);
   };
 
-  long line_no = 0;
-  size_t pos = 0;
-  while (pos < text.size()) {
-    size_t end = text.find('\n', pos);
-    if (end == std::string::npos) end = text.size();
-    std::string_view line(text.data() + pos, end - pos);
-    pos = end + 1;
-    ++line_no;
-    if (auto hash = line.find('#'); hash != std::string_view::npos) line = line.substr(0, hash);
-    for (const char ch : line) {
-      const auto c = static_cast<unsigned char>(ch);
-      if ((c < 0x20 && c != '\t' && c != '\r' && c != '\f' && c != '\v') || c == 0x7f)
-        throw Error(name, line_no, "binary data: this is not a text OBJ file");
-    }
+  for_each_line(text, name, "OBJ", [&](long line_no, std::string_view line) {
     std::string_view rest = line;
     const std::string_view kw = next_token(rest);
-    if (kw.empty()) continue;
+    if (kw.empty()) return;
 
     if (kw == "v") {
       double c[3];
@@ -197,7 +193,7 @@ RawMesh read_obj(std::istream& in, const std::string& name, const MaterialLibrar
       select_group();
     }
     // Other statements (vn, vt, s, l, ...) carry nothing we use.
-  }
+  });
 
   if (mesh.group_names.empty()) {
     mesh.triangle_group.assign(mesh.triangles.size(), 0);
