@@ -134,7 +134,7 @@ void add_view_options(CLI::App* app, pipeline::ViewsConfig& v, const std::string
 void add_scene_commands(CLI::App& app, const Common& common, Commands& commands);    // generate, info, sample, isa
 void add_build_commands(CLI::App& app, const Common& common, Commands& commands);    // build, export
 void add_cut_commands(CLI::App& app, const Common& common, Commands& commands);      // extract, compress, query, view
-void add_pvs_commands(CLI::App& app, const Common& common, Commands& commands);      // pvs, bake
+void add_pvs_commands(CLI::App& app, const Common& common, Commands& commands);      // pvs, bake, measure
 void add_compare_command(CLI::App& app, const Common& common, Commands& commands);   // compare
 
 }  // namespace viewcells::cli

@@ -1,5 +1,6 @@
 // pvs, bake: potentially visible sets by adaptive global visibility sampling.
 #include <filesystem>
+#include <iostream>
 #include <memory>
 
 #include "options.h"
@@ -229,9 +230,73 @@ void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
 
 }  // namespace
 
+struct MeasureArgs {
+  std::string scene, pvs, objects = "auto", cameras = "auto", report;
+  uint32_t count = 5000, width = 64, height = 48;
+  double fov = 90, cost_a = CostModel{}.a, cost_b = CostModel{}.b, max_pitch = 30;
+  uint64_t seed = 1;
+  bool fast = false;
+};
+
+int run_measure(const MeasureArgs& a, const Common& c) {
+  check_files({a.scene, a.pvs}, {a.report});
+  ThreadLimit threads(c.threads);
+  pipeline::MeasureConfig config;
+  config.scene.path = a.scene;
+  config.scene.grouping = parse_grouping(a.objects);
+  config.scene.robust = !a.fast;
+  config.pvs_path = a.pvs;
+  config.placement = pipeline::parse_camera_placement(a.cameras);
+  config.cameras = a.count;
+  config.seed = a.seed;
+  config.frame.width = a.width;
+  config.frame.height = a.height;
+  config.frame.fov_degrees = a.fov;
+  config.play.max_pitch_degrees = a.max_pitch;
+  config.model.a = a.cost_a;
+  config.model.b = a.cost_b;
+  config.model.validate();
+  const pipeline::MeasureResult result = pipeline::measure(config, c.logger());
+  write_report_to(a.report, result, c);
+  if (a.report.empty()) std::cout << pipeline::report_json(result);
+  return 0;
+}
+
+void add_measure_command(CLI::App& app, const Common& common, Commands& commands) {
+  auto a = std::make_shared<MeasureArgs>();
+  auto* ms = app.add_subcommand(
+      "measure",
+      "Measure what a shipped PVS gives a viewer: render cameras by ray casting, and per frame count what the engine "
+      "draws (the PVS of the camera's view cell: render cost, triangles, objects) and the pixels it gets wrong "
+      "(objects shown but missing from that PVS). Without a .pvs, a Quake 3 map's own PVS (q3map2's vis rows) is "
+      "measured, so both sides of a comparison meet the same cameras");
+  ms->add_option("scene", a->scene, "The scene (a Quake 3 map .bsp, or any scene file)")->required();
+  ms->add_option("pvs", a->pvs, "A .pvs file made for the scene (from bake, pvs or compress)");
+  ms->add_option("--objects", a->objects, "Object grouping used when the .pvs file was made")->capture_default_str();
+  ms->add_option("--cameras", a->cameras,
+                 "Where cameras stand: play (a Quake 3 map: player eyes 50 units above walkable floors reachable "
+                 "from the spawn points, any yaw, pitch within --max-pitch), view-box (uniform random points of the "
+                 "view space, looking anywhere) or auto (play on a map)")
+      ->capture_default_str();
+  ms->add_option("--count", a->count, "Number of cameras")->capture_default_str()->check(whole(1, 10'000'000));
+  ms->add_option("--width", a->width, "Frame width in pixels")->capture_default_str()->check(whole(1, 16384));
+  ms->add_option("--height", a->height, "Frame height in pixels")->capture_default_str()->check(whole(1, 16384));
+  ms->add_option("--fov", a->fov, "Horizontal field of view in degrees")->capture_default_str()->check(CLI::Range(1.0, 179.0));
+  ms->add_option("--max-pitch", a->max_pitch, "Play cameras: largest pitch up or down, in degrees")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 89.0));
+  ms->add_option("--seed", a->seed, "Random seed of the cameras")->capture_default_str();
+  ms->add_option("--cost-a", a->cost_a, "Render cost model: r = max(a, b * triangles)")->capture_default_str();
+  ms->add_option("--cost-b", a->cost_b, "Render cost model: cost per triangle")->capture_default_str();
+  ms->add_flag("--fast", a->fast, "Embree without robust mode");
+  ms->add_option("--report", a->report, "JSON report (default: printed)");
+  commands.push_back({ms, [a, &common] { return run_measure(*a, common); }});
+}
+
 void add_pvs_commands(CLI::App& app, const Common& common, Commands& commands) {
   add_pvs_command(app, common, commands);
   add_bake_command(app, common, commands);
+  add_measure_command(app, common, commands);
 }
 
 }  // namespace viewcells::cli

@@ -71,7 +71,7 @@ void AgvsSolver::Impl::draw_samples(uint64_t index, uint32_t n, const double sha
         const Box3& b = cells.cell_bounds(c);
         for (int tries = 0; tries < 1000; ++tries) {
           p = {rng.uniform(b.lo.x, b.hi.x), rng.uniform(b.lo.y, b.hi.y), rng.uniform(b.lo.z, b.hi.z)};
-          if (cells.cell_at(p) == static_cast<int32_t>(c)) break;
+          if (cells.cell_at(p) == static_cast<int32_t>(c) && (!config.view_space || config.view_space(p))) break;
         }
         dir = sphere_direction(rng.uniform(), rng.uniform());
         s.ref_cell.push_back(static_cast<int32_t>(c));

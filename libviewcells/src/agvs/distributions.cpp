@@ -44,12 +44,24 @@ Vec3 AgvsSolver::Impl::object_point(double u0, double u1, double u2, double u3, 
   return p;
 }
 
+bool AgvsSolver::Impl::next_view_point(int d, int dim, uint64_t& i, Vec3& point) {
+  const Halton& h = halton[d];
+  // Most of a map's view box may be solid: points outside the view space are skipped (a bound
+  // keeps a view space of nearly no volume from stalling the batch).
+  for (int tries = 0; tries < 10000; ++tries) {
+    i = halton_index[d]++;
+    point = view_point(h.at(i, dim), h.at(i, dim + 1), h.at(i, dim + 2));
+    if (!config.view_space || config.view_space(point)) return true;
+  }
+  return false;
+}
+
 bool AgvsSolver::Impl::draw(int d, Rng& rng, Vec3& point, Vec3& dir) {
   const Halton& h = halton[d];
   switch (d) {
     case kVsd: {
-      const uint64_t i = halton_index[d]++;
-      point = view_point(h.at(i, 0), h.at(i, 1), h.at(i, 2));
+      uint64_t i = 0;
+      if (!next_view_point(d, 0, i, point)) return false;
       dir = sphere_direction(h.at(i, 3), h.at(i, 4));
       return true;
     }
@@ -67,10 +79,10 @@ bool AgvsSolver::Impl::draw(int d, Rng& rng, Vec3& point, Vec3& dir) {
       return true;
     }
     case kTp: {
-      const uint64_t i = halton_index[d]++;
+      uint64_t i = 0;
+      if (!next_view_point(d, 4, i, point)) return false;
       Vec3 n;
       const Vec3 o = object_point(h.at(i, 0), h.at(i, 1), h.at(i, 2), h.at(i, 3), n);
-      point = view_point(h.at(i, 4), h.at(i, 5), h.at(i, 6));
       const Vec3 to = o - point;
       if (!(length(to) > eps)) return false;
       dir = normalize(to);

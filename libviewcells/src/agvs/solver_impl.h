@@ -104,6 +104,9 @@ struct AgvsSolver::Impl {
     return {b.lo.x + e.x * u0, b.lo.y + e.y * u1, b.lo.z + e.z * u2};
   }
 
+  /// The next Halton point of distribution d (dimensions dim .. dim+2) in the view space, and
+  /// its index; false when none was found within a bound.
+  bool next_view_point(int d, int dim, uint64_t& i, Vec3& point);
   /// Draws one sample of distribution d into (point, dir); false when it cannot (no candidate).
   bool draw(int d, Rng& rng, Vec3& point, Vec3& dir);
 

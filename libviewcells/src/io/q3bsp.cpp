@@ -433,7 +433,10 @@ std::vector<Vec3> q3_spawn_points(const Q3Map& map) {
   std::istringstream in(map.entities);
   std::string line;
   auto flush = [&] {
-    if ((classname == "info_player_deathmatch" || classname == "info_player_start") && !origin.empty()) {
+    const bool spawn = classname == "info_player_deathmatch" || classname == "info_player_start" ||
+                       classname == "team_CTF_redplayer" || classname == "team_CTF_blueplayer" ||
+                       classname == "team_CTF_redspawn" || classname == "team_CTF_bluespawn";
+    if (spawn && !origin.empty()) {
       Vec3 p;
       std::istringstream o(origin);
       if (o >> p.x >> p.y >> p.z) out.push_back(p);

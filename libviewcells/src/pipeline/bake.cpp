@@ -90,7 +90,10 @@ SubdivisionFile hierarchy(const BakeConfig& c, LoadedScene& loaded, uint32_t max
 std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, const LoadedScene& loaded, const PvsFile& pf,
                                               BakeResult& out, const Log& log) {
   const CellLocator cells(pf.bsp, pf.leaf_cell, pf.pvs.cell_count);
-  AgvsSolver solver(*loaded.scene, *loaded.caster, cells, c.agvs);
+  AgvsConfig agvs = c.agvs;
+  use_map_view_space(loaded.map, agvs);
+  out.agvs_in_view_space = static_cast<bool>(agvs.view_space);
+  AgvsSolver solver(*loaded.scene, *loaded.caster, cells, agvs);
   const uint64_t identity = pvs_state_identity(loaded.scene->fingerprint(), pf);
   const std::string state = c.work_dir.empty() ? std::string() : c.work_dir + "/pvs.vagvs";
   if (!state.empty() && std::filesystem::is_regular_file(state)) {

@@ -150,6 +150,8 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   out.cells = cells.cell_count();
   log("viewcells: " + std::to_string(cells.cell_count()) + " view cells (" + set.rule + "), PVS by " +
       to_string(c.agvs.method) + " until " + describe_stop(c));
+  // On a Quake 3 map, AGVS's points are drawn in its non-solid space.
+  if (is_q3_map(c.scene_path)) use_map_view_space(std::make_shared<const Q3Map>(read_q3bsp(c.scene_path)), out.agvs);
   std::optional<AgvsSolver> solver;
   make_solver(c, scenes, cells, pf, out.agvs, solver, out.edit, log);
   add_references(c, pf, *solver);

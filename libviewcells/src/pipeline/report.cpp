@@ -354,10 +354,16 @@ json agvs_curve(const AgvsStats& st, size_t references) {
   return curve;
 }
 
+json agvs_view_space(bool restricted) {
+  return effect(restricted, restricted ? "a Quake 3 map: AGVS's points are drawn in its non-solid space"
+                                       : "AGVS's points are drawn in the whole view box");
+}
+
 json pvs_effects(const PvsResult& r) {
   const AgvsStats& st = r.stats;
   const bool agvs = r.agvs.method == AgvsMethod::kAgvs;
   return {{"empty_space_detection", effect(st.empty_space.enabled, st.empty_space.reason)},
+          {"restricted_view_space", agvs_view_space(static_cast<bool>(r.agvs.view_space))},
           {"silhouette_mutation", effect(agvs, agvs ? "part of the AGVS mixture" : "AGVS only")},
           {"visibility_filter",
            effect(r.filtering, r.filtering ? "asked for (--filter / --filter-neighbours): the written PVSs are "
@@ -546,7 +552,8 @@ std::string report_json(const BakeResult& r) {
                                                            " cells exceeded the memory budget: merged cells' PVSs "
                                                            "are the unions of their parts"
                                                      : "the file fits the budget as sampled")},
-                 {"empty_space_detection", effect(st.empty_space.enabled, st.empty_space.reason)}}},
+                 {"empty_space_detection", effect(st.empty_space.enabled, st.empty_space.reason)},
+                 {"restricted_view_space", agvs_view_space(r.agvs_in_view_space)}}},
                {"scene_fingerprint", r.scene_fingerprint},
                {"objects", r.object_count},
                {"cells", r.cells},
@@ -582,6 +589,44 @@ std::string query_json(const PvsFile& f, const Vec3& p, int32_t cell) {
          "\n";
 }
 
+std::string report_json(const MeasureResult& r) {
+  const MeasureConfig& c = r.config;
+  json worst = json::array();
+  for (const WrongObject& w : r.worst)
+    worst.push_back({{"object", w.object}, {"name", w.name}, {"pixels", w.pixels}, {"cameras", w.cameras}, {"cause", w.cause}});
+  json report = {
+      {"command", "measure"},
+      {"scene", c.scene.path},
+      {"measured", r.measured},
+      {"pvs_file", c.pvs_path.empty() ? json(nullptr) : json(c.pvs_path)},
+      {"cells", r.cells},
+      {"objects", r.objects},
+      {"pvs_entries", r.pvs_entries},
+      {"storage_bytes", r.storage_bytes},
+      {"cameras", {{"count", r.error.cameras},
+                   {"placement", r.camera_rule},
+                   {"points_drawn", r.camera_points_drawn},
+                   {"seed", c.seed},
+                   {"width", c.frame.width},
+                   {"height", c.frame.height},
+                   {"fov_degrees", c.frame.fov_degrees}}},
+      {"frame", {{"cost", r.frame_cost},
+                 {"median_cost", r.median_frame_cost},
+                 {"triangles", r.frame_triangles},
+                 {"objects", r.frame_objects},
+                 {"cost_model", {{"a", c.model.a}, {"b", c.model.b}}}}},
+      {"pixel_error", {{"pixels", r.error.pixels},
+                       {"median_pixels", r.error.median_pixels},
+                       {"share", r.error.share},
+                       {"resolution", c.frame.resolution},
+                       {"cameras_with_wrong_pixels", r.error.cameras_wrong},
+                       {"by_cause", r.wrong_by_cause},
+                       {"worst_objects", worst}}},
+      {"seconds", r.seconds}};
+  if (r.leaf_surface_bytes) report["leaf_surface_bytes"] = r.leaf_surface_bytes;
+  return text(report);
+}
+
 template <class Result>
 void write_report(const std::string& path, const Result& result) {
   write_text_file(path, report_json(result));
@@ -594,5 +639,6 @@ template void write_report(const std::string&, const CompressResult&);
 template void write_report(const std::string&, const PvsResult&);
 template void write_report(const std::string&, const CompareRunResult&);
 template void write_report(const std::string&, const BakeResult&);
+template void write_report(const std::string&, const MeasureResult&);
 
 }  // namespace viewcells::pipeline

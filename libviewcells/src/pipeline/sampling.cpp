@@ -47,6 +47,11 @@ void use_map_view_space(LoadedScene& s, SamplerConfig& config) {
                  " leaves): sample origins in solid leaves are drawn again";
 }
 
+void use_map_view_space(const std::shared_ptr<const Q3Map>& map, AgvsConfig& config) {
+  if (!map) return;
+  config.view_space = [map](const Vec3& p) { return q3_in_view_space(*map, p); };
+}
+
 SamplingRun load_and_sample(const SceneSource& source, const SamplerConfig& config, const Log& log) {
   if (config.samples == 0 && config.target_segments == 0) throw Error("--samples must be positive");
   return sample_loaded(load_scene_for_rays(source, log), config, log);

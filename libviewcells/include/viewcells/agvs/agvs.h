@@ -24,6 +24,7 @@
 
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/cells/view_cells.h"
+#include "viewcells/eval/frames.h"
 #include "viewcells/pvs/global_pvs.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
@@ -79,6 +80,11 @@ struct AgvsConfig {
   /// resolve errors below several pixels), and it guarantees progress everywhere.
   double min_share = 0.25;
   EmptySpaceMode empty_space = EmptySpaceMode::kAuto;
+  /// Where a viewer can stand (a Quake 3 map's non-solid space); empty: the whole view box.
+  /// The view space-direction and two-point samples' points, and REF's, are drawn there (Halton
+  /// points outside are skipped), so no samples are spent in solid space and the pixel error
+  /// estimator's cameras stand where viewers do.
+  std::function<bool(const Vec3&)> view_space;
   /// Keep the visibility filter's sampling densities (segments per cell; per cell and object,
   /// those that hit it: 2 bytes per cell and object). Required by the object space filter.
   bool filter_statistics = false;
@@ -223,12 +229,6 @@ LeafPvsRun leaf_pvs_by_agvs(const Scene& scene, const RayCaster& caster, const S
 /// cell (with the PVS alone it would show something else). Cameras inside solids are drawn
 /// again when `skip_inside_solids` (scenes of closed objects). Returns wrong pixels per
 /// camera, scaled to `resolution` pixels.
-struct PixelErrorMeasure {
-  double pixels = 0;     ///< mean wrong pixels per camera, scaled to `resolution`
-  double share = 0;      ///< wrong pixels / all pixels
-  uint32_t cameras = 0;
-  uint32_t cameras_wrong = 0;  ///< cameras with at least one wrong pixel
-};
 PixelErrorMeasure measure_pixel_error(const Scene& scene, const RayCaster& caster, const CellLocator& cells,
                                       const GlobalPvs& pvs, uint32_t cameras, uint32_t width, uint32_t height,
                                       double fov_degrees, uint64_t seed, bool skip_inside_solids,

@@ -131,7 +131,8 @@ RawMesh q3_world_mesh(const Q3Map& map, const Q3MeshOptions& options = {}, Q3Mes
 /// engine fogs them out), or 0 when the map has none.
 double q3_far_plane(const Q3Map& map);
 
-/// Spawn points (origin of info_player_deathmatch / info_player_start entities).
+/// Spawn points: origins of info_player_deathmatch, info_player_start and the team spawns of
+/// capture-the-flag maps (team_CTF_red/blueplayer, team_CTF_red/bluespawn).
 std::vector<Vec3> q3_spawn_points(const Q3Map& map);
 
 }  // namespace viewcells

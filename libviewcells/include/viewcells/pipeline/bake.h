@@ -46,6 +46,7 @@ struct BakeResult {
   AgvsStats agvs;
   double pixel_error = 0, pixel_error_bound = 0;  ///< NaN: not known
   bool agvs_resumed = false;
+  bool agvs_in_view_space = false;  ///< a Quake 3 map: AGVS drew its points in the non-solid space
   uint64_t pvs_entries = 0, file_bytes = 0;
   double mean_pvs = 0;
   double seconds = 0;

@@ -9,6 +9,7 @@
 #include "viewcells/pipeline/compare.h"
 #include "viewcells/pipeline/cut.h"
 #include "viewcells/pipeline/info.h"
+#include "viewcells/pipeline/measure.h"
 #include "viewcells/pipeline/pvs.h"
 #include "viewcells/pipeline/sampling.h"
 
@@ -23,6 +24,7 @@ std::string report_json(const CompressResult& result);
 std::string report_json(const PvsResult& result);
 std::string report_json(const CompareRunResult& result);
 std::string report_json(const BakeResult& result);
+std::string report_json(const MeasureResult& result);
 
 /// The cell and PVS of a point as `viewcells query --json` prints it.
 std::string query_json(const PvsFile& file, const Vec3& point, int32_t cell);

@@ -9,6 +9,7 @@
 #include <optional>
 #include <string>
 
+#include "viewcells/agvs/agvs.h"
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
@@ -45,6 +46,9 @@ LoadedScene load_scene_for_rays(const SceneSource& source, const Log& log);
 /// A Quake 3 map's view space is its non-solid space: sample origins are drawn there, and the
 /// view box defaults to the bounds of its non-solid leaves. Nothing for other scenes.
 void use_map_view_space(LoadedScene& loaded, SamplerConfig& config);
+
+/// On a Quake 3 map (`map` not null), AGVS draws its points in the map's non-solid space too.
+void use_map_view_space(const std::shared_ptr<const Q3Map>& map, AgvsConfig& config);
 
 /// Loading and sampling, with what a report needs.
 struct SamplingRun {

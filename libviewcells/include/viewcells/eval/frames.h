@@ -1,0 +1,69 @@
+#pragma once
+/// What a viewer gets from a shipped PVS, measured by frames: cameras stand in the view
+/// space, and each is rendered by ray casting against the whole scene. A pixel is wrong when
+/// the object it shows is not in the PVS of the camera's view cell (an engine drawing only
+/// that PVS would show something else there). The same cameras measure any PVS of the scene
+/// (ours, a map compiler's), so two can be compared frame by frame.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "viewcells/cells/view_cells.h"
+#include "viewcells/core/rng.h"
+#include "viewcells/core/vec3.h"
+#include "viewcells/pvs/global_pvs.h"
+#include "viewcells/raycast/ray_caster.h"
+#include "viewcells/scene/scene.h"
+
+namespace viewcells {
+
+/// A pinhole camera: `forward` is the view axis, `right` and `up` span the image plane (all
+/// unit length, orthogonal).
+struct Camera {
+  Vec3 eye, forward, right, up;
+};
+
+/// A camera at `eye` looking anywhere: forward uniform on the sphere, a random roll about it.
+Camera camera_looking_anywhere(const Vec3& eye, Rng& rng);
+/// A camera at `eye` as a player holds it: `yaw` about the vertical (+z) axis, `pitch` up
+/// from the horizontal (radians, |pitch| < pi/2), no roll.
+Camera camera_looking(const Vec3& eye, double yaw, double pitch);
+
+/// Cameras at uniform random points of the locator's view box that lie in a cell, looking
+/// anywhere (the AGVS estimator's definition, paper section 4.5). With `skip_inside_solids`
+/// (scenes of closed objects), a point whose random probe ray meets a back face first is inside
+/// a solid and drawn again. Drawn serially from `seed`: reproducible. `cells` receives each
+/// camera's cell.
+std::vector<Camera> view_box_cameras(const RayCaster& caster, const CellLocator& locator, uint32_t count,
+                                     uint64_t seed, bool skip_inside_solids, std::vector<int32_t>& cells);
+
+struct FrameConfig {
+  uint32_t width = 32, height = 32;
+  double fov_degrees = 90;            ///< horizontal
+  uint32_t resolution = 1024 * 1024;  ///< wrong pixels are reported per frame of this many pixels
+};
+
+/// An object shown at a camera although the camera's cell's PVS lacks it.
+struct WrongView {
+  uint32_t camera = 0;
+  uint32_t object = 0;
+  uint32_t pixels = 0;  ///< pixels of the camera's frame that show it
+};
+
+struct PixelErrorMeasure {
+  double pixels = 0;         ///< mean wrong pixels per camera, scaled to `resolution`
+  double share = 0;          ///< wrong pixels / all pixels
+  double median_pixels = 0;  ///< median over the cameras of their wrong pixels, scaled to `resolution`
+  uint32_t cameras = 0;
+  uint32_t cameras_wrong = 0;     ///< cameras with at least one wrong pixel
+  std::vector<WrongView> wrong;   ///< every (camera, object) with wrong pixels, by camera then object
+};
+
+/// Renders every camera (in parallel; the result does not depend on the thread count) and
+/// counts the pixels whose object (rendered objects only; see-through objects do not stop the
+/// camera's rays and are not counted) is missing from pvs's row `cells[k]` (each < the PVS's
+/// cell count).
+PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, std::span<const Camera> cameras,
+                                 std::span<const int32_t> cells, const GlobalPvs& pvs, const FrameConfig& config);
+
+}  // namespace viewcells

@@ -1,0 +1,72 @@
+#pragma once
+/// `viewcells measure`: what a shipped PVS gives a viewer, measured by frames. The same
+/// cameras render the scene; per frame, the render cost of the PVS the engine would draw
+/// (that of the camera's view cell) and the pixels it gets wrong (objects shown but missing
+/// from that PVS). Any .pvs file of the scene can be measured, and on a Quake 3 map also the
+/// map's own PVS (q3map2's cluster rows: visible clusters -> their leaves -> their surfaces),
+/// so both sides of a comparison are measured alike. On a map the cameras stand where players
+/// do (q3/play.h); elsewhere at random points of the view box, looking anywhere.
+#include <cstdint>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "viewcells/bsp/cost_model.h"
+#include "viewcells/eval/frames.h"
+#include "viewcells/pipeline/sampling.h"
+#include "viewcells/q3/play.h"
+
+namespace viewcells::pipeline {
+
+enum class CameraPlacement { kAuto, kPlay, kViewBox };
+/// Parses "auto", "play", "view-box" (Error otherwise).
+CameraPlacement parse_camera_placement(const std::string& name);
+
+struct MeasureConfig {
+  SceneSource scene;
+  std::string pvs_path;  ///< the .pvs to measure; empty: the map's own PVS (a Quake 3 map's vis rows)
+  CameraPlacement placement = CameraPlacement::kAuto;  ///< auto: play on a map, view box otherwise
+  uint32_t cameras = 5000;
+  uint64_t seed = 1;
+  FrameConfig frame{64, 48, 90.0, 1024 * 1024};
+  PlayCameraConfig play;  ///< count and seed come from above
+  CostModel model;        ///< r(o) of the frame cost (the pixel term is not used)
+};
+
+/// The objects with the most wrong pixels.
+struct WrongObject {
+  uint32_t object = 0;
+  std::string name;
+  uint64_t pixels = 0;
+  uint32_t cameras = 0;
+  std::string cause;  ///< for the map's own PVS: see MeasureResult::wrong_by_cause; else "missed"
+};
+
+struct MeasureResult {
+  MeasureConfig config;
+  std::string measured;  ///< what was measured, in words
+  uint32_t cells = 0, objects = 0;
+  uint64_t pvs_entries = 0;
+  uint64_t storage_bytes = 0;     ///< the .pvs file, or q3map2's uncompressed cluster rows
+  uint64_t leaf_surface_bytes = 0;  ///< q3map2 only: the leaf -> surface lists its renderer also needs
+  std::string camera_rule;
+  uint64_t camera_points_drawn = 0;
+  PixelErrorMeasure error;
+  // Per frame (mean over the cameras): what the engine draws, the PVS of the camera's cell.
+  double frame_cost = 0;  ///< r(PVS) with the cost model
+  double frame_triangles = 0, frame_objects = 0;
+  double median_frame_cost = 0;
+  /// Wrong pixels by cause. For the map's own PVS:
+  ///  - "far": the object lies beyond the map's _farplanedist from the eye (culled on purpose);
+  ///  - "unlisted": the object's surface is in no leaf of the map (the game never draws it);
+  ///  - "rejected": a line of sight q3map2's PVS rejects (or where the scene models differ).
+  /// For a .pvs: "missed" (what sampling did not find).
+  std::map<std::string, uint64_t> wrong_by_cause;
+  std::vector<WrongObject> worst;  ///< up to 10, most wrong pixels first
+  double seconds = 0;
+  int threads = 1;
+};
+
+MeasureResult measure(const MeasureConfig& config, const Log& log);
+
+}  // namespace viewcells::pipeline

@@ -1,0 +1,55 @@
+#pragma once
+/// Where players stand and look on a Quake 3 map: cameras that represent play, for measuring
+/// shipped PVSs (ours and the map's own) frame by frame. A camera stands at a player's eye
+/// height above a floor a player can walk on, in non-solid space reachable from the map's
+/// spawn points, looking as a player does (any yaw, pitch within a bound, no roll).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "viewcells/eval/frames.h"
+#include "viewcells/io/q3bsp.h"
+#include "viewcells/raycast/ray_caster.h"
+#include "viewcells/scene/scene.h"
+
+namespace viewcells {
+
+/// Quake 3's player: a box 56 units tall whose origin is 24 units above its feet, the eye 26
+/// above the origin (DEFAULT_VIEWHEIGHT); floors up to 45.6 degrees steep are walkable
+/// (MIN_WALK_NORMAL 0.7).
+struct PlayCameraConfig {
+  uint32_t count = 5000;
+  uint64_t seed = 1;
+  double eye_height = 50;      ///< above the floor
+  double player_height = 56;   ///< free space needed above the floor
+  double walk_normal = 0.7;    ///< least z of a walkable floor's unit normal
+  /// A point is dropped onto the floor below it when that floor is at most this far down, so
+  /// that floors are about evenly likely per area (rather than per height of the room above).
+  double max_drop = 128;
+  double max_pitch_degrees = 30;  ///< pitch uniform in [-max, max], yaw uniform
+};
+
+struct PlayCameras {
+  std::vector<Camera> cameras;
+  std::vector<int32_t> leaves;  ///< the map leaf of each camera's eye
+  uint64_t points_drawn = 0;    ///< random points tried for the cameras
+  size_t spawn_points = 0;
+  size_t open_leaves = 0, reachable_leaves = 0;  ///< non-solid leaves; those reachable from a spawn
+  std::string rule;  ///< how the cameras were placed, in words
+};
+
+/// The leaves with a cluster reachable from the map's spawn points through non-solid leaves
+/// that share a face of positive area (every non-solid leaf when the map has no spawn point):
+/// per map leaf, whether reachable.
+std::vector<bool> q3_reachable_leaves(const Q3Map& map, size_t* spawn_points = nullptr);
+
+/// `config.count` play cameras, drawn serially from `config.seed` (reproducible): a uniform
+/// point of the non-solid space in a reachable leaf, dropped onto the first surface below it
+/// (a front face, walkable, at most max_drop down, with player_height free above it), the eye
+/// eye_height above that floor (again in a reachable non-solid leaf). `caster` casts against
+/// the scene made from the map (brush hulls included). Error when the map has too few such
+/// floors.
+PlayCameras q3_play_cameras(const Q3Map& map, const Scene& scene, const RayCaster& caster,
+                            const PlayCameraConfig& config);
+
+}  // namespace viewcells

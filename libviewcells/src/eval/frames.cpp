@@ -1,0 +1,125 @@
+// Frames rendered at cameras: the measured pixel error of a PVS (AGVS paper 4.5) and what a
+// viewer's frames show, for any PVS of a scene.
+#include "viewcells/eval/frames.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <numeric>
+
+#include "agvs/halton.h"
+#include "viewcells/core/error.h"
+
+namespace viewcells {
+
+using agvs_detail::sphere_direction;
+
+Camera camera_looking_anywhere(const Vec3& eye, Rng& rng) {
+  Camera cam;
+  cam.eye = eye;
+  cam.forward = sphere_direction(rng.uniform(), rng.uniform());
+  Vec3 right, up;
+  orthonormal_basis(cam.forward, right, up);
+  const double roll = 2 * std::numbers::pi * rng.uniform();  // random orientation about the view axis
+  cam.right = right * std::cos(roll) + up * std::sin(roll);
+  cam.up = cross(cam.right, cam.forward) * -1.0;
+  return cam;
+}
+
+Camera camera_looking(const Vec3& eye, double yaw, double pitch) {
+  Camera cam;
+  cam.eye = eye;
+  cam.forward = {std::cos(pitch) * std::cos(yaw), std::cos(pitch) * std::sin(yaw), std::sin(pitch)};
+  cam.right = {std::sin(yaw), -std::cos(yaw), 0};
+  cam.up = cross(cam.right, cam.forward);
+  return cam;
+}
+
+std::vector<Camera> view_box_cameras(const RayCaster& caster, const CellLocator& locator, uint32_t count,
+                                     uint64_t seed, bool skip_inside_solids, std::vector<int32_t>& cells) {
+  Rng rng(seed, 77);
+  const Box3& box = locator.view_box();
+  std::vector<Camera> cams;
+  cams.reserve(count);
+  cells.assign(count, -1);
+  for (uint32_t k = 0; k < count; ++k) {
+    Vec3 eye;
+    for (int tries = 0;; ++tries) {
+      if (tries > 100000) throw Error("no camera position found outside the solids");
+      eye = {rng.uniform(box.lo.x, box.hi.x), rng.uniform(box.lo.y, box.hi.y), rng.uniform(box.lo.z, box.hi.z)};
+      cells[k] = locator.cell_at(eye);
+      if (cells[k] < 0) continue;
+      if (!skip_inside_solids) break;
+      const Hit probe = caster.intersect(Ray{eye, sphere_direction(rng.uniform(), rng.uniform())});
+      if (!probe.hit() || probe.front) break;  // a back face first: the eye is inside a solid
+    }
+    cams.push_back(camera_looking_anywhere(eye, rng));
+  }
+  return cams;
+}
+
+PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, std::span<const Camera> cameras,
+                                 std::span<const int32_t> cells, const GlobalPvs& pvs, const FrameConfig& config) {
+  const uint32_t width = config.width, height = config.height;
+  if (cameras.empty() || width == 0 || height == 0) throw Error("the pixel error needs cameras and pixels");
+  if (!(config.fov_degrees > 0 && config.fov_degrees < 180))
+    throw Error("the field of view must be between 0 and 180 degrees");
+  if (cells.size() != cameras.size()) throw Error("measure_frames: one cell per camera");
+  for (int32_t c : cells)
+    if (c < 0 || static_cast<uint32_t>(c) >= pvs.cell_count()) throw Error("measure_frames: a camera outside the cells");
+  const double f = std::tan(0.5 * config.fov_degrees * std::numbers::pi / 180.0);
+  const double aspect = static_cast<double>(height) / width;
+  const uint32_t n = static_cast<uint32_t>(cameras.size());
+  std::vector<std::vector<WrongView>> wrong_of(n);
+  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, n, 1), [&](const tbb::blocked_range<uint32_t>& range) {
+    std::vector<Ray> rays(size_t(width) * height);
+    std::vector<Hit> hits(rays.size());
+    std::vector<uint32_t> objects;
+    for (uint32_t k = range.begin(); k < range.end(); ++k) {
+      const Camera& cam = cameras[k];
+      for (uint32_t y = 0; y < height; ++y)
+        for (uint32_t x = 0; x < width; ++x) {
+          const double sx = (2 * (x + 0.5) / width - 1) * f, sy = (2 * (y + 0.5) / height - 1) * f * aspect;
+          rays[size_t(y) * width + x] = Ray{cam.eye, normalize(cam.forward + cam.right * sx + cam.up * sy)};
+        }
+      // Large images: in slices, so that one camera also uses every core.
+      tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+        caster.intersect(std::span<const Ray>(rays.data() + r.begin(), r.size()),
+                         std::span<Hit>(hits.data() + r.begin(), r.size()));
+      });
+      objects.clear();
+      for (const Hit& h : hits)
+        if (h.hit() && scene.objects[h.object].rendered && !pvs.contains(static_cast<uint32_t>(cells[k]), h.object))
+          objects.push_back(h.object);
+      std::sort(objects.begin(), objects.end());
+      for (size_t i = 0; i < objects.size();) {
+        size_t j = i;
+        while (j < objects.size() && objects[j] == objects[i]) ++j;
+        wrong_of[k].push_back({k, objects[i], static_cast<uint32_t>(j - i)});
+        i = j;
+      }
+    }
+  });
+  PixelErrorMeasure out;
+  out.cameras = n;
+  std::vector<uint64_t> per_camera(n, 0);
+  for (uint32_t k = 0; k < n; ++k) {
+    for (const WrongView& w : wrong_of[k]) per_camera[k] += w.pixels;
+    out.cameras_wrong += per_camera[k] > 0;
+    out.wrong.insert(out.wrong.end(), wrong_of[k].begin(), wrong_of[k].end());
+  }
+  const uint64_t wrong = std::accumulate(per_camera.begin(), per_camera.end(), uint64_t{0});
+  const double frame = static_cast<double>(width) * height;
+  out.share = static_cast<double>(wrong) / (frame * n);
+  out.pixels = out.share * config.resolution;
+  std::nth_element(per_camera.begin(), per_camera.begin() + n / 2, per_camera.end());
+  double median = static_cast<double>(per_camera[n / 2]);
+  if (n % 2 == 0) median = 0.5 * (median + static_cast<double>(*std::max_element(per_camera.begin(), per_camera.begin() + n / 2)));
+  out.median_pixels = median / frame * config.resolution;
+  return out;
+}
+
+}  // namespace viewcells

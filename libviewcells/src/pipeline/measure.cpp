@@ -1,0 +1,206 @@
+#include "viewcells/pipeline/measure.h"
+
+#include <algorithm>
+#include <filesystem>
+
+#include "viewcells/cells/view_cells.h"
+#include "viewcells/core/error.h"
+#include "viewcells/core/format.h"
+#include "viewcells/core/parallel.h"
+#include "viewcells/core/progress.h"
+#include "viewcells/pvs/pvs.h"
+#include "viewcells/q3/view_space.h"
+
+namespace viewcells::pipeline {
+
+CameraPlacement parse_camera_placement(const std::string& name) {
+  if (name == "auto") return CameraPlacement::kAuto;
+  if (name == "play") return CameraPlacement::kPlay;
+  if (name == "view-box") return CameraPlacement::kViewBox;
+  throw Error("unknown camera placement '" + name + "' (auto, play, view-box)");
+}
+
+namespace {
+
+/// The PVS measured: its rows, and the view cell of a point (-1: none).
+struct Measured {
+  GlobalPvs pvs;
+  std::function<int32_t(const Vec3&)> cell_at;
+  std::unique_ptr<CellLocator> locator;  ///< for view-box cameras
+};
+
+/// What the engine would draw at each camera, and the wrong pixels' causes.
+void frame_costs(const Scene& scene, const GlobalPvs& pvs, const std::vector<int32_t>& cam_cells,
+                 const CostModel& model, MeasureResult& out) {
+  CostModel m = model;
+  m.c = 0;
+  const std::vector<double> cost = per_object_costs(scene, m);
+  std::vector<double> cell_cost(pvs.cell_count(), 0.0), cell_tris(pvs.cell_count(), 0.0);
+  for (uint32_t c = 0; c < pvs.cell_count(); ++c)
+    for (uint32_t o : pvs.list(c)) {
+      cell_cost[c] += cost[o];
+      cell_tris[c] += scene.objects[o].rendered ? scene.objects[o].triangle_count : 0;
+    }
+  std::vector<double> per_camera;
+  for (int32_t c : cam_cells) {
+    out.frame_cost += cell_cost[c];
+    out.frame_triangles += cell_tris[c];
+    out.frame_objects += pvs.size(c);
+    per_camera.push_back(cell_cost[c]);
+  }
+  const double n = static_cast<double>(cam_cells.size());
+  out.frame_cost /= n;
+  out.frame_triangles /= n;
+  out.frame_objects /= n;
+  std::sort(per_camera.begin(), per_camera.end());
+  const size_t k = per_camera.size();
+  out.median_frame_cost = k % 2 ? per_camera[k / 2] : 0.5 * (per_camera[k / 2 - 1] + per_camera[k / 2]);
+}
+
+}  // namespace
+
+MeasureResult measure(const MeasureConfig& c, const Log& log) {
+  Stopwatch total;
+  MeasureResult out;
+  out.config = c;
+  out.threads = worker_threads();
+  if (c.cameras == 0) throw Error("measure: --cameras must be positive");
+  const bool map_scene = is_q3_map(c.scene.path);
+  if (c.pvs_path.empty() && !map_scene)
+    throw Error("measure needs a .pvs file to measure (only a Quake 3 map brings its own PVS)");
+  const CameraPlacement placement =
+      c.placement == CameraPlacement::kAuto ? (map_scene ? CameraPlacement::kPlay : CameraPlacement::kViewBox)
+                                            : c.placement;
+  if (placement == CameraPlacement::kPlay && !map_scene)
+    throw Error("play cameras need a Quake 3 map (.bsp): players' floors and spawn points come from it");
+
+  LoadedScene loaded = load_scene_for_rays(c.scene, log);
+  const Scene& scene = *loaded.scene;
+  Measured m;
+  if (!c.pvs_path.empty()) {
+    PvsFile f = read_pvs(c.pvs_path);
+    if (f.object_count != scene.object_count() || (f.scene_fingerprint && f.scene_fingerprint != scene.fingerprint()))
+      throw Error(c.pvs_path, 0, "was not made for the scene " + c.scene.path + " (objects or geometry differ)");
+    std::vector<std::vector<uint32_t>> lists(f.pvs.cell_count);
+    for (uint32_t i = 0; i < f.pvs.cell_count; ++i) lists[i] = f.pvs.cell_pvs(i);
+    m.pvs = GlobalPvs::from_lists(f.object_count, lists);
+    out.storage_bytes = std::filesystem::file_size(c.pvs_path);
+    out.measured = c.pvs_path + " (" + std::to_string(f.pvs.cell_count) + " view cells: " + f.rule + ")";
+    m.locator = std::make_unique<CellLocator>(f.bsp, f.leaf_cell, f.pvs.cell_count);
+    const CellLocator* loc = m.locator.get();
+    m.cell_at = [loc](const Vec3& p) { return loc->cell_at(p); };
+  } else {
+    const Q3Map& map = *loaded.map;
+    if (!map.has_visibility())
+      throw Error(c.scene.path, 0, "the map has no visibility data: give a .pvs file to measure");
+    m.pvs = GlobalPvs::from_lists(static_cast<uint32_t>(scene.object_count()), q3_admitted_objects(scene, map));
+    out.storage_bytes = uint64_t(map.cluster_count) * uint64_t(map.cluster_bytes);
+    out.leaf_surface_bytes = map.leaf_surfaces.size() * sizeof(int32_t);
+    out.measured = "the map's own PVS (q3map2's vis rows: " + std::to_string(map.cluster_count) +
+                   " clusters -> their leaves -> their surfaces)";
+    const Q3Map* mp = &map;
+    m.cell_at = [mp](const Vec3& p) { return mp->leaves[mp->leaf_at(p)].cluster; };
+  }
+  out.cells = m.pvs.cell_count();
+  out.objects = m.pvs.object_count();
+  out.pvs_entries = m.pvs.entries();
+
+  // The cameras.
+  Stopwatch sw;
+  std::vector<Camera> cameras;
+  std::vector<int32_t> cells;
+  if (placement == CameraPlacement::kPlay) {
+    PlayCameraConfig pc = c.play;
+    pc.count = c.cameras;
+    pc.seed = c.seed;
+    PlayCameras play = q3_play_cameras(*loaded.map, scene, *loaded.caster, pc);
+    cameras = std::move(play.cameras);
+    out.camera_rule = play.rule;
+    out.camera_points_drawn = play.points_drawn;
+    for (const Camera& cam : cameras) {
+      const int32_t cell = m.cell_at(cam.eye);
+      if (cell < 0)
+        throw Error(c.pvs_path.empty() ? c.scene.path : c.pvs_path, 0,
+                    "a player's eye at (" + fmt(cam.eye.x, 1) + ", " + fmt(cam.eye.y, 1) + ", " + fmt(cam.eye.z, 1) +
+                        ") lies in no view cell");
+      cells.push_back(cell);
+    }
+  } else if (map_scene) {
+    // Uniform random points of the map's non-solid space (solid space sees nothing a player could).
+    const Q3Map& map = *loaded.map;
+    Rng rng(c.seed, 93);
+    const Box3 box = q3_view_box(map);
+    const uint64_t max_draws = 100000 + uint64_t{1000} * c.cameras;
+    while (cameras.size() < c.cameras) {
+      if (++out.camera_points_drawn > max_draws)
+        throw Error(c.scene.path, 0, "measure: too few camera positions in the map's non-solid space");
+      const Vec3 eye{rng.uniform(box.lo.x, box.hi.x), rng.uniform(box.lo.y, box.hi.y), rng.uniform(box.lo.z, box.hi.z)};
+      const Camera cam = camera_looking_anywhere(eye, rng);
+      if (!q3_in_view_space(map, eye)) continue;
+      const int32_t cell = m.cell_at(eye);
+      if (cell < 0) continue;
+      cameras.push_back(cam);
+      cells.push_back(cell);
+    }
+    out.camera_rule = "uniform random points of the map's non-solid space, looking anywhere";
+  } else {
+    const bool closed = decide_empty_space(scene, EmptySpaceMode::kAuto).enabled;
+    cameras = view_box_cameras(*loaded.caster, *m.locator, c.cameras, c.seed, closed, cells);
+    out.camera_rule = std::string("uniform random points of the view box") +
+                      (closed ? " outside the solids" : "") + ", looking anywhere";
+  }
+  log("viewcells: " + std::to_string(cameras.size()) + " cameras (" + out.camera_rule + ") in " + fmt(sw.seconds(), 2) +
+      " s");
+
+  // The frames.
+  sw.restart();
+  GlobalPvs pvs = std::move(m.pvs);
+  out.error = measure_frames(scene, *loaded.caster, cameras, cells, pvs, c.frame);
+  frame_costs(scene, pvs, cells, c.model, out);
+
+  // Causes and the worst objects.
+  std::vector<uint64_t> pixels(scene.object_count(), 0);
+  std::vector<uint32_t> seen_by(scene.object_count(), 0);
+  std::vector<std::string> cause(scene.object_count(), "missed");
+  for (const WrongView& w : out.error.wrong) {
+    pixels[w.object] += w.pixels;
+    ++seen_by[w.object];
+  }
+  if (c.pvs_path.empty()) {
+    const Q3Map& map = *loaded.map;
+    const std::vector<int32_t> surface = q3_object_surfaces(scene, map);
+    std::vector<bool> listed(map.surfaces.size(), false);
+    for (const Q3Leaf& l : map.leaves)
+      if (l.cluster >= 0)
+        for (int32_t k = 0; k < l.surface_count; ++k) listed[map.leaf_surfaces[l.first_surface + k]] = true;
+    const double far = q3_far_plane(map);
+    for (const WrongView& w : out.error.wrong) {
+      const Box3& b = scene.objects[w.object].bounds;
+      const Vec3& e = cameras[w.camera].eye;
+      const Vec3 nearest{std::clamp(e.x, b.lo.x, b.hi.x), std::clamp(e.y, b.lo.y, b.hi.y), std::clamp(e.z, b.lo.z, b.hi.z)};
+      const std::string why = !listed[surface[w.object]]              ? "unlisted"
+                              : far > 0 && length(nearest - e) > far ? "far"
+                                                                      : "rejected";
+      out.wrong_by_cause[why] += w.pixels;
+      cause[w.object] = why;
+    }
+  } else {
+    for (const WrongView& w : out.error.wrong) out.wrong_by_cause["missed"] += w.pixels;
+  }
+  std::vector<uint32_t> order;
+  for (uint32_t o = 0; o < scene.object_count(); ++o)
+    if (pixels[o]) order.push_back(o);
+  std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return pixels[a] != pixels[b] ? pixels[a] > pixels[b] : a < b; });
+  if (order.size() > 10) order.resize(10);
+  for (uint32_t o : order) out.worst.push_back({o, scene.objects[o].name, pixels[o], seen_by[o], cause[o]});
+
+  out.seconds = total.seconds();
+  log("viewcells: " + out.measured + ": per frame " + fmt(out.frame_triangles, 4) + " triangles in " +
+      fmt(out.frame_objects, 4) + " objects drawn (cost " + fmt(out.frame_cost, 4) + "), wrong pixels " +
+      fmt(out.error.pixels, 3) + " per " + std::to_string(c.frame.resolution) + " (median " +
+      fmt(out.error.median_pixels, 3) + "; " + std::to_string(out.error.cameras_wrong) + " of " +
+      std::to_string(out.error.cameras) + " cameras wrong), " + fmt(sw.seconds(), 2) + " s");
+  return out;
+}
+
+}  // namespace viewcells::pipeline

@@ -1,0 +1,130 @@
+// Frames rendered at cameras (eval/frames.h): the measured pixel error against a count made
+// by hand, and cameras placed where players stand on OpenArena's oa_dm2 (q3/play.h) with the
+// map's own PVS measured by them.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+
+#include "support/test_scenes.h"
+#include "viewcells/core/parallel.h"
+#include "viewcells/eval/frames.h"
+#include "viewcells/io/scene_io.h"
+#include "viewcells/q3/play.h"
+#include "viewcells/q3/view_space.h"
+
+namespace viewcells {
+namespace {
+
+TEST(Frames, WrongPixelsAreThoseOfObjectsMissingFromThePvs) {
+  const Scene scene = test::cube_grid(4);
+  const auto caster = make_embree_caster(scene);
+  const CellLocator cells = test::kd_cells(scene, 8);
+  std::vector<int32_t> cam_cells;
+  const std::vector<Camera> cams = view_box_cameras(*caster, cells, 60, 5, true, cam_cells);
+  ASSERT_EQ(cams.size(), 60u);
+  const FrameConfig frame{24, 16, 90.0, 1024 * 1024};
+  // Every object in every PVS: nothing is wrong.
+  std::vector<std::vector<uint32_t>> all(cells.cell_count());
+  for (auto& l : all)
+    for (uint32_t o = 0; o < scene.object_count(); ++o) l.push_back(o);
+  const PixelErrorMeasure full = measure_frames(scene, *caster, cams, cam_cells, GlobalPvs::from_lists(scene.object_count(), all), frame);
+  EXPECT_EQ(full.share, 0.0);
+  EXPECT_TRUE(full.wrong.empty());
+  // Object 0 left out everywhere: the wrong pixels are exactly the pixels showing object 0,
+  // counted here by casting every camera's rays one by one.
+  for (auto& l : all) l.erase(l.begin());
+  const PixelErrorMeasure m = measure_frames(scene, *caster, cams, cam_cells, GlobalPvs::from_lists(scene.object_count(), all), frame);
+  const double f = std::tan(0.25 * std::numbers::pi);
+  uint64_t expected = 0;
+  std::vector<uint64_t> per_camera(cams.size(), 0);
+  for (size_t k = 0; k < cams.size(); ++k)
+    for (uint32_t y = 0; y < frame.height; ++y)
+      for (uint32_t x = 0; x < frame.width; ++x) {
+        const double sx = (2 * (x + 0.5) / frame.width - 1) * f, sy = (2 * (y + 0.5) / frame.height - 1) * f * 16 / 24;
+        const Hit h = caster->intersect(Ray{cams[k].eye, normalize(cams[k].forward + cams[k].right * sx + cams[k].up * sy)});
+        if (h.hit() && h.object == 0) ++per_camera[k];
+      }
+  for (uint64_t w : per_camera) expected += w;
+  ASSERT_GT(expected, 0u) << "no camera sees object 0: choose another seed";
+  uint64_t listed = 0;
+  for (const WrongView& w : m.wrong) {
+    EXPECT_EQ(w.object, 0u);
+    EXPECT_EQ(w.pixels, per_camera[w.camera]);
+    listed += w.pixels;
+  }
+  EXPECT_EQ(listed, expected);
+  EXPECT_DOUBLE_EQ(m.share, static_cast<double>(expected) / (60.0 * 24 * 16));
+  EXPECT_DOUBLE_EQ(m.pixels, m.share * 1024 * 1024);
+  EXPECT_EQ(m.cameras_wrong, m.wrong.size());
+  // The same with one thread.
+  ThreadLimit one(1);
+  const PixelErrorMeasure serial = measure_frames(scene, *caster, cams, cam_cells, GlobalPvs::from_lists(scene.object_count(), all), frame);
+  EXPECT_EQ(serial.share, m.share);
+  EXPECT_EQ(serial.median_pixels, m.median_pixels);
+}
+
+TEST(Frames, PlayerCameraIsLevel) {
+  const Camera c = camera_looking({1, 2, 3}, 0.7, 0.2);
+  EXPECT_NEAR(length(c.forward), 1, 1e-12);
+  EXPECT_NEAR(length(c.right), 1, 1e-12);
+  EXPECT_NEAR(length(c.up), 1, 1e-12);
+  EXPECT_NEAR(c.right.z, 0, 1e-12);  // no roll
+  EXPECT_GT(c.up.z, 0);
+  EXPECT_NEAR(dot(c.forward, c.right), 0, 1e-12);
+  EXPECT_NEAR(dot(c.forward, c.up), 0, 1e-12);
+  EXPECT_NEAR(std::asin(c.forward.z), 0.2, 1e-12);
+}
+
+std::string oa_dm2() {
+  const std::string path = std::string(VIEWCELLS_DATA_DIR) + "/maps/bsp/oa_dm2.bsp";
+  if (std::filesystem::exists(path)) return path;
+  if (std::getenv("VIEWCELLS_REQUIRE_MAPS")) ADD_FAILURE() << path << " is missing: run scripts/fetch-maps.sh";
+  return "";
+}
+
+TEST(Q3PlayCameras, PlayersStandOnReachableFloorsAndQ3map2sPvsShowsWhatTheySee) {
+  const std::string path = oa_dm2();
+  if (path.empty()) GTEST_SKIP() << "oa_dm2.bsp not fetched (scripts/fetch-maps.sh)";
+  const Q3Map map = read_q3bsp(path);
+  const Scene scene = load_scene(path);
+  const auto caster = make_embree_caster(scene);
+  PlayCameraConfig config;
+  config.count = 400;
+  const PlayCameras play = q3_play_cameras(map, scene, *caster, config);
+  ASSERT_EQ(play.cameras.size(), 400u);
+  EXPECT_GT(play.spawn_points, 0u);
+  EXPECT_GT(play.reachable_leaves, play.open_leaves / 2);
+  EXPECT_LE(play.reachable_leaves, play.open_leaves);
+  const std::vector<bool> reachable = q3_reachable_leaves(map);
+  for (size_t k = 0; k < play.cameras.size(); ++k) {
+    const Camera& c = play.cameras[k];
+    ASSERT_TRUE(q3_in_view_space(map, c.eye));
+    ASSERT_TRUE(reachable[map.leaf_at(c.eye)]);
+    ASSERT_EQ(play.leaves[k], map.leaf_at(c.eye));
+    EXPECT_LE(std::abs(c.forward.z), std::sin(30 * std::numbers::pi / 180) + 1e-12);
+    // A walkable floor eye_height below the eye, nothing between.
+    const Hit down = caster->intersect(Ray{c.eye, {0, 0, -1}});
+    ASSERT_TRUE(down.hit());
+    EXPECT_NEAR(down.t, config.eye_height, 1e-3);
+    EXPECT_TRUE(down.front);
+    EXPECT_GE(normalize(scene.triangle_normal(down.triangle)).z, config.walk_normal);
+  }
+  // Drawn serially: the same cameras again.
+  const PlayCameras again = q3_play_cameras(map, scene, *caster, config);
+  ASSERT_EQ(again.points_drawn, play.points_drawn);
+  EXPECT_EQ(again.cameras.back().eye, play.cameras.back().eye);
+  // q3map2's PVS is conservative: players see nothing it rejects (the map's scene model is the
+  // game's), except surfaces in no leaf, which the game never draws.
+  const std::vector<std::vector<uint32_t>> admitted = q3_admitted_objects(scene, map);
+  std::vector<int32_t> clusters;
+  for (const Camera& c : play.cameras) clusters.push_back(map.leaves[map.leaf_at(c.eye)].cluster);
+  const PixelErrorMeasure m = measure_frames(scene, *caster, play.cameras, clusters,
+                                             GlobalPvs::from_lists(scene.object_count(), admitted), FrameConfig{64, 48});
+  EXPECT_LE(m.share, 1e-5) << m.wrong.size() << " (camera, object) pairs wrong";
+}
+
+}  // namespace
+}  // namespace viewcells
