@@ -62,6 +62,7 @@ struct PvsArgs {
   bool fast = false;
   uint32_t measure_cameras = 0;
   uint32_t measure_size = 1024;
+  std::vector<uint64_t> measure_at;
   std::string save, resume, edited_from;
   double save_every = 0;
   std::vector<std::string> references;
@@ -93,6 +94,7 @@ int run_pvs(const PvsArgs& a, const Common& c) {
   config.filter_object_space = a.filter;
   config.measure_cameras = a.measure_cameras;
   config.measure_size = a.measure_size;
+  config.measure_at = a.measure_at;
   config.save = a.save;
   config.save_every = a.save_every;
   config.resume = a.resume;
@@ -118,8 +120,9 @@ void add_pvs_command(CLI::App& app, const Common& common, Commands& commands) {
   pv->add_option("--seed", a->agvs.seed, "Random seed")->capture_default_str();
   pv->add_flag("--fast", a->fast, "Embree without robust mode");
   pv->add_option("--measure-cameras", a->measure_cameras,
-                 "Also measure the pixel error: render this many random cameras by ray casting and count the "
-                 "pixels whose object is missing from the PVS")
+                 "Also measure the pixel error: render this many cameras by ray casting and count the pixels whose "
+                 "object is missing from the PVS (cameras at random points of the view box looking anywhere; on a "
+                 "Quake 3 map, player eyes above floors reachable from the spawn points, as `measure` places them)")
       ->check(whole(1, 1'000'000));
   auto* save = pv->add_option("--save", a->save,
                                "Write the solver's state here at the end, to continue later with --resume");
@@ -148,6 +151,11 @@ void add_pvs_command(CLI::App& app, const Common& common, Commands& commands) {
                  "entries found so far that it has too")
       ->expected(1, AgvsPoint::kReferences)
       ->check(CLI::ExistingFile);
+  pv->add_option("--measure-at", a->measure_at,
+                 "With --measure-cameras: also measure the PVSs after these sample counts (increasing), with the same "
+                 "cameras, for a convergence curve by measured error (the report's measured_curve; the solver's "
+                 "clock stops while measuring)")
+      ->check(whole(1, kMaxSamples));
   pv->add_option("--measure-size", a->measure_size, "Width and height of the measuring cameras, in pixels")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
@@ -246,13 +254,13 @@ int run_measure(const MeasureArgs& a, const Common& c) {
   config.scene.grouping = parse_grouping(a.objects);
   config.scene.robust = !a.fast;
   config.pvs_path = a.pvs;
-  config.placement = pipeline::parse_camera_placement(a.cameras);
-  config.cameras = a.count;
-  config.seed = a.seed;
+  config.cameras.placement = pipeline::parse_camera_placement(a.cameras);
+  config.cameras.count = a.count;
+  config.cameras.seed = a.seed;
   config.frame.width = a.width;
   config.frame.height = a.height;
   config.frame.fov_degrees = a.fov;
-  config.play.max_pitch_degrees = a.max_pitch;
+  config.cameras.play.max_pitch_degrees = a.max_pitch;
   config.model.a = a.cost_a;
   config.model.b = a.cost_b;
   config.model.validate();

@@ -796,6 +796,89 @@ def maps(*args):
     open("docs/results/q3-maps.md", "w").write("\n".join(lines))
 
 
+@command("OUT_DIR PIXEL_ERROR SECONDS")
+def shipped(out, err, secs):
+    """docs/results/q3-shipped.md and .csv: q3map2's PVS as shipped against ours, by the same play cameras."""
+    rows, skipped, failed = [], [], []
+    for d in sorted(glob.glob(f"{out}/*/")):
+        name = os.path.basename(d.rstrip("/"))
+        if os.path.exists(f"{out}/{name}.skipped"):
+            skipped.append(name); continue
+        if os.path.exists(f"{out}/{name}.failed"):
+            failed.append((name, open(f"{out}/{name}.failed").read().strip().splitlines()[-1])); continue
+        if not os.path.exists(f"{d}/ours.json"):
+            continue
+        q, o, b = (json.load(open(f"{d}/{f}.json")) for f in ("q3map2", "ours", "bake"))
+        rows.append(dict(
+            map=name, clusters=q["cells"], cells=o["cells"], cameras=o["cameras"]["count"],
+            q3_cost=q["frame"]["cost"], ours_cost=o["frame"]["cost"], ratio=o["frame"]["cost"] / q["frame"]["cost"],
+            q3_tris=q["frame"]["triangles"], ours_tris=o["frame"]["triangles"],
+            q3_err=q["pixel_error"]["pixels"], q3_err_median=q["pixel_error"]["median_pixels"],
+            q3_causes=q["pixel_error"]["by_cause"],
+            ours_err=o["pixel_error"]["pixels"], ours_err_median=o["pixel_error"]["median_pixels"],
+            ours_cams_wrong=o["pixel_error"]["cameras_with_wrong_pixels"],
+            estimated=b["estimated_pixel_error"], bound=b["pixel_error_bound"],
+            q3_bytes=q["storage_bytes"], q3_leaf_bytes=q.get("leaf_surface_bytes", 0), ours_bytes=o["storage_bytes"],
+            agvs_samples=b["agvs"]["samples"], bake_s=float(open(f"{d}/bake_wall_seconds").read())))
+        r = rows[-1]
+        r["goal"] = r["ratio"] <= 0.5 and r["ours_err_median"] <= 1 and r["ours_bytes"] <= r["q3_bytes"]
+    if not rows:
+        raise SystemExit("vctables: no measured maps in " + out)
+    with open("docs/results/q3-shipped.csv", "w", newline="") as f:
+        w = csv.writer(f)
+        keys = [k for k in rows[0] if k != "q3_causes"]
+        w.writerow(keys + ["q3_wrong_far", "q3_wrong_unlisted", "q3_wrong_rejected"])
+        for r in rows:
+            w.writerow([r[k] for k in keys] + [r["q3_causes"].get(c, 0) for c in ("far", "unlisted", "rejected")])
+
+    def est(r):
+        return f"{r['estimated']:.2f}" if r["estimated"] is not None else (
+            f"< {r['bound']:.2f}" if r["bound"] is not None else "n/a")
+
+    lines = [f"{len(rows)} maps ({len(skipped)} without vis data skipped" + (f", {len(failed)} failed" if failed else "")
+             + f"). Both sides are measured by the same {rows[0]['cameras']:,} play cameras per map (`viewcells "
+             "measure`: player eyes 50 units above walkable floors reachable from the spawn points, yaw uniform, pitch "
+             "within +-30 degrees, 64x48 pixels, 90 degrees wide). Per frame, the render cost is r(PVS) of the camera's "
+             "cell, r(o) = max(100, triangles) (what the engine draws); a pixel is wrong when the surface it shows is "
+             "not in that PVS; errors are per 1024x1024 frame. q3map2: the map's own vis rows (visible clusters -> "
+             "their leaves -> their surfaces), its storage the uncompressed rows. Ours: `viewcells bake MAP --cells "
+             f"CLUSTERS --pixel-error {err} --time {secs}` (1M construction samples, AV-M cells at q3map2's cluster "
+             "count, PVSs by AGVS until the estimated error is below the target or the time is up), its storage the "
+             ".pvs file (point location and names included).\n",
+             "| map | clusters | q3map2 cost / frame | ours | ours / q3map2 | q3map2 wrong px (mean) | ours wrong px "
+             "(mean / median) | cameras wrong (ours) | AGVS estimate | q3map2 rows (B) | ours .pvs (B) | bake (s) | goal |",
+             "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |"]
+    for r in rows:
+        lines.append(f"| {r['map']} | {r['clusters']:,} | {r['q3_cost']:,.0f} | {r['ours_cost']:,.0f} | {r['ratio']:.3f} | "
+                     f"{r['q3_err']:.2f} | {r['ours_err']:.2f} / {r['ours_err_median']:.0f} | {r['ours_cams_wrong']:,} | "
+                     f"{est(r)} | {r['q3_bytes']:,} | {r['ours_bytes']:,} | {r['bake_s']:.0f} | "
+                     f"{'yes' if r['goal'] else 'no'} |")
+    lines.append("")
+    ratios = [r["ratio"] for r in rows]
+    met = sum(r["goal"] for r in rows)
+    lines.append(f"**Ours draws {statistics.median(ratios):.3f} of q3map2's render cost per frame (median over maps; "
+                 f"range {min(ratios):.3f} to {max(ratios):.3f}).** Ours / q3map2 at most 0.5 on "
+                 f"{sum(x <= 0.5 for x in ratios)} of {len(rows)} maps. Our measured error: mean over maps "
+                 f"{statistics.mean(r['ours_err'] for r in rows):.2f} wrong pixels per 1024x1024 frame (median "
+                 f"{statistics.median(r['ours_err'] for r in rows):.2f}); the median camera has at most 1 wrong pixel on "
+                 f"{sum(r['ours_err_median'] <= 1 for r in rows)} maps, the mean is at most 1 on "
+                 f"{sum(r['ours_err'] <= 1 for r in rows)}. Our .pvs fits q3map2's rows on "
+                 f"{sum(r['ours_bytes'] <= r['q3_bytes'] for r in rows)} maps. All three (cost at most half, median "
+                 f"camera at most 1 wrong pixel, within the rows' storage): {met} of {len(rows)} maps.\n")
+    causes = {c: sum(r["q3_causes"].get(c, 0) for r in rows) for c in ("far", "unlisted", "rejected")}
+    lines.append(f"q3map2's own error: mean {statistics.mean(r['q3_err'] for r in rows):.2f} wrong pixels per frame over "
+                 f"maps; wrong pixels by cause over all maps: {causes['far']:,} far (beyond the map's _farplanedist: "
+                 f"culled on purpose), {causes['unlisted']:,} unlisted (a surface in no leaf: the game never draws it), "
+                 f"{causes['rejected']:,} rejected (a line of sight its PVS rejects, or where our scene model differs "
+                 f"from the game's).\n")
+    lines.append(f"Bake time: median {statistics.median(r['bake_s'] for r in rows):.0f} s per map, "
+                 f"{sum(r['bake_s'] for r in rows):.0f} s in all (2 cores).\n")
+    if failed:
+        lines.append("Failed: " + "; ".join(f"{n} ({e})" for n, e in failed) + "\n")
+    lines.append("Per map in docs/results/q3-shipped.csv.\n")
+    open("docs/results/q3-shipped.md", "w").write("\n".join(lines))
+
+
 @command("PK3 OUT_DIR")
 def unpack_maps(*args):
     """Extracts maps/*.bsp from a .pk3 (zip) into a directory, each file atomically."""

@@ -38,7 +38,7 @@ json_get() {
 
 # --help explains every subcommand.
 expect_ok "$VC" --help
-for sub in generate info sample build export extract compress pvs query view compare bake; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
+for sub in generate info sample build export extract compress pvs query view compare bake measure; do grep -q "$sub" out.txt && ok || bad "--help lacks $sub"; done
 expect_ok "$VC" sample --help
 grep -q -- "--measure-raw" out.txt && ok || bad "sample --help lacks --measure-raw"
 
@@ -357,6 +357,28 @@ assert 'non-solid' in s['view_space'], s['view_space']
   expect_error "not one surface" "$VC" compare "$MAPS/oa_dm2.bsp" --samples 1000 --objects components -o q3bad
   expect_ok "$VC" build "$MAPS/oa_dm2.bsp" --samples 50000 --max-cells 100 -o dm2.vcells --report dm2.json -q
   [ "$(json_get dm2.json "['settings']['view_box_source']")" = "the map's non-solid leaves" ] && ok || bad "build on a map: view box"
+  # measure: the map's own PVS (q3map2's vis rows) and a baked one, by the same play cameras.
+  expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" --count 300 --report q3m.json -q
+  [ "$(json_get q3m.json "['cells']")" = "1041" ] && ok || bad "measure on oa_dm2: $(json_get q3m.json "['cells']") clusters"
+  expect_ok "$VC" bake "$MAPS/oa_dm2.bsp" --cells 40 --samples 50000 --max-cells 100 --merge-pvs samples \
+    --agvs-samples 100000 -o dm2.pvs --report dm2bake.json -q
+  [ "$(json_get dm2bake.json "['effects']['restricted_view_space']['enabled']")" = "True" ] && ok || bad "bake on a map: AGVS not in the view space"
+  expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" dm2.pvs --count 300 --report ourm.json -q
+  [ "$(json_get ourm.json "['cells']")" = "40" ] && ok || bad "measure of a baked map: cells"
+  [ "$(json_get ourm.json "['cameras']['placement']")" = "$(json_get q3m.json "['cameras']['placement']")" ] &&
+    [ "$(json_get ourm.json "['cameras']['points_drawn']")" = "$(json_get q3m.json "['cameras']['points_drawn']")" ] &&
+    ok || bad "measure: the two sides met different cameras"
+  python3 -c "
+import json, sys
+for f in ('q3m.json', 'ourm.json'):
+    r = json.load(open(f))
+    assert r['frame']['cost'] > 0 and r['frame']['triangles'] > 0, f
+    assert 0 <= r['pixel_error']['share'] <= 1, f
+    assert sum(r['pixel_error']['by_cause'].values()) == round(r['pixel_error']['share'] * 300 * 64 * 48), f
+    assert 'spawn points' in r['cameras']['placement'], f
+" && ok || bad "measure on oa_dm2: report"
+  expect_error "play cameras need a Quake 3 map" "$VC" measure office.obj dm2.pvs --cameras play
+  expect_error "was not made for the scene" "$VC" measure office.obj dm2.pvs
 elif [ -n "${VIEWCELLS_REQUIRE_MAPS:-}" ]; then
   bad "oa_dm2.bsp is missing (scripts/fetch-maps.sh)"
 fi
@@ -451,6 +473,15 @@ expect_error "too small" "$VC" bake office.obj --memory 50 --samples 20000 --max
 cmp -s bake1.pvs keep.pvs && ok || bad "a failing bake replaced its output"
 expect_error "needs a budget" "$VC" bake office.obj -o x.pvs
 expect_error "excludes" "$VC" bake office.obj --cells 4 --memory 1M -o x.pvs
+
+# measure: frames at cameras for a .pvs of any scene; a map is needed for its own PVS.
+expect_ok "$VC" measure office.obj bake1.pvs --count 200 --width 16 --height 16 --report om.json -q
+[ "$(json_get om.json "['cells']")" = "12" ] && ok || bad "measure: cells"
+grep -q "view box" <<<"$(json_get om.json "['cameras']['placement']")" && ok || bad "measure: cameras not in the view box"
+expect_ok "$VC" measure office.obj bake1.pvs --count 200 --width 16 --height 16 --report om2.json -q --threads 1
+[ "$(json_get om.json "['pixel_error']['share']")" = "$(json_get om2.json "['pixel_error']['share']")" ] && ok || bad "measure differs between thread counts"
+expect_error "needs a .pvs file" "$VC" measure office.obj
+expect_error "unknown camera placement" "$VC" measure office.obj bake1.pvs --cameras everywhere
 
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

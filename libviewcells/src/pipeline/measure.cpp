@@ -59,19 +59,66 @@ void frame_costs(const Scene& scene, const GlobalPvs& pvs, const std::vector<int
 
 }  // namespace
 
+CameraSet draw_cameras(const Scene& scene, const RayCaster& caster, const Q3Map* map, const CameraConfig& c,
+                       const std::function<int32_t(const Vec3&)>& cell_at, const CellLocator* locator,
+                       const std::string& what) {
+  if (c.count == 0) throw Error("measure: the number of cameras must be positive");
+  const CameraPlacement placement =
+      c.placement == CameraPlacement::kAuto ? (map ? CameraPlacement::kPlay : CameraPlacement::kViewBox) : c.placement;
+  if (placement == CameraPlacement::kPlay && !map)
+    throw Error("play cameras need a Quake 3 map (.bsp): players' floors and spawn points come from it");
+  CameraSet out;
+  if (placement == CameraPlacement::kPlay) {
+    PlayCameraConfig pc = c.play;
+    pc.count = c.count;
+    pc.seed = c.seed;
+    PlayCameras play = q3_play_cameras(*map, scene, caster, pc);
+    out.cameras = std::move(play.cameras);
+    out.rule = play.rule;
+    out.points_drawn = play.points_drawn;
+    for (const Camera& cam : out.cameras) {
+      const int32_t cell = cell_at(cam.eye);
+      if (cell < 0)
+        throw Error(what, 0, "a player's eye at (" + fmt(cam.eye.x, 1) + ", " + fmt(cam.eye.y, 1) + ", " +
+                                 fmt(cam.eye.z, 1) + ") lies in no view cell");
+      out.cells.push_back(cell);
+    }
+  } else if (map) {
+    // Uniform random points of the map's non-solid space (solid space sees nothing a player could).
+    Rng rng(c.seed, 93);
+    const Box3 box = q3_view_box(*map);
+    const uint64_t max_draws = 100000 + uint64_t{1000} * c.count;
+    while (out.cameras.size() < c.count) {
+      if (++out.points_drawn > max_draws)
+        throw Error(map->path, 0, "measure: too few camera positions in the map's non-solid space");
+      const Vec3 eye{rng.uniform(box.lo.x, box.hi.x), rng.uniform(box.lo.y, box.hi.y), rng.uniform(box.lo.z, box.hi.z)};
+      const Camera cam = camera_looking_anywhere(eye, rng);
+      if (!q3_in_view_space(*map, eye)) continue;
+      const int32_t cell = cell_at(eye);
+      if (cell < 0) continue;
+      out.cameras.push_back(cam);
+      out.cells.push_back(cell);
+    }
+    out.rule = "uniform random points of the map's non-solid space, looking anywhere";
+  } else {
+    if (!locator) throw Error("view-box cameras need the view cells");
+    const bool closed = decide_empty_space(scene, EmptySpaceMode::kAuto).enabled;
+    out.cameras = view_box_cameras(caster, *locator, c.count, c.seed, closed, out.cells);
+    out.rule = std::string("uniform random points of the view box") + (closed ? " outside the solids" : "") +
+               ", looking anywhere";
+  }
+  return out;
+}
+
 MeasureResult measure(const MeasureConfig& c, const Log& log) {
   Stopwatch total;
   MeasureResult out;
   out.config = c;
   out.threads = worker_threads();
-  if (c.cameras == 0) throw Error("measure: --cameras must be positive");
   const bool map_scene = is_q3_map(c.scene.path);
   if (c.pvs_path.empty() && !map_scene)
     throw Error("measure needs a .pvs file to measure (only a Quake 3 map brings its own PVS)");
-  const CameraPlacement placement =
-      c.placement == CameraPlacement::kAuto ? (map_scene ? CameraPlacement::kPlay : CameraPlacement::kViewBox)
-                                            : c.placement;
-  if (placement == CameraPlacement::kPlay && !map_scene)
+  if (c.cameras.placement == CameraPlacement::kPlay && !map_scene)
     throw Error("play cameras need a Quake 3 map (.bsp): players' floors and spawn points come from it");
 
   LoadedScene loaded = load_scene_for_rays(c.scene, log);
@@ -105,50 +152,13 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
   out.objects = m.pvs.object_count();
   out.pvs_entries = m.pvs.entries();
 
-  // The cameras.
   Stopwatch sw;
-  std::vector<Camera> cameras;
-  std::vector<int32_t> cells;
-  if (placement == CameraPlacement::kPlay) {
-    PlayCameraConfig pc = c.play;
-    pc.count = c.cameras;
-    pc.seed = c.seed;
-    PlayCameras play = q3_play_cameras(*loaded.map, scene, *loaded.caster, pc);
-    cameras = std::move(play.cameras);
-    out.camera_rule = play.rule;
-    out.camera_points_drawn = play.points_drawn;
-    for (const Camera& cam : cameras) {
-      const int32_t cell = m.cell_at(cam.eye);
-      if (cell < 0)
-        throw Error(c.pvs_path.empty() ? c.scene.path : c.pvs_path, 0,
-                    "a player's eye at (" + fmt(cam.eye.x, 1) + ", " + fmt(cam.eye.y, 1) + ", " + fmt(cam.eye.z, 1) +
-                        ") lies in no view cell");
-      cells.push_back(cell);
-    }
-  } else if (map_scene) {
-    // Uniform random points of the map's non-solid space (solid space sees nothing a player could).
-    const Q3Map& map = *loaded.map;
-    Rng rng(c.seed, 93);
-    const Box3 box = q3_view_box(map);
-    const uint64_t max_draws = 100000 + uint64_t{1000} * c.cameras;
-    while (cameras.size() < c.cameras) {
-      if (++out.camera_points_drawn > max_draws)
-        throw Error(c.scene.path, 0, "measure: too few camera positions in the map's non-solid space");
-      const Vec3 eye{rng.uniform(box.lo.x, box.hi.x), rng.uniform(box.lo.y, box.hi.y), rng.uniform(box.lo.z, box.hi.z)};
-      const Camera cam = camera_looking_anywhere(eye, rng);
-      if (!q3_in_view_space(map, eye)) continue;
-      const int32_t cell = m.cell_at(eye);
-      if (cell < 0) continue;
-      cameras.push_back(cam);
-      cells.push_back(cell);
-    }
-    out.camera_rule = "uniform random points of the map's non-solid space, looking anywhere";
-  } else {
-    const bool closed = decide_empty_space(scene, EmptySpaceMode::kAuto).enabled;
-    cameras = view_box_cameras(*loaded.caster, *m.locator, c.cameras, c.seed, closed, cells);
-    out.camera_rule = std::string("uniform random points of the view box") +
-                      (closed ? " outside the solids" : "") + ", looking anywhere";
-  }
+  const CameraSet cams = draw_cameras(scene, *loaded.caster, loaded.map.get(), c.cameras, m.cell_at, m.locator.get(),
+                                      c.pvs_path.empty() ? c.scene.path : c.pvs_path);
+  const std::vector<Camera>& cameras = cams.cameras;
+  const std::vector<int32_t>& cells = cams.cells;
+  out.camera_rule = cams.rule;
+  out.camera_points_drawn = cams.points_drawn;
   log("viewcells: " + std::to_string(cameras.size()) + " cameras (" + out.camera_rule + ") in " + fmt(sw.seconds(), 2) +
       " s");
 

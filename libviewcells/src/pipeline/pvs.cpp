@@ -10,6 +10,7 @@
 #include "viewcells/core/progress.h"
 #include "viewcells/core/binary_file.h"
 #include "viewcells/io/scene_io.h"
+#include "viewcells/pipeline/measure.h"
 
 namespace viewcells::pipeline {
 
@@ -31,6 +32,10 @@ void check_config(const PvsConfig& c) {
     throw Error("--filter-k sets the object space filter's factor: add --filter");
   if (!c.edited_from.empty() && c.resume.empty())
     throw Error("--edited-from needs --resume: the state computed on that scene, to carry over to --scene");
+  if (!c.measure_at.empty() && !c.measure_cameras)
+    throw Error("--measure-at needs --measure-cameras: the cameras that measure the PVSs");
+  for (size_t i = 1; i < c.measure_at.size(); ++i)
+    if (c.measure_at[i] <= c.measure_at[i - 1]) throw Error("--measure-at: sample counts must increase");
 }
 
 /// The scenes: the one sampled, and before an edit the one the hierarchy was built from.
@@ -96,20 +101,61 @@ void add_references(const PvsConfig& c, const PvsFile& pf, AgvsSolver& solver) {
   }
 }
 
+/// The cameras that measure the pixel error: player eyes on a Quake 3 map, else random points
+/// of the view box (as the estimator's cameras).
+CameraSet measuring_cameras(const PvsConfig& c, const Scenes& s, const Q3Map* map, const CellLocator& cells) {
+  CameraConfig cc;
+  cc.count = c.measure_cameras;
+  cc.seed = c.agvs.seed + 17;
+  return draw_cameras(s.scene, *s.caster, map, cc, [&cells](const Vec3& p) { return cells.cell_at(p); }, &cells,
+                      c.hierarchy_path);
+}
+
+FrameConfig measuring_frame(const PvsConfig& c, const PvsResult& out) {
+  return FrameConfig{c.measure_size, c.measure_size, 90.0, out.agvs.resolution};
+}
+
+/// Runs the solver up to each of c.measure_at and measures its PVSs there.
+void measured_run(const PvsConfig& c, const Scenes& s, const CameraSet& cams, AgvsSolver& solver, PvsResult& out,
+                  const Log& log) {
+  const AgvsConfig& a = c.agvs;
+  for (uint64_t n : c.measure_at) {
+    if (a.max_samples && n > a.max_samples) break;
+    solver.set_limits(n, a.max_seconds, 0);
+    solver.run();
+    const AgvsStats& st = solver.stats();
+    MeasuredPoint p;
+    p.samples = st.samples;
+    p.rays = st.rays;
+    p.seconds = st.seconds;
+    p.mean_pvs = solver.mean_pvs();
+    p.estimated = solver.pixel_error();
+    p.measured = measure_frames(s.scene, *s.caster, cams.cameras, cams.cells, solver.pvs(), measuring_frame(c, out));
+    p.measured.wrong.clear();
+    log("viewcells: after " + std::to_string(p.samples) + " samples (" + fmt(p.seconds, 2) + " s): measured pixel error " +
+        fmt(p.measured.pixels, 3));
+    out.measured_curve.push_back(std::move(p));
+    if (a.max_seconds > 0 && st.seconds >= a.max_seconds) break;
+  }
+  solver.set_limits(a.max_samples, a.max_seconds, a.pixel_error);
+}
+
 /// Measures the pixel error of the PVSs written (and of the unfiltered ones, when filtered).
-void measure(const PvsConfig& c, const Scenes& s, const CellLocator& cells, const AgvsSolver& solver,
+void measure(const PvsConfig& c, const Scenes& s, const CameraSet& cams, const AgvsSolver& solver,
              const GlobalPvs& written, PvsResult& out, const Log& log) {
   Stopwatch ms;
   auto run = [&](const GlobalPvs& pvs) {
-    return measure_pixel_error(s.scene, *s.caster, cells, pvs, c.measure_cameras, c.measure_size, c.measure_size,
-                               90.0, c.agvs.seed + 17, out.stats.empty_space.enabled, out.agvs.resolution);
+    PixelErrorMeasure m = measure_frames(s.scene, *s.caster, cams.cameras, cams.cells, pvs, measuring_frame(c, out));
+    m.wrong.clear();
+    return m;
   };
   out.measured = run(written);
   if (out.filtering) out.measured_unfiltered = run(solver.pvs());
   log("viewcells: measured pixel error " + fmt(out.measured->pixels, 2) +
       (out.filtering ? " (unfiltered " + fmt(out.measured_unfiltered->pixels, 2) + ")" : std::string()) + " of " +
       std::to_string(out.agvs.resolution) + " pixels (" + std::to_string(out.measured->cameras) + " cameras of " +
-      std::to_string(c.measure_size) + "x" + std::to_string(c.measure_size) + ", " + fmt(ms.seconds(), 1) + " s)");
+      std::to_string(c.measure_size) + "x" + std::to_string(c.measure_size) + ": " + cams.rule + "; " +
+      fmt(ms.seconds(), 1) + " s)");
 }
 
 std::string describe_stop(const PvsConfig& c) {
@@ -150,8 +196,15 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   out.cells = cells.cell_count();
   log("viewcells: " + std::to_string(cells.cell_count()) + " view cells (" + set.rule + "), PVS by " +
       to_string(c.agvs.method) + " until " + describe_stop(c));
-  // On a Quake 3 map, AGVS's points are drawn in its non-solid space.
-  if (is_q3_map(c.scene_path)) use_map_view_space(std::make_shared<const Q3Map>(read_q3bsp(c.scene_path)), out.agvs);
+  // On a Quake 3 map, AGVS's points are drawn in its non-solid space, and cameras stand where players do.
+  std::shared_ptr<const Q3Map> map;
+  if (is_q3_map(c.scene_path)) map = std::make_shared<const Q3Map>(read_q3bsp(c.scene_path));
+  use_map_view_space(map, out.agvs);
+  std::optional<CameraSet> cams;
+  if (c.measure_cameras) {
+    cams = measuring_cameras(c, scenes, map.get(), cells);
+    out.camera_rule = cams->rule;
+  }
   std::optional<AgvsSolver> solver;
   make_solver(c, scenes, cells, pf, out.agvs, solver, out.edit, log);
   add_references(c, pf, *solver);
@@ -165,6 +218,7 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
       solver->save(c.save, identity);
     });
   }
+  if (cams && !c.measure_at.empty()) measured_run(c, scenes, *cams, *solver, out, log);
   solver->run();
   if (!c.save.empty()) {
     solver->save(c.save, pvs_state_identity(scenes.scene.fingerprint(), pf));
@@ -195,7 +249,7 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   write_pvs_checked(c.output, pf, lists);
   out.pixel_error = solver->pixel_error();
   out.pixel_error_bound = solver->pixel_error_bound();
-  if (c.measure_cameras) measure(c, scenes, cells, *solver, written, out, log);
+  if (cams) measure(c, scenes, *cams, *solver, written, out, log);
   const double err = out.pixel_error, bound = out.pixel_error_bound;
   log("viewcells: " + std::to_string(out.stats.samples) + " samples (" + std::to_string(out.stats.rays) + " rays) in " +
       fmt(out.stats.seconds, 2) + " s; mean PVS " + fmt(out.mean_pvs, 1) + " objects; estimated pixel error " +

@@ -331,6 +331,16 @@ json measure_json(const std::optional<PixelErrorMeasure>& m, uint32_t size) {
            : json(nullptr);
 }
 
+json measured_curve(const std::vector<MeasuredPoint>& curve) {
+  json out = json::array();
+  for (const MeasuredPoint& p : curve)
+    out.push_back({{"samples", p.samples}, {"rays", p.rays}, {"seconds", p.seconds}, {"mean_pvs", p.mean_pvs},
+                   {"estimated_pixel_error", number_or_null(p.estimated)}, {"measured_pixels", p.measured.pixels},
+                   {"measured_median_pixels", p.measured.median_pixels},
+                   {"cameras_with_wrong_pixels", p.measured.cameras_wrong}});
+  return out;
+}
+
 json agvs_distributions(const AgvsStats& st) {
   json dists = json::array();
   for (int d = 0; d < AgvsStats::kDistributions; ++d)
@@ -416,6 +426,8 @@ std::string report_json(const PvsResult& r) {
                {"pixel_error_bound", number_or_null(r.pixel_error_bound)},
                {"estimator_window_rays", st.window_rays},
                {"measured_pixel_error", measure_json(r.measured, c.measure_size)},
+               {"measuring_cameras", r.camera_rule.empty() ? json(nullptr) : json(r.camera_rule)},
+               {"measured_curve", measured_curve(r.measured_curve)},
                {"stop_reason", st.stop_reason},
                // Where this run's time went (resumed: this run's part only).
                {"phases",
@@ -606,7 +618,7 @@ std::string report_json(const MeasureResult& r) {
       {"cameras", {{"count", r.error.cameras},
                    {"placement", r.camera_rule},
                    {"points_drawn", r.camera_points_drawn},
-                   {"seed", c.seed},
+                   {"seed", c.cameras.seed},
                    {"width", c.frame.width},
                    {"height", c.frame.height},
                    {"fov_degrees", c.frame.fov_degrees}}},

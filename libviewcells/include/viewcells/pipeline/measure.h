@@ -7,11 +7,13 @@
 /// so both sides of a comparison are measured alike. On a map the cameras stand where players
 /// do (q3/play.h); elsewhere at random points of the view box, looking anywhere.
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
 
 #include "viewcells/bsp/cost_model.h"
+#include "viewcells/cells/view_cells.h"
 #include "viewcells/eval/frames.h"
 #include "viewcells/pipeline/sampling.h"
 #include "viewcells/q3/play.h"
@@ -22,15 +24,34 @@ enum class CameraPlacement { kAuto, kPlay, kViewBox };
 /// Parses "auto", "play", "view-box" (Error otherwise).
 CameraPlacement parse_camera_placement(const std::string& name);
 
+struct CameraConfig {
+  CameraPlacement placement = CameraPlacement::kAuto;  ///< auto: play on a map, view box otherwise
+  uint32_t count = 5000;
+  uint64_t seed = 1;
+  PlayCameraConfig play;  ///< count and seed come from above
+};
+
+/// Cameras for measuring frames, and the view cell of each.
+struct CameraSet {
+  std::vector<Camera> cameras;
+  std::vector<int32_t> cells;
+  std::string rule;  ///< how they were placed, in words
+  uint64_t points_drawn = 0;
+};
+
+/// Draws the cameras (serially: reproducible). `map`: the scene's Quake 3 map or null;
+/// `cell_at`: the view cell of a point (-1: none; a play camera in none is an Error naming
+/// `what`); `locator`: the view cells, needed for view-box cameras on scenes that are not maps.
+CameraSet draw_cameras(const Scene& scene, const RayCaster& caster, const Q3Map* map, const CameraConfig& config,
+                       const std::function<int32_t(const Vec3&)>& cell_at, const CellLocator* locator,
+                       const std::string& what);
+
 struct MeasureConfig {
   SceneSource scene;
   std::string pvs_path;  ///< the .pvs to measure; empty: the map's own PVS (a Quake 3 map's vis rows)
-  CameraPlacement placement = CameraPlacement::kAuto;  ///< auto: play on a map, view box otherwise
-  uint32_t cameras = 5000;
-  uint64_t seed = 1;
+  CameraConfig cameras;
   FrameConfig frame{64, 48, 90.0, 1024 * 1024};
-  PlayCameraConfig play;  ///< count and seed come from above
-  CostModel model;        ///< r(o) of the frame cost (the pixel term is not used)
+  CostModel model;  ///< r(o) of the frame cost (the pixel term is not used)
 };
 
 /// The objects with the most wrong pixels.

@@ -23,6 +23,10 @@ struct PvsConfig {
   bool filter_object_space = false;
   uint32_t measure_cameras = 0;
   uint32_t measure_size = 1024;
+  /// With measure_cameras: also measure the PVSs (unfiltered) after these many samples
+  /// (ascending; those beyond the stopping rule are not reached), with the same cameras. The
+  /// solver's clock does not run while measuring.
+  std::vector<uint64_t> measure_at;
   std::string save, resume, edited_from;
   double save_every = 0;  ///< with `save`: also write the state every this many seconds (a checkpoint)
   std::vector<std::string> references;
@@ -31,6 +35,15 @@ struct PvsConfig {
 
 /// The identity a saved AGVS state carries: the scene's fingerprint and the view cells.
 uint64_t pvs_state_identity(uint64_t scene_fingerprint, const PvsFile& cells);
+
+/// The PVSs measured by cameras part-way through the run.
+struct MeasuredPoint {
+  uint64_t samples = 0, rays = 0;
+  double seconds = 0;          ///< the solver's own time so far (measuring excluded)
+  double mean_pvs = 0;
+  double estimated = 0;        ///< the estimator's pixel error then (NaN: none)
+  PixelErrorMeasure measured;  ///< `wrong` left empty
+};
 
 struct PvsResult {
   PvsConfig config;
@@ -45,6 +58,8 @@ struct PvsResult {
   double setup_seconds = 0;
   int threads = 1;
   std::optional<PixelErrorMeasure> measured, measured_unfiltered;
+  std::string camera_rule;               ///< how the measuring cameras were placed
+  std::vector<MeasuredPoint> measured_curve;
   std::optional<AgvsEditStats> edit;
 };
 

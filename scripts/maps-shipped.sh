@@ -1,0 +1,57 @@
+#!/usr/bin/env bash
+# As shipped, on OpenArena maps: what a player's frames draw and get wrong with q3map2's PVS
+# (the map's own vis rows) and with ours (`viewcells bake`: AV-M view cells at q3map2's
+# cluster count, PVSs by AGVS until its estimated pixel error is below PIXEL_ERROR per
+# 1024x1024 frame or SECONDS have passed), both measured by `viewcells measure` with the same
+# play cameras (5,000 player eyes above walkable floors reachable from the spawn points,
+# 64x48 pixels, 90 degrees). Writes docs/results/q3-shipped.md and .csv and the section
+# "q3shipped" of docs/results.md.
+# Usage: scripts/maps-shipped.sh [PIXEL_ERROR] [SECONDS] [MAP_NAME...]   (defaults 1, 300, every map)
+# SHIPPED_REUSE=1 keeps maps already measured in out/shipped (to redo only the tables).
+set -euo pipefail
+err="${1:-1}"
+secs="${2:-300}"
+shift $(($# < 2 ? $# : 2))
+source "$(dirname "$0")/bench-setup.sh"
+bash scripts/fetch-maps.sh >/dev/null
+out=out/shipped
+mkdir -p "$out" docs/results
+if [ $# -gt 0 ]; then
+  maps=()
+  for n in "$@"; do maps+=("data/maps/bsp/$n.bsp"); done
+else
+  maps=(data/maps/bsp/*.bsp)
+fi
+i=0
+for map in "${maps[@]}"; do
+  i=$((i + 1))
+  name=$(basename "$map" .bsp)
+  d="$out/$name"
+  if [ "${SHIPPED_REUSE:-0}" = 1 ] && { [ -f "$d/ours.json" ] || [ -f "$d.skipped" ]; }; then continue; fi
+  rm -rf "$d" "$d.skipped" "$d.failed"
+  mkdir -p "$d"
+  "$vc" info "$map" --json "$d/info.json" >/dev/null
+  clusters=$(python3 scripts/vctables.py get "$d/info.json" quake3 clusters)
+  if [ "$clusters" = 0 ]; then
+    echo "no visibility data" > "$d.skipped"
+    echo "shipped: [$i/${#maps[@]}] $name: no visibility data, skipped"
+    continue
+  fi
+  if "$vc" measure "$map" --report "$d/q3map2.json" -q 2> "$d/err" &&
+     start=$(date +%s.%N) &&
+     "$vc" bake "$map" --cells "$clusters" --pixel-error "$err" --time "$secs" --seed 1 -o "$d/ours.pvs" \
+       --report "$d/bake.json" -q 2>> "$d/err" &&
+     python3 scripts/vctables.py elapsed "$start" > "$d/bake_wall_seconds" &&
+     "$vc" measure "$map" "$d/ours.pvs" --report "$d/ours.json" -q 2>> "$d/err"; then
+    echo "shipped: [$i/${#maps[@]}] $name: $clusters clusters, bake $(cat "$d/bake_wall_seconds") s"
+  else
+    cp "$d/err" "$d.failed"
+    echo "shipped: [$i/${#maps[@]}] $name: FAILED ($(tail -1 "$d/err"))"
+  fi
+done
+
+python3 scripts/vctables.py shipped "$out" "$err" "$secs"
+echo "scripts/maps-shipped.sh $err $secs $*" | sed 's/ *$//' > docs/results/q3-shipped.command
+python3 scripts/vctables.py replace-section docs/results.md q3shipped "$(cat docs/results/q3-shipped.command)" \
+  docs/results/q3-shipped.md
+echo "shipped: docs/results.md (section q3shipped), docs/results/q3-shipped.csv"
