@@ -167,6 +167,24 @@ TEST(Agvs, GlobalSamplingSeesMoreThanPerCellSampling) {
   EXPECT_GT(mean[0], mean[1]) << "AGVS over SGVS";
 }
 
+TEST(Agvs, RefCastsOneRayPerSample) {
+  // The paper's REF: a random cell, a random point in it, one ray; the object it hits first
+  // joins that cell's PVS, so a sample adds at most one entry.
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 4});
+  const CellLocator cells = office_cells(scene, 12);
+  const auto caster = make_embree_caster(scene);
+  AgvsSolver ref(scene, *caster, cells, quiet(AgvsMethod::kRef, 40000));
+  ref.run();
+  EXPECT_EQ(ref.stats().rays, ref.stats().samples);
+  EXPECT_GT(ref.pvs().entries(), 0u);
+  EXPECT_LE(ref.pvs().entries(), ref.stats().samples);
+  // Global sampling with fewer rays (two per sample, and re-casts) finds more.
+  AgvsSolver sgvs(scene, *caster, cells, quiet(AgvsMethod::kSgvs, 15000));
+  sgvs.run();
+  EXPECT_LE(sgvs.stats().rays, ref.stats().rays);  // re-casts from inside solids included
+  EXPECT_GT(sgvs.pvs().entries(), ref.pvs().entries());
+}
+
 TEST(Agvs, MeasuredPixelError) {
   const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
   const CellLocator cells = office_cells(scene, 16);

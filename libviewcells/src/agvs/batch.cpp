@@ -113,6 +113,30 @@ void AgvsSolver::Impl::draw_samples(uint64_t index, uint32_t n, const double sha
   }
 }
 
+void AgvsSolver::Impl::cast_ref_chunk(const BatchSamples& s, BatchChunk& c) const {
+  // The paper's REF: one ray per sample, forward from the point; what it hits first goes into
+  // the point's cell. Where closed solids make inside and outside (empty space detection), a
+  // back face first means the point is inside a solid: no camera stands there, nothing is seen.
+  // See-through surfaces the ray crosses are not followed.
+  std::vector<Ray> rays(c.size);
+  std::vector<Hit> hits(c.size);
+  for (uint32_t k = 0; k < c.size; ++k) rays[k] = Ray{s.points[c.first + k], s.dirs[c.first + k]};
+  caster_ref().intersect(rays, hits);
+  c.rays = c.size;
+  c.segs = SegmentSet{};
+  c.segs.reserve(c.size);
+  c.sample_of.clear();
+  const double far = 2 * cells.view_box().diagonal();
+  for (uint32_t k = 0; k < c.size; ++k) {
+    const Hit& h = hits[k];
+    const bool seen = h.hit() && (h.front || !stats.empty_space.enabled);
+    const Vec3 end = rays[k].origin + rays[k].dir * (h.hit() ? h.t : far);
+    c.segs.push_back(rays[k].origin, end, kNoObject, seen ? h.object : kNoObject);
+    c.sample_of.push_back(k);
+  }
+  c.pierced.assign(c.segs.size(), {});
+}
+
 std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const BatchSamples& s) {
   // Cast in fixed chunks within each distribution, in parallel; outputs in sample order.
   constexpr uint32_t kChunk = 1024;
@@ -127,10 +151,13 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
     }
   // A chunk: its samples cast, and the cells of each segment.
   auto cast_chunk = [&](BatchChunk& c) {
+    if (config.method == AgvsMethod::kRef) {
+      cast_ref_chunk(s, c);
+      return;
+    }
     c.rays = caster().cast(std::span<const Vec3>(s.points.data() + c.first, c.size),
                            std::span<const Vec3>(s.dirs.data() + c.first, c.size), c.segs, c.sample_of);
     c.pierced.assign(c.segs.size(), {});
-    if (config.method == AgvsMethod::kRef) return;
     std::vector<std::tuple<int32_t, double, double>> stack;
     std::vector<int32_t> leaves;
     for (size_t i = 0; i < c.segs.size(); ++i)

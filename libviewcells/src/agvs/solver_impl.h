@@ -156,6 +156,8 @@ struct AgvsSolver::Impl {
   struct BatchChunk;
   struct BatchCounts;
   void draw_samples(uint64_t index, uint32_t n, const double share[kDists], BatchSamples& s);
+  /// REF's casting as the paper describes it: one forward ray per sample, into chunk `c`.
+  void cast_ref_chunk(const BatchSamples& s, BatchChunk& c) const;
   std::vector<BatchChunk> cast_samples(const BatchSamples& s);
   /// Applies a batch's segments in sample order: the table (on several ranks, each rank's own
   /// cells, then the gains and flags reduced over the ranks), then the counts and mutation

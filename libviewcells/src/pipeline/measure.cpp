@@ -132,6 +132,7 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
     for (uint32_t i = 0; i < f.pvs.cell_count; ++i) lists[i] = f.pvs.cell_pvs(i);
     m.pvs = GlobalPvs::from_lists(f.object_count, lists);
     out.storage_bytes = std::filesystem::file_size(c.pvs_path);
+    out.pvs_bytes = varint_bytes(f.pvs.stored);
     out.measured = c.pvs_path + " (" + std::to_string(f.pvs.cell_count) + " view cells: " + f.rule + ")";
     m.locator = std::make_unique<CellLocator>(f.bsp, f.leaf_cell, f.pvs.cell_count);
     const CellLocator* loc = m.locator.get();
@@ -141,7 +142,7 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
     if (!map.has_visibility())
       throw Error(c.scene.path, 0, "the map has no visibility data: give a .pvs file to measure");
     m.pvs = GlobalPvs::from_lists(static_cast<uint32_t>(scene.object_count()), q3_admitted_objects(scene, map));
-    out.storage_bytes = uint64_t(map.cluster_count) * uint64_t(map.cluster_bytes);
+    out.storage_bytes = out.pvs_bytes = uint64_t(map.cluster_count) * uint64_t(map.cluster_bytes);
     out.leaf_surface_bytes = map.leaf_surfaces.size() * sizeof(int32_t);
     out.measured = "the map's own PVS (q3map2's vis rows: " + std::to_string(map.cluster_count) +
                    " clusters -> their leaves -> their surfaces)";

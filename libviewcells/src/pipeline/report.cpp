@@ -615,6 +615,7 @@ std::string report_json(const MeasureResult& r) {
       {"objects", r.objects},
       {"pvs_entries", r.pvs_entries},
       {"storage_bytes", r.storage_bytes},
+      {"pvs_bytes", r.pvs_bytes},
       {"cameras", {{"count", r.error.cameras},
                    {"placement", r.camera_rule},
                    {"points_drawn", r.camera_points_drawn},
