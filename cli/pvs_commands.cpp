@@ -168,7 +168,7 @@ struct BakeArgs {
   SamplingOptions sampling;
   CellOptions cells;
   uint32_t view_cells = 0;
-  std::string memory;
+  std::string memory, memory_of = "file";
   AgvsOptions agvs;
   MergeOptions merge;
   uint64_t agvs_seed = 1;
@@ -187,6 +187,8 @@ int run_bake(BakeArgs a, const Common& c) {
   config.merge_agvs = a.merge.agvs(c, a.sampling.seed, config.sampling.samples);
   config.cells = a.view_cells;
   config.memory = a.memory.empty() ? 0 : parse_bytes(a.memory);
+  if (a.memory_of != "file" && a.memory_of != "lists") throw Error("--memory-of is file or lists, not '" + a.memory_of + "'");
+  config.memory_of_lists = a.memory_of == "lists";
   if (!a.agvs.samples && !(a.agvs.seconds > 0) && !(a.agvs.pixel_error > 0)) a.agvs.pixel_error = 10;
   config.agvs = a.agvs.config(c);
   config.agvs.seed = a.sampling.seed;
@@ -212,6 +214,10 @@ void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
                  "Budget: a .pvs file of at most this many bytes (K, M, G allowed); the file written is measured, "
                  "and the cells are merged further until it fits")
       ->excludes(cells);
+  bk->add_option("--memory-of", a->memory_of,
+                 "What --memory counts: file (the whole .pvs) or lists (the compressed PVS lists alone, without point "
+                 "location and object names: what stands against a map compiler's vis rows)")
+      ->capture_default_str();
   bk->add_option("--max-cells", a->cells.max_cells,
                  "Elementary cells to build before merging (default: 4 x --cells, or 4096 with --memory)")
       ->check(whole(1, kMaxCells));

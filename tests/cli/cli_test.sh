@@ -467,6 +467,19 @@ for budget in 3000 6K 20000; do
   limit=$(python3 -c "print(int(float('$budget'.rstrip('K')) * (1024 if '$budget'.endswith('K') else 1)))")
   [ "$bytes" -le "$limit" ] && ok || bad "bake --memory $budget wrote $bytes bytes"
 done
+# --memory-of lists: the budget holds for the compressed lists alone, and buys more cells than
+# the same budget for the whole file; measure reports the same list bytes.
+expect_ok "$VC" bake office.obj --memory 3000 --memory-of lists --samples 20000 --max-cells 300 --agvs-samples 50000 \
+  -o meml.pvs -q --report meml.json
+[ "$(json_get meml.json "['budget']['counts']")" = lists ] && [ "$(json_get meml.json "['list_bytes']")" -le 3000 ] && ok ||
+  bad "bake --memory-of lists: $(json_get meml.json "['list_bytes']") list bytes"
+expect_ok "$VC" bake office.obj --memory 3000 --samples 20000 --max-cells 300 --agvs-samples 50000 -o memf.pvs -q \
+  --report memf.json
+[ "$(json_get meml.json "['cells']")" -ge "$(json_get memf.json "['cells']")" ] && ok ||
+  bad "3000 bytes of lists hold fewer cells than a 3000-byte file"
+expect_ok "$VC" measure office.obj meml.pvs --count 20 --width 8 --height 8 --report memlm.json -q
+[ "$(json_get memlm.json "['pvs_bytes']")" = "$(json_get meml.json "['list_bytes']")" ] && ok || bad "measure's pvs_bytes differ from bake's list_bytes"
+expect_error "file or lists" "$VC" bake office.obj --memory 3000 --memory-of everything -o x.pvs
 cp bake1.pvs keep.pvs
 expect_error "too small" "$VC" bake office.obj --memory 50 --samples 20000 --max-cells 300 --agvs-samples 50000 \
   -o keep.pvs -q

@@ -157,12 +157,13 @@ namespace {
 
 /// The .pvs of the view cells `set` with the PVSs `lists`: written, read back and compared
 /// (`check`), or only measured (the sizes a search tries). Returns its bytes.
+/// With `lists_only` (and not `check`), the bytes of the compressed PVS lists alone.
 uint64_t write_cut(const std::string& path, const SubdivisionFile& file, const ViewCellSet& set,
-                   const std::vector<std::vector<uint32_t>>* lists, bool check) {
+                   const std::vector<std::vector<uint32_t>>* lists, bool check, bool lists_only = false) {
   PvsFile pf = pvs_file_for(file, set);
   pf.rule += "; PVS by agvs";
   if (lists) pf.pvs = compress_pvs(*file.history, set.cells, *lists);
-  if (!check) return pvs_file_bytes(pf);
+  if (!check) return lists_only ? varint_bytes(pf.pvs.stored) : pvs_file_bytes(pf);
   write_pvs_checked(path, pf, *lists);
   return std::filesystem::file_size(staged_path(path));
 }
@@ -175,13 +176,13 @@ ViewCellSet first_cut(const BakeConfig& c, const SubdivisionFile& file, const Lo
   if (c.cells) return extract_by_count(h, std::min<size_t>(c.cells, h.leaf_count));
   ViewCellSet set;
   try {
-    set = extract_by_file_size(file, c.memory);
+    set = extract_by_file_size(file, c.memory, c.memory_of_lists);
   } catch (const Error& e) {
     throw Error(c.output, 0, e.what());
   }
   const size_t n = set.cells.size();
   log("viewcells: bake: " + std::to_string(n) + " view cells fit in " + std::to_string(c.memory) +
-      " bytes with the hierarchy's PVSs");
+      " bytes with the hierarchy's PVSs" + (c.memory_of_lists ? " (the compressed lists alone)" : ""));
   return set;
 }
 
@@ -209,15 +210,17 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   ViewCellSet written = set;
   std::vector<std::vector<uint32_t>> written_lists = lists;
   out.file_bytes = write_cut(c.output, file, set, &lists, true);
-  if (c.memory && out.file_bytes > c.memory) {
+  out.list_bytes = write_cut(c.output, file, set, &lists, false, true);
+  const uint64_t used = c.memory_of_lists ? out.list_bytes : out.file_bytes;
+  if (c.memory && used > c.memory) {
     // AGVS found more than the construction samples: the largest coarser cut that fits, with
     // the unions of the sampled PVSs.
-    log("viewcells: bake: " + std::to_string(out.file_bytes) + " bytes for " + std::to_string(set.cells.size()) +
+    log("viewcells: bake: " + std::to_string(used) + " bytes for " + std::to_string(set.cells.size()) +
         " cells exceed the budget of " + std::to_string(c.memory) + ": coarsening");
     const size_t n = largest_fitting(h.min_cells(), set.cells.size() - 1, c.memory, [&](size_t count) {
       const ViewCellSet cut = extract_by_count(h, count);
       const auto coarse = coarsen(h, set.cells, lists, cut.cells);
-      return write_cut(c.output, file, cut, &coarse, false);
+      return write_cut(c.output, file, cut, &coarse, false, c.memory_of_lists);
     });
     if (n == 0)
       throw Error(c.output, 0, "not even " + std::to_string(h.min_cells()) + " view cell(s) fit in " +
@@ -225,6 +228,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     written = extract_by_count(h, n);
     written_lists = coarsen(h, set.cells, lists, written.cells);
     out.file_bytes = write_cut(c.output, file, written, &written_lists, true);
+    out.list_bytes = write_cut(c.output, file, written, &written_lists, false, true);
   }
   out.cells = static_cast<uint32_t>(written.cells.size());
   out.rule = written.rule + "; PVS by agvs";

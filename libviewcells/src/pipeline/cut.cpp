@@ -37,18 +37,24 @@ size_t largest_fitting(size_t lo, size_t hi, uint64_t memory, const std::functio
   return best;
 }
 
-ViewCellSet extract_by_file_size(const SubdivisionFile& file, uint64_t bytes) {
+ViewCellSet extract_by_file_size(const SubdivisionFile& file, uint64_t bytes, bool lists_only) {
   const MergeHistory& h = *file.history;
-  const std::string rule = "most cells whose .pvs file fits in " + std::to_string(bytes) + " bytes";
+  const std::string rule = std::string(lists_only ? "most cells whose compressed PVS lists fit in "
+                                                  : "most cells whose .pvs file fits in ") +
+                           std::to_string(bytes) + " bytes";
   auto cut = [&](size_t count) {
     ViewCellSet set = extract_by_count(h, count);
     set.rule = rule;  // the rule is in the file: measure it as written
     return set;
   };
-  auto bytes_of = [&](size_t count) { return pvs_file_bytes(pvs_file_for(file, cut(count))); };
+  auto bytes_of = [&](size_t count) {
+    const PvsFile pf = pvs_file_for(file, cut(count));
+    return lists_only ? varint_bytes(pf.pvs.stored) : pvs_file_bytes(pf);
+  };
   const size_t n = largest_fitting(h.min_cells(), h.leaf_count, bytes, bytes_of);
   if (n == 0)
-    throw Error("a budget of " + std::to_string(bytes) + " bytes is too small: the .pvs file of the coarsest " +
+    throw Error("a budget of " + std::to_string(bytes) + " bytes is too small: the " +
+                (lists_only ? "PVS lists" : ".pvs file") + " of the coarsest " +
                 std::to_string(h.min_cells()) + " view cell(s) takes " + std::to_string(bytes_of(h.min_cells())) +
                 " bytes");
   return cut(n);

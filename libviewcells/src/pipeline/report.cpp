@@ -535,7 +535,8 @@ std::string report_json(const CompareRunResult& r) {
 std::string report_json(const BakeResult& r) {
   const BakeConfig& c = r.config;
   const AgvsStats& st = r.agvs;
-  json budget = c.memory ? json{{"memory_bytes", c.memory}} : json{{"cells", c.cells}};
+  json budget = c.memory ? json{{"memory_bytes", c.memory}, {"counts", c.memory_of_lists ? "lists" : "file"}}
+                         : json{{"cells", c.cells}};
   return text({{"command", "bake"},
                {"scene", c.scene.path},
                {"output", c.output},
@@ -571,6 +572,7 @@ std::string report_json(const BakeResult& r) {
                {"cells", r.cells},
                {"rule", r.rule},
                {"file_bytes", r.file_bytes},
+               {"list_bytes", r.list_bytes},
                {"pvs_entries", r.pvs_entries},
                {"mean_pvs_size", r.mean_pvs},
                {"estimated_pixel_error", number_or_null(r.pixel_error)},

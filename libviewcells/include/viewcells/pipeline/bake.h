@@ -24,6 +24,9 @@ struct BakeConfig {
   std::optional<AgvsConfig> merge_agvs;  ///< as BuildConfig::merge_agvs
   uint32_t cells = 0;              ///< budget: this many view cells ...
   uint64_t memory = 0;             ///< ... or a .pvs file of at most this many bytes
+  /// The memory budget counts the compressed PVS lists alone (what stands against a map
+  /// compiler's vis rows), not the whole file with point location and object names.
+  bool memory_of_lists = false;
   AgvsConfig agvs;                 ///< stopping rule (pixel error, time, samples), seed, batch
   std::string output;              ///< .pvs
   std::string work_dir;            ///< empty: nothing kept between runs
@@ -48,6 +51,7 @@ struct BakeResult {
   bool agvs_resumed = false;
   bool agvs_in_view_space = false;  ///< a Quake 3 map: AGVS drew its points in the non-solid space
   uint64_t pvs_entries = 0, file_bytes = 0;
+  uint64_t list_bytes = 0;  ///< the compressed PVS lists of the file written (varints)
   double mean_pvs = 0;
   double seconds = 0;
   int threads = 1;
