@@ -297,6 +297,66 @@ class Tables(unittest.TestCase):
                       "median 1.036, worst 1.071 (m2)", md)
         self.assertIn("AV-M / AV-S at a quarter of it: at most 1 on 2 of 2 maps", md)
 
+    def test_shipped_table(self):
+        out = f"{self.d}/shipped"
+
+        def measured(cells, cost, err, median, pvs_bytes, causes=None):
+            return {"cells": cells, "cameras": {"count": 100}, "frame": {"cost": cost, "triangles": cost / 2},
+                    "pixel_error": {"pixels": err, "median_pixels": median, "by_cause": causes or {},
+                                    "cameras_with_wrong_pixels": 3},
+                    "storage_bytes": pvs_bytes + 10, "pvs_bytes": pvs_bytes, "leaf_surface_bytes": 100}
+        bake = {"estimated_pixel_error": None, "pixel_error_bound": 1.5, "agvs": {"samples": 1000}}
+        # m1: ours at the clusters fits the rows; m2: it does not, and the bake that fits costs 0.6;
+        # m3: it does not and nothing fits, but rows + leaf lists hold it.
+        for name, ours_cost, ours_bytes, fit in [("m1", 40.0, 900, None), ("m2", 30.0, 2000, (5, 60.0, 950)),
+                                                 ("m3", 45.0, 1050, None)]:
+            dump(f"{out}/{name}/q3map2.json", measured(10, 100.0, 0.0, 0.0, 1000, {"far": 4}))
+            dump(f"{out}/{name}/ours.json", measured(10, ours_cost, 2.0, 0.0, ours_bytes))
+            dump(f"{out}/{name}/bake.json", bake)
+            open(f"{out}/{name}/bake_wall_seconds", "w").write("12.5")
+            if fit:
+                dump(f"{out}/{name}/fit.json", measured(fit[0], fit[1], 3.0, 0.0, fit[2]))
+        os.makedirs(f"{out}/m4")
+        open(f"{out}/m4.skipped", "w").write("no visibility data")
+        cwd = os.getcwd()
+        os.makedirs(f"{self.d}/docs/results")
+        os.chdir(self.d)
+        try:
+            run("shipped", out, 1, 45)
+            md = open("docs/results/q3-shipped.md").read()
+        finally:
+            os.chdir(cwd)
+        self.assertIn("3 maps (1 without vis data skipped)", md)
+        self.assertEqual(row(md, "m1")[4], "0.400")
+        self.assertEqual(row(md, "m2")[12], "5, 0.600, 3.00")
+        self.assertEqual(row(md, "m3")[12], "none")
+        self.assertEqual([row(md, m)[13] for m in ("m1", "m2", "m3")], ["yes / yes", "no / no", "no / yes"])
+        self.assertIn("median over maps; range 0.300 to 0.450", md)
+        self.assertIn("All three (cost at most half, median camera at most 1 wrong pixel, within the rows' bytes): "
+                      "1 of 3 maps", md)
+        self.assertIn("12 far", md)
+
+    def test_agvs_measured_time_to_error(self):
+        out = f"{self.d}/am"
+
+        def pvs(curve, end):
+            return {"cells": 50, "samples": end[2], "seconds": end[0], "measured_pixel_error": {"pixels": end[1]},
+                    "measured_curve": [{"seconds": t, "measured_pixels": e, "samples": n} for t, e, n in curve]}
+        # AGVS: 1000 px at 1 s, 10 px at 10 s; SGVS: 1000 px at 4 s, ends at 100 px after 100 s; REF never below 1000.
+        dump(f"{out}/s/agvs.json", pvs([(1, 1000, 10), (10, 10, 100)], (20, 5, 200)))
+        dump(f"{out}/s/sgvs.json", pvs([(4, 1000, 10), (100, 100, 100)], (100, 100, 100)))
+        dump(f"{out}/s/ref.json", pvs([(1, 5000, 10)], (100, 2000, 100)))
+        t = run("agvs-measured", out, 100, "s")
+        agvs = row(t, "s")
+        self.assertEqual(agvs[2], "AGVS")
+        self.assertEqual(agvs[6:8], ["1.00 s", "3.16 s"])  # 100 px: halfway on the log-log line from 1 s to 10 s
+        sgvs = [r for r in t.splitlines() if "| SGVS |" in r][0]
+        self.assertIn("4.00 s (4.0 x)", sgvs)
+        self.assertIn("100.00 s (31.6 x)", sgvs)
+        ref = [r for r in t.splitlines() if "| REF |" in r][0]
+        self.assertIn("not reached (> 100 x)", ref)  # 1,000 px: AGVS at 1 s, REF not within 100 s
+        self.assertTrue(os.path.exists(f"{out}/s/agvs.dat"))
+
     def test_runtime_table(self):
         bench = {"context": {"num_cpus": 2, "mhz_per_cpu": 2450, "library_version": "v1.7.1"},
                  "benchmarks": [{"name": "BM_Locate", "run_type": "iteration", "cpu_time": 125.0, "time_unit": "ns",
