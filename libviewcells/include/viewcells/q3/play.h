@@ -23,9 +23,6 @@ struct PlayCameraConfig {
   double eye_height = 50;      ///< above the floor
   double player_height = 56;   ///< free space needed above the floor
   double walk_normal = 0.7;    ///< least z of a walkable floor's unit normal
-  /// A point is dropped onto the floor below it when that floor is at most this far down, so
-  /// that floors are about evenly likely per area (rather than per height of the room above).
-  double max_drop = 128;
   double max_pitch_degrees = 30;  ///< pitch uniform in [-max, max], yaw uniform
 };
 
@@ -44,11 +41,10 @@ struct PlayCameras {
 std::vector<bool> q3_reachable_leaves(const Q3Map& map, size_t* spawn_points = nullptr);
 
 /// `config.count` play cameras, drawn serially from `config.seed` (reproducible): a uniform
-/// point of the non-solid space in a reachable leaf, dropped onto the first surface below it
-/// (a front face, walkable, at most max_drop down, with player_height free above it), the eye
-/// eye_height above that floor (again in a reachable non-solid leaf). `caster` casts against
-/// the scene made from the map (brush hulls included). Error when the map has too few such
-/// floors.
+/// point of the walkable surfaces (rendered, occluding triangles whose normal points up at
+/// least walk_normal; drawn by area), kept when player_height above it is free and the eye,
+/// eye_height above it, lies in a reachable non-solid leaf. `caster` casts against the scene
+/// made from the map (brush hulls included). Error when the map has too few such floors.
 PlayCameras q3_play_cameras(const Q3Map& map, const Scene& scene, const RayCaster& caster,
                             const PlayCameraConfig& config);
 
