@@ -11,6 +11,7 @@
 
 #include "support/test_scenes.h"
 #include "viewcells/agvs/agvs.h"
+#include "viewcells/eval/frames.h"
 #include "viewcells/agvs/penumbra.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"

@@ -1,5 +1,5 @@
 // AGVS paper 4.5: termination by the pixel error: the estimate from the view space-direction
-// rays (equation 5), its bound, and the measurement by rendered cameras that checks it.
+// rays (equation 5) and its bound (eval/frames.h measures it with rendered cameras).
 #include "solver_impl.h"
 
 namespace viewcells {
@@ -43,16 +43,6 @@ void AgvsSolver::Impl::evaluate_window() {
   for (uint64_t acc = 0; keep < window.size() && (keep == 0 || acc + window[keep].first <= reach); ++keep)
     acc += window[keep].first;
   window.resize(keep);
-}
-
-PixelErrorMeasure measure_pixel_error(const Scene& scene, const RayCaster& caster, const CellLocator& cells,
-                                      const GlobalPvs& pvs, uint32_t cameras, uint32_t width, uint32_t height,
-                                      double fov_degrees, uint64_t seed, bool skip_inside_solids,
-                                      uint32_t resolution) {
-  if (cameras == 0 || width == 0 || height == 0) throw Error("the pixel error needs cameras and pixels");
-  std::vector<int32_t> cam_cells;
-  const std::vector<Camera> cams = view_box_cameras(caster, cells, cameras, seed, skip_inside_solids, cam_cells);
-  return measure_frames(scene, caster, cams, cam_cells, pvs, FrameConfig{width, height, fov_degrees, resolution});
 }
 
 }  // namespace viewcells

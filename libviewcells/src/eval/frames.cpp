@@ -122,4 +122,14 @@ PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, st
   return out;
 }
 
+PixelErrorMeasure measure_pixel_error(const Scene& scene, const RayCaster& caster, const CellLocator& cells,
+                                      const GlobalPvs& pvs, uint32_t cameras, uint32_t width, uint32_t height,
+                                      double fov_degrees, uint64_t seed, bool skip_inside_solids,
+                                      uint32_t resolution) {
+  if (cameras == 0 || width == 0 || height == 0) throw Error("the pixel error needs cameras and pixels");
+  std::vector<int32_t> cam_cells;
+  const std::vector<Camera> cams = view_box_cameras(caster, cells, cameras, seed, skip_inside_solids, cam_cells);
+  return measure_frames(scene, caster, cams, cam_cells, pvs, FrameConfig{width, height, fov_degrees, resolution});
+}
+
 }  // namespace viewcells

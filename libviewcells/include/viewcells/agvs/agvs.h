@@ -24,7 +24,6 @@
 
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/cells/view_cells.h"
-#include "viewcells/eval/frames.h"
 #include "viewcells/pvs/global_pvs.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
@@ -221,17 +220,5 @@ struct LeafPvsRun {
 };
 LeafPvsRun leaf_pvs_by_agvs(const Scene& scene, const RayCaster& caster, const Subdivision& s,
                             const AgvsConfig& config, const std::vector<std::vector<uint32_t>>& base = {});
-
-/// The measured pixel error of a solution (paper section 4.5, the estimator's definition):
-/// cameras at uniform random points of the view box, randomly oriented, `width` x `height`
-/// pixels over a `fov_degrees` horizontal field of view, rendered by ray casting. A pixel is
-/// wrong when the object it shows with the full scene is not in the PVS of the camera's
-/// cell (with the PVS alone it would show something else). Cameras inside solids are drawn
-/// again when `skip_inside_solids` (scenes of closed objects). Returns wrong pixels per
-/// camera, scaled to `resolution` pixels.
-PixelErrorMeasure measure_pixel_error(const Scene& scene, const RayCaster& caster, const CellLocator& cells,
-                                      const GlobalPvs& pvs, uint32_t cameras, uint32_t width, uint32_t height,
-                                      double fov_degrees, uint64_t seed, bool skip_inside_solids,
-                                      uint32_t resolution = 1024 * 1024);
 
 }  // namespace viewcells

@@ -66,4 +66,16 @@ struct PixelErrorMeasure {
 PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, std::span<const Camera> cameras,
                                  std::span<const int32_t> cells, const GlobalPvs& pvs, const FrameConfig& config);
 
+/// The measured pixel error of a solution (paper section 4.5, the estimator's definition):
+/// cameras at uniform random points of the view box, randomly oriented, `width` x `height`
+/// pixels over a `fov_degrees` horizontal field of view, rendered by ray casting. A pixel is
+/// wrong when the object it shows with the full scene is not in the PVS of the camera's
+/// cell (with the PVS alone it would show something else). Cameras inside solids are drawn
+/// again when `skip_inside_solids` (scenes of closed objects). Returns wrong pixels per
+/// camera, scaled to `resolution` pixels.
+PixelErrorMeasure measure_pixel_error(const Scene& scene, const RayCaster& caster, const CellLocator& cells,
+                                      const GlobalPvs& pvs, uint32_t cameras, uint32_t width, uint32_t height,
+                                      double fov_degrees, uint64_t seed, bool skip_inside_solids,
+                                      uint32_t resolution = 1024 * 1024);
+
 }  // namespace viewcells

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "viewcells/agvs/agvs.h"
+#include "viewcells/eval/frames.h"
 #include "viewcells/pipeline/cut.h"
 
 namespace viewcells::pipeline {
