@@ -158,7 +158,7 @@ void add_pvs_command(CLI::App& app, const Common& common, Commands& commands) {
       ->check(whole(1, kMaxSamples));
   pv->add_option("--measure-size", a->measure_size, "Width and height of the measuring cameras, in pixels")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(whole(1, 2048));
   pv->add_option("-o,--output", a->output, "The .pvs file to write")->required();
   pv->add_option("--report", a->report, "JSON report: samples, rays, mean PVS size, estimated pixel error, curve");
   commands.push_back({pv, [a, &common] { return run_pvs(*a, common); }});
@@ -293,8 +293,8 @@ void add_measure_command(CLI::App& app, const Common& common, Commands& commands
                  "view space, looking anywhere) or auto (play on a map)")
       ->capture_default_str();
   ms->add_option("--count", a->count, "Number of cameras")->capture_default_str()->check(whole(1, 10'000'000));
-  ms->add_option("--width", a->width, "Frame width in pixels")->capture_default_str()->check(whole(1, 16384));
-  ms->add_option("--height", a->height, "Frame height in pixels")->capture_default_str()->check(whole(1, 16384));
+  ms->add_option("--width", a->width, "Frame width in pixels")->capture_default_str()->check(whole(1, 2048));
+  ms->add_option("--height", a->height, "Frame height in pixels")->capture_default_str()->check(whole(1, 2048));
   ms->add_option("--fov", a->fov, "Horizontal field of view in degrees")->capture_default_str()->check(CLI::Range(1.0, 179.0));
   ms->add_option("--max-pitch", a->max_pitch, "Play cameras: largest pitch up or down, in degrees")
       ->capture_default_str()

@@ -495,6 +495,7 @@ expect_ok "$VC" measure office.obj bake1.pvs --count 200 --width 16 --height 16 
 [ "$(json_get om.json "['pixel_error']['share']")" = "$(json_get om2.json "['pixel_error']['share']")" ] && ok || bad "measure differs between thread counts"
 expect_error "needs a .pvs file" "$VC" measure office.obj
 expect_error "unknown camera placement" "$VC" measure office.obj bake1.pvs --cameras everywhere
+expect_error "--width" "$VC" measure office.obj bake1.pvs --width 100000
 
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
