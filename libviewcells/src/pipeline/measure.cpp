@@ -29,23 +29,27 @@ struct Measured {
   std::unique_ptr<CellLocator> locator;  ///< for view-box cameras
 };
 
-/// What the engine would draw at each camera, and the wrong pixels' causes.
+/// What the engine would draw at each camera: the rendered objects of its cell's PVS (a
+/// sampled PVS may also hold the sky or brush hulls, which cost nothing and are not drawn).
 void frame_costs(const Scene& scene, const GlobalPvs& pvs, const std::vector<int32_t>& cam_cells,
                  const CostModel& model, MeasureResult& out) {
   CostModel m = model;
   m.c = 0;
   const std::vector<double> cost = per_object_costs(scene, m);
-  std::vector<double> cell_cost(pvs.cell_count(), 0.0), cell_tris(pvs.cell_count(), 0.0);
+  std::vector<double> cell_cost(pvs.cell_count(), 0.0), cell_tris(pvs.cell_count(), 0.0),
+      cell_objects(pvs.cell_count(), 0.0);
   for (uint32_t c = 0; c < pvs.cell_count(); ++c)
     for (uint32_t o : pvs.list(c)) {
+      if (!scene.objects[o].rendered) continue;
       cell_cost[c] += cost[o];
-      cell_tris[c] += scene.objects[o].rendered ? scene.objects[o].triangle_count : 0;
+      cell_tris[c] += scene.objects[o].triangle_count;
+      cell_objects[c] += 1;
     }
   std::vector<double> per_camera;
   for (int32_t c : cam_cells) {
     out.frame_cost += cell_cost[c];
     out.frame_triangles += cell_tris[c];
-    out.frame_objects += pvs.size(c);
+    out.frame_objects += cell_objects[c];
     per_camera.push_back(cell_cost[c]);
   }
   const double n = static_cast<double>(cam_cells.size());
