@@ -78,12 +78,7 @@ TEST(Frames, PlayerCameraIsLevel) {
   EXPECT_NEAR(std::asin(c.forward.z), 0.2, 1e-12);
 }
 
-std::string oa_dm2() {
-  const std::string path = std::string(VIEWCELLS_DATA_DIR) + "/maps/bsp/oa_dm2.bsp";
-  if (std::filesystem::exists(path)) return path;
-  if (std::getenv("VIEWCELLS_REQUIRE_MAPS")) ADD_FAILURE() << path << " is missing: run scripts/fetch-maps.sh";
-  return "";
-}
+std::string oa_dm2() { return test::oa_dm2_path(VIEWCELLS_DATA_DIR); }
 
 TEST(Q3PlayCameras, PlayersStandOnReachableFloorsAndQ3map2sPvsShowsWhatTheySee) {
   const std::string path = oa_dm2();

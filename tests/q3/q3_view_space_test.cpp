@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 
+#include "support/test_scenes.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/rng.h"
 #include "viewcells/io/scene_io.h"
@@ -97,12 +98,7 @@ TEST(Q3ViewSpace, ClusterCostsAndAdmittedObjects) {
 }
 
 /// oa_dm2 from the fetch script's cache, or "" (the test then skips unless maps are required).
-std::string oa_dm2() {
-  const std::string path = std::string(VIEWCELLS_DATA_DIR) + "/maps/bsp/oa_dm2.bsp";
-  if (std::filesystem::exists(path)) return path;
-  if (std::getenv("VIEWCELLS_REQUIRE_MAPS")) ADD_FAILURE() << path << " is missing: run scripts/fetch-maps.sh";
-  return "";
-}
+std::string oa_dm2() { return test::oa_dm2_path(VIEWCELLS_DATA_DIR); }
 
 TEST(Q3OaDm2, ClustersCoverTheNonSolidLeaves) {
   const std::string path = oa_dm2();

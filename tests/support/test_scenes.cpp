@@ -6,6 +6,9 @@
 
 #include <unistd.h>
 
+#include <gtest/gtest.h>
+
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 
@@ -78,6 +81,13 @@ CellLocator kd_cells(const Scene& scene, uint32_t n, uint64_t samples) {
   const std::vector<int32_t> leaves = s.leaves();
   for (size_t i = 0; i < leaves.size(); ++i) leaf_cell[leaves[i]] = static_cast<int32_t>(i);
   return CellLocator(std::move(s), std::move(leaf_cell), static_cast<uint32_t>(leaves.size()));
+}
+
+std::string oa_dm2_path(const std::string& data_dir) {
+  const std::string path = data_dir + "/maps/bsp/oa_dm2.bsp";
+  if (std::filesystem::exists(path)) return path;
+  if (std::getenv("VIEWCELLS_REQUIRE_MAPS")) ADD_FAILURE() << path << " is missing: run scripts/fetch-maps.sh";
+  return "";
 }
 
 }  // namespace viewcells::test

@@ -21,5 +21,8 @@ CellLocator kd_cells(const Scene& scene, uint32_t n, uint64_t samples = 20000);
 std::string temp_path(const std::string& name);
 /// Writes text to a file (for loader tests).
 void write_file(const std::string& path, const std::string& text);
+/// OpenArena's oa_dm2 from scripts/fetch-maps.sh's cache under `data_dir`, or "" (the test then
+/// skips; with VIEWCELLS_REQUIRE_MAPS set, its absence is also a failure).
+std::string oa_dm2_path(const std::string& data_dir);
 
 }  // namespace viewcells::test

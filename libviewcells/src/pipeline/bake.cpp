@@ -155,17 +155,28 @@ std::vector<std::vector<uint32_t>> coarsen(const MergeHistory& h, const std::vec
 
 namespace {
 
+/// The bytes of a cut's .pvs: the whole file, and its compressed PVS lists alone.
+struct CutBytes {
+  uint64_t file = 0, lists = 0;
+  uint64_t budgeted(bool lists_only) const { return lists_only ? lists : file; }
+};
+
 /// The .pvs of the view cells `set` with the PVSs `lists`: written, read back and compared
-/// (`check`), or only measured (the sizes a search tries). Returns its bytes.
-/// With `lists_only` (and not `check`), the bytes of the compressed PVS lists alone.
-uint64_t write_cut(const std::string& path, const SubdivisionFile& file, const ViewCellSet& set,
-                   const std::vector<std::vector<uint32_t>>* lists, bool check, bool lists_only = false) {
+/// (`check`), or only measured (the sizes a search tries).
+CutBytes write_cut(const std::string& path, const SubdivisionFile& file, const ViewCellSet& set,
+                   const std::vector<std::vector<uint32_t>>* lists, bool check) {
   PvsFile pf = pvs_file_for(file, set);
   pf.rule += "; PVS by agvs";
   if (lists) pf.pvs = compress_pvs(*file.history, set.cells, *lists);
-  if (!check) return lists_only ? varint_bytes(pf.pvs.stored) : pvs_file_bytes(pf);
+  CutBytes b;
+  b.lists = varint_bytes(pf.pvs.stored);
+  if (!check) {
+    b.file = pvs_file_bytes(pf);
+    return b;
+  }
   write_pvs_checked(path, pf, *lists);
-  return std::filesystem::file_size(staged_path(path));
+  b.file = std::filesystem::file_size(staged_path(path));
+  return b;
 }
 
 /// The view cells to sample: the count asked for, or under a memory budget the most cells
@@ -209,9 +220,8 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   out.agvs_cells = static_cast<uint32_t>(set.cells.size());
   ViewCellSet written = set;
   std::vector<std::vector<uint32_t>> written_lists = lists;
-  out.file_bytes = write_cut(c.output, file, set, &lists, true);
-  out.list_bytes = write_cut(c.output, file, set, &lists, false, true);
-  const uint64_t used = c.memory_of_lists ? out.list_bytes : out.file_bytes;
+  CutBytes bytes = write_cut(c.output, file, set, &lists, true);
+  const uint64_t used = bytes.budgeted(c.memory_of_lists);
   if (c.memory && used > c.memory) {
     // AGVS found more than the construction samples: the largest coarser cut that fits, with
     // the unions of the sampled PVSs.
@@ -220,16 +230,17 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     const size_t n = largest_fitting(h.min_cells(), set.cells.size() - 1, c.memory, [&](size_t count) {
       const ViewCellSet cut = extract_by_count(h, count);
       const auto coarse = coarsen(h, set.cells, lists, cut.cells);
-      return write_cut(c.output, file, cut, &coarse, false, c.memory_of_lists);
+      return write_cut(c.output, file, cut, &coarse, false).budgeted(c.memory_of_lists);
     });
     if (n == 0)
       throw Error(c.output, 0, "not even " + std::to_string(h.min_cells()) + " view cell(s) fit in " +
                                    std::to_string(c.memory) + " bytes");
     written = extract_by_count(h, n);
     written_lists = coarsen(h, set.cells, lists, written.cells);
-    out.file_bytes = write_cut(c.output, file, written, &written_lists, true);
-    out.list_bytes = write_cut(c.output, file, written, &written_lists, false, true);
+    bytes = write_cut(c.output, file, written, &written_lists, true);
   }
+  out.file_bytes = bytes.file;
+  out.list_bytes = bytes.lists;
   out.cells = static_cast<uint32_t>(written.cells.size());
   out.rule = written.rule + "; PVS by agvs";
   for (const auto& l : written_lists) out.pvs_entries += l.size();
