@@ -246,20 +246,89 @@ struct Marks {
   }
 };
 
-/// A segment part's extent along one axis, with the objects at its segment's ends (so the
-/// sweep reads one array in order instead of the segment set by id).
-struct AxisExtent {
-  double lo, hi;
+/// A segment part that is a point along an axis (its two ends share the coordinate there): on
+/// that axis it lies in the plane through its coordinate, so the sweep takes it apart.
+struct PointPart {
+  double at;
   uint32_t object_a, object_b;
 };
 
-/// Per object: the first candidate position index at which it is on the negative side of the
-/// plane and the last at which it is on the positive side (see Builder::side_costs), with the
-/// objects touched so far; reset in O(1) by bumping an epoch.
-struct SideMarks {
+/// What the axis sweep needs of a node's segment parts, from one pass over them: per object
+/// seen, along each axis, the lowest low end and the highest high end of its parts that have
+/// length along that axis (+inf and -inf when none has), with the objects in the order the
+/// parts first name them; and, per axis, the parts that are points along it. An object is on
+/// the negative side of x = c once one of its parts begins below c, on the positive side while
+/// one ends above it, so these extremes decide both sides' PVSs at every position.
+struct NodeExtents {
+  struct Range {
+    double lo[3] = {INFINITY, INFINITY, INFINITY};
+    double hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+  };
+  std::vector<uint32_t> objects;
+  std::vector<Range> ranges;  ///< per entry of objects
+  std::array<std::vector<PointPart>, 3> points;
+};
+
+/// Object -> its entry in the NodeExtents being built; reset in O(1) by bumping an epoch.
+struct ExtentSlots {
+  std::vector<uint32_t> stamp, slot;
+  uint32_t epoch = 0;
+  void reset(size_t n) {
+    if (stamp.size() < n) {
+      stamp.assign(n, 0);
+      slot.resize(n);
+    }
+    if (++epoch == 0) {
+      std::fill(stamp.begin(), stamp.end(), 0);
+      epoch = 1;
+    }
+  }
+  /// The entry of object o in `into` (added, with empty ranges, the first time).
+  NodeExtents::Range& entry(uint32_t o, NodeExtents& into) {
+    if (stamp[o] != epoch) {
+      stamp[o] = epoch;
+      slot[o] = static_cast<uint32_t>(into.objects.size());
+      into.objects.push_back(o);
+      into.ranges.emplace_back();
+    }
+    return into.ranges[slot[o]];
+  }
+  /// Adds the segment part p0-p1 seen by objects a and b.
+  void add_part(const Vec3& p0, const Vec3& p1, uint32_t a, uint32_t b, NodeExtents& into) {
+    if (a == kNoObject && b == kNoObject) return;
+    for (uint32_t o : {a, b}) {
+      if (o == kNoObject) continue;
+      NodeExtents::Range& r = entry(o, into);
+      for (int axis = 0; axis < 3; ++axis) {
+        const double c0 = p0[axis], c1 = p1[axis];
+        if (c0 == c1) continue;  // a point along this axis: listed below
+        r.lo[axis] = std::min(r.lo[axis], std::min(c0, c1));
+        r.hi[axis] = std::max(r.hi[axis], std::max(c0, c1));
+      }
+    }
+    for (int axis = 0; axis < 3; ++axis)
+      if (p0[axis] == p1[axis]) into.points[axis].push_back({p0[axis], a, b});
+  }
+  /// Adds the extents of later parts, keeping the order objects were first seen in.
+  void merge(const NodeExtents& later, NodeExtents& into) {
+    for (size_t i = 0; i < later.objects.size(); ++i) {
+      NodeExtents::Range& r = entry(later.objects[i], into);
+      const NodeExtents::Range& l = later.ranges[i];
+      for (int axis = 0; axis < 3; ++axis) {
+        r.lo[axis] = std::min(r.lo[axis], l.lo[axis]);
+        r.hi[axis] = std::max(r.hi[axis], l.hi[axis]);
+      }
+    }
+    for (int axis = 0; axis < 3; ++axis)
+      into.points[axis].insert(into.points[axis].end(), later.points[axis].begin(), later.points[axis].end());
+  }
+};
+
+/// Per object, the position indices its point parts along an axis give it (see
+/// Builder::side_costs); reset in O(1) by bumping an epoch.
+struct PointMarks {
   std::vector<uint32_t> stamp;
   std::vector<int32_t> first, last;
-  std::vector<uint32_t> touched;
   std::vector<double> padded;  ///< scratch: the positions padded to a power of two
   uint32_t epoch = 0;
   void reset(size_t n) {
@@ -268,7 +337,6 @@ struct SideMarks {
       first.resize(n);
       last.resize(n);
     }
-    touched.clear();
     if (++epoch == 0) {
       std::fill(stamp.begin(), stamp.end(), 0);
       epoch = 1;
@@ -280,7 +348,6 @@ struct SideMarks {
       stamp[o] = epoch;
       first[o] = jl;
       last[o] = jr;
-      touched.push_back(o);
       return;
     }
     first[o] = std::min(first[o], jl);
@@ -684,15 +751,22 @@ class Builder {
     if (refs.empty() || out_.nodes[node].pvs_cost == 0) return ev;
     RawVector<double> storage;
     const double* r = candidate_costs(node, storage);
-    const std::array<std::vector<AxisExtent>, 3> ext = axis_extents(refs);
+    const NodeExtents ext = node_extents(refs);
     Candidate results[4];
-    tbb::parallel_for(0, 4, [&](int task) {
-      if (task < 3) {
-        results[task] = best_axis_candidate(node, task, ext[task], ev, r);
+    auto task = [&](int t) {
+      if (t < 3) {
+        results[t] = best_axis_candidate(node, t, ext, ev, r);
       } else if (ga_) {
         results[3] = best_geometry_candidate(node, ev, r);
       }
-    });
+    };
+    // Small nodes in this thread (their sibling is evaluated beside them); the same results.
+    constexpr size_t kParallelParts = 1 << 13;
+    if (refs.size() < kParallelParts && !ga_) {
+      for (int t = 0; t < 3; ++t) task(t);
+    } else {
+      tbb::parallel_for(0, 4, task);
+    }
     for (const Candidate& c : results)  // in a fixed order: ties keep the earlier kind/axis
       if (c.valid && (!ev.best.valid || c.reduction > ev.best.reduction)) ev.best = c;
     return ev;
@@ -759,15 +833,24 @@ class Builder {
     return best;
   }
 
+  /// The coordinate along `axis` of the end i of a node's segment parts: the low end of part
+  /// i / 2 for even i, its high end for odd i.
+  double part_end(const std::vector<SegRef>& refs, size_t i, int axis) const {
+    const SegRef& s = refs[i >> 1];
+    const SegEnds& e = ends_[s.id];
+    const double c0 = e.at(s.t0)[axis], c1 = e.at(s.t1)[axis];
+    return (i & 1) ? std::max(c0, c1) : std::min(c0, c1);
+  }
+
   /// The axis-aligned positions tried in `node` along `axis` (sorted, distinct, strictly inside
   /// the cell's bounds): all segment ends when there are at most max_axis_candidates, else a
   /// random choice, reproducible per node and axis (SubdivisionConfig::exact_candidates).
-  std::vector<double> axis_positions(int32_t node, int axis, const std::vector<AxisExtent>& ext, double lo_b,
-                                     double hi_b) const {
+  std::vector<double> axis_positions(int32_t node, int axis, double lo_b, double hi_b) const {
+    const std::vector<SegRef>& refs = refs_[node];
     const size_t k = config_.max_axis_candidates;
     Rng rng(config_.seed, (static_cast<uint64_t>(node) << 2) | static_cast<uint64_t>(axis));
     std::vector<double> positions;
-    const size_t ends = 2 * ext.size();
+    const size_t ends = 2 * refs.size();
     if (!config_.exact_candidates && ends > 4 * k) {
       // Random segment ends (those on the cell's bounds rejected) until k distinct ones or 4k
       // draws (walls, where many segments end, repeat): O(k), then sorted, not O(n log n).
@@ -775,16 +858,18 @@ class Builder {
       drawn.reset(k);
       positions.reserve(k);
       for (size_t draw = 0; draw < 4 * k && positions.size() < k; ++draw) {
-        const size_t i = rng.below(ends);
-        const double c = (i & 1) ? ext[i >> 1].hi : ext[i >> 1].lo;
+        const double c = part_end(refs, rng.below(ends), axis);
         if (c > lo_b && c < hi_b && drawn.insert(c)) positions.push_back(c);
       }
       std::sort(positions.begin(), positions.end());
     } else {
       positions.reserve(ends);
-      for (const AxisExtent& e : ext)
-        for (double c : {e.lo, e.hi})
+      for (size_t i = 0; i < refs.size(); ++i) {
+        prefetch_ends(refs, i);
+        const SegEnds& e = ends_[refs[i].id];
+        for (double c : {e.at(refs[i].t0)[axis], e.at(refs[i].t1)[axis]})
           if (c > lo_b && c < hi_b) positions.push_back(c);
+      }
       std::sort(positions.begin(), positions.end());
       positions.erase(std::unique(positions.begin(), positions.end()), positions.end());
     }
@@ -797,17 +882,17 @@ class Builder {
     return positions;
   }
 
-  /// r(PVS) of both sides of the planes at the sorted positions x[0..k-1], in one pass. A
+  /// r(PVS) of both sides of the planes at the sorted positions x[0..k-1] along `axis`. A
   /// segment part [lo, hi] is on the negative side at x when lo < x (or it lies in the plane,
   /// lo == hi == x), on the positive side when hi > x (or lies in it): from the first position
   /// index jl on, up to the last index jr. An object is on the negative side from the smallest
-  /// jl of its segments on, on the positive side up to the largest jr; a histogram of those
-  /// indices and prefix sums give both sides' costs at every position in O(n log k + k).
-  void side_costs(const std::vector<AxisExtent>& ext, const std::vector<double>& x, const double* r,
+  /// jl of its parts on, on the positive side up to the largest jr, which its lowest low end
+  /// and highest high end give (NodeExtents); a histogram of those indices and prefix sums give
+  /// both sides' costs at every position in O(objects log k + k).
+  void side_costs(const NodeExtents& ext, int axis, const std::vector<double>& x, const double* r,
                   std::vector<double>& left, std::vector<double>& right) {
     const size_t k = x.size();
-    SideMarks& m = side_marks_.local();
-    m.reset(r_.size());
+    PointMarks& m = point_marks_.local();
     // Branch-free binary searches over x padded with +inf to a power of two: the count of
     // positions below v (lower bound) or at most v (upper bound).
     size_t p = 1;
@@ -826,19 +911,29 @@ class Builder {
       for (size_t step = p / 2; step > 0; step /= 2) i += xp[i + step - 1] <= v ? step : 0;
       return static_cast<int32_t>(i);
     };
-    for (const AxisExtent& e : ext) {
-      // A part along the axis is on the negative side from the first x above lo, on the positive
-      // side up to the last x below hi; a point (lo == hi) also at x == lo, in the plane.
-      const bool point = e.lo == e.hi;
-      const int32_t jl = point ? below(e.lo) : at_most(e.lo);
-      const int32_t jr = (point ? at_most(e.hi) : below(e.hi)) - 1;
-      m.touch(e.object_a, jl, jr);
-      m.touch(e.object_b, jl, jr);
+    // A point along the axis is on both sides at a position equal to its coordinate.
+    const std::vector<PointPart>& points = ext.points[axis];
+    if (!points.empty()) {
+      m.reset(r_.size());
+      for (const PointPart& e : points) {
+        const int32_t jl = below(e.at), jr = at_most(e.at) - 1;
+        m.touch(e.object_a, jl, jr);
+        m.touch(e.object_b, jl, jr);
+      }
     }
     std::vector<double> from(k + 1, 0.0), upto(k + 1, 0.0);
-    for (uint32_t o : m.touched) {
-      from[m.first[o]] += r[o];                          // index k: never on the negative side
-      upto[static_cast<size_t>(m.last[o] + 1)] += r[o];  // index 0: never on the positive side
+    const int32_t none = static_cast<int32_t>(k);
+    for (size_t i = 0; i < ext.objects.size(); ++i) {
+      const uint32_t o = ext.objects[i];
+      const double lo = ext.ranges[i].lo[axis], hi = ext.ranges[i].hi[axis];
+      int32_t first = lo == INFINITY ? none : at_most(lo);  // index k: never on the negative side
+      int32_t last = below(hi) - 1;                           // -1: never on the positive side
+      if (!points.empty() && m.stamp[o] == m.epoch) {
+        first = std::min(first, m.first[o]);
+        last = std::max(last, m.last[o]);
+      }
+      from[first] += r[o];
+      upto[static_cast<size_t>(last + 1)] += r[o];
     }
     left.assign(k, 0.0);
     right.assign(k, 0.0);
@@ -848,44 +943,45 @@ class Builder {
     for (size_t j = k; j-- > 0;) right[j] = cost += upto[j + 1];
   }
 
-  /// The extents of the node's segment parts along x, y and z: one pass over its parts
-  /// (in parallel for large nodes; each entry is computed alone, so the result is the same).
-  std::array<std::vector<AxisExtent>, 3> axis_extents(const std::vector<SegRef>& refs) const {
-    std::array<std::vector<AxisExtent>, 3> ext;
-    for (auto& e : ext) e.resize(refs.size());
-    auto fill = [&](size_t begin, size_t end) {
+  /// The node's parts' extents per object (NodeExtents), in one pass over its parts (in
+  /// parallel chunks for large nodes, merged in order, so the result is the same).
+  NodeExtents node_extents(const std::vector<SegRef>& refs) {
+    auto fill = [&](size_t begin, size_t end, NodeExtents& into) {
+      ExtentSlots& slots = extent_slots_.local();
+      slots.reset(r_.size());
       for (size_t i = begin; i < end; ++i) {
         prefetch_ends(refs, i);
         const SegRef& s = refs[i];
         const SegEnds& e = ends_[s.id];
-        const Vec3 p0 = e.at(s.t0), p1 = e.at(s.t1);
-        for (int axis = 0; axis < 3; ++axis) {
-          const double c0 = p0[axis], c1 = p1[axis];
-          ext[axis][i] = {std::min(c0, c1), std::max(c0, c1), e.object_a, e.object_b};
-        }
+        slots.add_part(e.at(s.t0), e.at(s.t1), e.object_a, e.object_b, into);
       }
     };
     constexpr size_t kGrain = 1 << 15;
+    NodeExtents all;
     if (refs.size() <= kGrain) {
-      fill(0, refs.size());
-    } else {
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, refs.size(), kGrain),
-                        [&](const tbb::blocked_range<size_t>& range) { fill(range.begin(), range.end()); });
+      fill(0, refs.size(), all);
+      return all;
     }
-    return ext;
+    std::vector<NodeExtents> chunks((refs.size() + kGrain - 1) / kGrain);
+    tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t c) {
+      fill(c * kGrain, std::min(refs.size(), (c + 1) * kGrain), chunks[c]);
+    });
+    ExtentSlots& slots = extent_slots_.local();
+    slots.reset(r_.size());
+    for (const NodeExtents& c : chunks) slots.merge(c, all);
+    return all;
   }
 
   /// The best axis-aligned split of `node` along `axis` among its candidate positions.
-  Candidate best_axis_candidate(int32_t node, int axis, const std::vector<AxisExtent>& ext, Evaluation& ev,
-                                const double* r) {
+  Candidate best_axis_candidate(int32_t node, int axis, const NodeExtents& ext, Evaluation& ev, const double* r) {
     const ConvexPolyhedron& cell = out_.cells[node];
     const Box3 bounds = cell.bounds();
     const double lo_b = bounds.lo[axis], hi_b = bounds.hi[axis];
-    const std::vector<double> positions = axis_positions(node, axis, ext, lo_b, hi_b);
+    const std::vector<double> positions = axis_positions(node, axis, lo_b, hi_b);
     if (positions.empty()) return {};
     const size_t k = positions.size();
     std::vector<double> left, right;
-    side_costs(ext, positions, r, left, right);
+    side_costs(ext, axis, positions, r, left, right);
     const double own = node_cost(node);
     const double volume = out_.nodes[node].volume, weight = out_.nodes[node].weight;
     const HeightBandDensity& density = config_.density;
@@ -899,18 +995,26 @@ class Builder {
       return area * (density.outside * ((x - lo_b) - in_band) + in_band);
     };
     const ConvexPolyhedron part = (!box && density.enabled) ? density.band_part(cell) : ConvexPolyhedron();
-    Candidate best;
+    bool found = false;
+    size_t best_j = 0;
+    double best_reduction = 0;
     for (size_t j = 0; j < k; ++j) {
-      const Plane plane = Plane::axis_aligned(axis, positions[j]);
-      const double vl = box ? volume * (positions[j] - lo_b) / (hi_b - lo_b) : cell.volume_below(plane);
+      const double vl = box ? volume * (positions[j] - lo_b) / (hi_b - lo_b)
+                            : cell.volume_below(Plane::axis_aligned(axis, positions[j]));
       if (!(vl > kMinPart * volume && volume - vl > kMinPart * volume)) continue;
-      const double wl = box ? box_weight_below(positions[j]) : density.weight_below(cell, part, plane);
+      const double wl = box ? box_weight_below(positions[j])
+                            : density.weight_below(cell, part, Plane::axis_aligned(axis, positions[j]));
       const double wr = weight - wl;
       const double reduction = own - (wl * left[j] + wr * right[j]) / total_weight_;
-      if (!best.valid || reduction > best.reduction) best = {true, plane, reduction};
+      if (!found || reduction > best_reduction) {
+        found = true;
+        best_j = j;
+        best_reduction = reduction;
+      }
     }
     __atomic_add_fetch(&ev.axis, k, __ATOMIC_RELAXED);
-    return best;
+    if (!found) return {};
+    return {true, Plane::axis_aligned(axis, positions[best_j]), best_reduction};
   }
 
   /// Planes of non-axis-aligned triangles hit inside the node, a random subset; each costs O(n).
@@ -1046,7 +1150,8 @@ class Builder {
   std::vector<Candidate> best_;
   std::atomic<uint64_t> axis_evaluated_{0}, geometry_evaluated_{0}, parts_evaluated_{0};
   tbb::enumerable_thread_specific<Marks> marks_;
-  tbb::enumerable_thread_specific<SideMarks> side_marks_;
+  tbb::enumerable_thread_specific<ExtentSlots> extent_slots_;
+  tbb::enumerable_thread_specific<PointMarks> point_marks_;
   tbb::enumerable_thread_specific<std::pair<Marks, Marks>> side_pair_marks_;  ///< geometry-aligned: both sides
   mutable tbb::enumerable_thread_specific<DrawnSet> drawn_;
 };
