@@ -12,14 +12,20 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include <algorithm>
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <map>
+#include <memory>
 #include <queue>
+
+#include <sys/mman.h>
 
 #include "viewcells/core/default_init.h"
 #include "viewcells/core/error.h"
@@ -214,6 +220,33 @@ struct alignas(64) SegEnds {
   Vec3 at(double t) const { return a * (1.0 - t) + b * t; }
 };
 
+/// A fixed-size array in 2 MB pages where the system offers them (Linux transparent huge
+/// pages on request): the subdivision reads SegEnds by id at random, and with 4 kB pages
+/// nearly every read of a 100 MB array also misses the address translation cache.
+template <class T>
+class HugePageArray {
+ public:
+  explicit HugePageArray(size_t n) : n_(n) {
+    constexpr size_t kHuge = size_t{2} << 20;
+    const size_t bytes = std::max<size_t>(kHuge, (n * sizeof(T) + kHuge - 1) / kHuge * kHuge);
+    data_ = static_cast<T*>(std::aligned_alloc(kHuge, bytes));
+    if (!data_) throw std::bad_alloc();
+#ifdef MADV_HUGEPAGE
+    madvise(data_, bytes, MADV_HUGEPAGE);  // a hint: without it the pages are small, not wrong
+#endif
+  }
+  ~HugePageArray() { std::free(data_); }
+  HugePageArray(const HugePageArray&) = delete;
+  HugePageArray& operator=(const HugePageArray&) = delete;
+  T& operator[](size_t i) { return data_[i]; }
+  const T& operator[](size_t i) const { return data_[i]; }
+  size_t size() const { return n_; }
+
+ private:
+  T* data_ = nullptr;
+  size_t n_ = 0;
+};
+
 /// Which children a segment part goes to, from the exact sides of its two ends:
 /// bit 0 negative, bit 1 positive.
 inline int classify(int s0, int s1) {
@@ -266,7 +299,23 @@ struct NodeExtents {
   };
   std::vector<uint32_t> objects;
   std::vector<Range> ranges;  ///< per entry of objects
+  /// Per entry of objects: 1 when it and the next entry were first seen at the two ends of
+  /// one part (so that r(PVS) adds their costs in the order a pass over the parts does).
+  std::vector<uint8_t> paired;
   std::array<std::vector<PointPart>, 3> points;
+  /// r(PVS) of the parts: each object's r once, added as a pass over the parts adds them.
+  double pvs_cost(const std::vector<double>& r) const {
+    double c = 0;
+    for (size_t i = 0; i < objects.size(); ++i) {
+      if (paired[i]) {
+        c += r[objects[i]] + r[objects[i + 1]];
+        ++i;
+      } else {
+        c += r[objects[i]];
+      }
+    }
+    return c;
+  }
 };
 
 /// Object -> its entry in the NodeExtents being built; reset in O(1) by bumping an epoch.
@@ -290,29 +339,43 @@ struct ExtentSlots {
       slot[o] = static_cast<uint32_t>(into.objects.size());
       into.objects.push_back(o);
       into.ranges.emplace_back();
+      into.paired.push_back(0);
     }
     return into.ranges[slot[o]];
   }
   /// Adds the segment part p0-p1 seen by objects a and b.
   void add_part(const Vec3& p0, const Vec3& p1, uint32_t a, uint32_t b, NodeExtents& into) {
     if (a == kNoObject && b == kNoObject) return;
-    for (uint32_t o : {a, b}) {
+    double lo[3], hi[3];
+    for (int axis = 0; axis < 3; ++axis) {
+      const double c0 = p0[axis], c1 = p1[axis];
+      if (c0 == c1) {  // a point along this axis: listed apart, no range
+        into.points[axis].push_back({c0, a, b});
+        lo[axis] = INFINITY;
+        hi[axis] = -INFINITY;
+      } else {
+        lo[axis] = std::min(c0, c1);
+        hi[axis] = std::max(c0, c1);
+      }
+    }
+    const size_t before = into.objects.size();
+    for (uint32_t o : {a, b == a ? kNoObject : b}) {
       if (o == kNoObject) continue;
       NodeExtents::Range& r = entry(o, into);
       for (int axis = 0; axis < 3; ++axis) {
-        const double c0 = p0[axis], c1 = p1[axis];
-        if (c0 == c1) continue;  // a point along this axis: listed below
-        r.lo[axis] = std::min(r.lo[axis], std::min(c0, c1));
-        r.hi[axis] = std::max(r.hi[axis], std::max(c0, c1));
+        r.lo[axis] = std::min(r.lo[axis], lo[axis]);
+        r.hi[axis] = std::max(r.hi[axis], hi[axis]);
       }
     }
-    for (int axis = 0; axis < 3; ++axis)
-      if (p0[axis] == p1[axis]) into.points[axis].push_back({p0[axis], a, b});
+    if (into.objects.size() == before + 2) into.paired[before] = 1;
   }
   /// Adds the extents of later parts, keeping the order objects were first seen in.
   void merge(const NodeExtents& later, NodeExtents& into) {
     for (size_t i = 0; i < later.objects.size(); ++i) {
+      // A pair stays a pair only if both are new here (else the part adds one cost alone).
+      const bool first_seen = stamp[later.objects[i]] != epoch;
       NodeExtents::Range& r = entry(later.objects[i], into);
+      if (first_seen && later.paired[i] && stamp[later.objects[i + 1]] != epoch) into.paired.back() = 1;
       const NodeExtents::Range& l = later.ranges[i];
       for (int axis = 0; axis < 3; ++axis) {
         r.lo[axis] = std::min(r.lo[axis], l.lo[axis]);
@@ -450,7 +513,8 @@ class Builder {
         r_(per_object_costs(scene, model)),
         config_(config),
         out_(out),
-        total_volume_(segs.view_box.volume()) {}
+        total_volume_(segs.view_box.volume()),
+        ends_(segs.size()) {}
 
   void run() {
     const auto start = std::chrono::steady_clock::now();
@@ -469,7 +533,6 @@ class Builder {
     }
     // Box faces: -x, +x, -y, +y, -z, +z match planes 0..5.
     ConvexPolyhedron root = ConvexPolyhedron::box(b, 0);
-    ends_.resize(segs_.size());
     std::vector<SegRef> refs(segs_.size());
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, static_cast<uint32_t>(segs_.size()), 1 << 14),
                       [&](const tbb::blocked_range<uint32_t>& range) {
@@ -509,6 +572,13 @@ class Builder {
     Progress progress("subdividing", config_.max_cells);
     progress.advance(1);
     uint32_t stagnant = 0;
+    // Look-ahead: while a split's children are evaluated, the parts of the cell now first in
+    // the queue are divided by its best plane. That cell is split next unless one of the
+    // children outranks it; either way its division waits here until it is split (a few at
+    // most are kept). Splits happen in exactly the serial order, so the tree is the same.
+    const bool look_ahead = config_.strategy == SplitStrategy::kCost;
+    constexpr size_t kMaxAhead = 4;
+    std::vector<std::pair<int32_t, Partition>> ahead;
     out_.stats.stop_reason = "reached the maximum number of cells";
     while (out_.leaf_count() < config_.max_cells) {
       if (queue.empty()) {
@@ -527,13 +597,30 @@ class Builder {
         break;
       }
       const double before = node_cost(node);
-      if (!apply_split(node, cand.plane)) continue;  // degenerate after all: leave the cell whole
+      auto done = std::find_if(ahead.begin(), ahead.end(), [&](const auto& entry) { return entry.first == node; });
+      const bool split = apply_split(node, cand.plane, done == ahead.end() ? nullptr : &done->second);
+      if (done != ahead.end()) ahead.erase(done);
+      if (!split) continue;  // degenerate after all: leave the cell whole
       const int32_t c0 = out_.nodes[node].child[0], c1 = out_.nodes[node].child[1];
       const double after = node_cost(c0) + node_cost(c1);
       cost += after - before;
       out_.splits.push_back({node, before - after, cost});
       best_.resize(out_.nodes.size());
-      tbb::parallel_invoke([&] { evaluate_into(c0); }, [&] { evaluate_into(c1); });
+      int32_t next = -1;
+      if (look_ahead && !queue.empty() && out_.leaf_count() + 1 < config_.max_cells) {
+        next = queue.top().second;
+        for (const auto& entry : ahead)
+          if (entry.first == next) next = -1;
+      }
+      Partition next_parts;
+      tbb::parallel_invoke([&] { evaluate_into(c0); }, [&] { evaluate_into(c1); },
+                           [&] {
+                             if (next >= 0) next_parts = partition(next, best_[next].plane);
+                           });
+      if (next >= 0) {
+        if (ahead.size() == kMaxAhead) ahead.erase(ahead.begin());
+        ahead.emplace_back(next, std::move(next_parts));
+      }
       for (int32_t c : {c0, c1})
         if (best_[c].valid) queue.push({priority(c), c});
       if (config_.show_progress) progress.advance(1);
@@ -583,7 +670,7 @@ class Builder {
   /// A node's parts name their segments in increasing but sparse order, which the hardware does
   /// not predict: the segment a few parts ahead is fetched while this one is used.
   void prefetch_ends(const std::vector<SegRef>& refs, size_t i) const {
-    constexpr size_t kAhead = 16;
+    constexpr size_t kAhead = 48;
     if (i + kAhead < refs.size()) __builtin_prefetch(&ends_[refs[i + kAhead].id]);
   }
 
@@ -609,18 +696,20 @@ class Builder {
     return storage.data();
   }
 
-  /// A node's volume, weight and r(PVS) (thread-safe: the two children are measured at once).
-  BspNode measure_node(int32_t parent, const ConvexPolyhedron& cell, const std::vector<SegRef>& refs) {
+  /// A node's volume, weight and r(PVS) (thread-safe: the two children are measured at once);
+  /// r(PVS) from the node's extents when they are known and the costs are global.
+  BspNode measure_node(int32_t parent, const ConvexPolyhedron& cell, const std::vector<SegRef>& refs,
+                       const NodeExtents* ext) {
     BspNode node;
     node.parent = parent;
     node.volume = cell.volume();
     node.weight = config_.density.weight(cell);
-    node.pvs_cost = pvs_cost(cell, refs);
+    node.pvs_cost = ext && !model_.pixel_term() ? ext->pvs_cost(r_) : pvs_cost(cell, refs);
     return node;
   }
 
   int32_t add_node(int32_t parent, ConvexPolyhedron cell, std::vector<SegRef> refs) {
-    const BspNode node = measure_node(parent, cell, refs);
+    const BspNode node = measure_node(parent, cell, refs, nullptr);
     return add_node(node, std::move(cell), std::move(refs));
   }
 
@@ -633,46 +722,63 @@ class Builder {
     return static_cast<int32_t>(out_.nodes.size() - 1);
   }
 
-  bool apply_split(int32_t node, const Plane& plane) {
-    const int32_t plane_id = static_cast<int32_t>(out_.planes.size());
-    auto halves = out_.cells[node].split(plane, plane_id);
-    if (!halves) return false;
-    // A sliver (its volume rounds to nothing or below) helps no one and breaks p(i) >= 0:
-    // the cell stays whole. Candidates are filtered by the same relative size, but they see
-    // estimated volumes; this is the exact check on the cells themselves.
-    const double min_part = kMinPart * out_.nodes[node].volume;
-    if (!(halves->first.volume() > min_part && halves->second.volume() > min_part)) {
-      ++slivers_refused_;
-      return false;
-    }
-    out_.planes.push_back(plane);
+  /// A node's parts divided by a plane: each child's parts and, for AV-S, extents. It reads
+  /// only the node's parts, so it can run beside other work (see run()).
+  struct Partition {
+    std::vector<SegRef> side[2];
+    std::array<NodeExtents, 2> ext;
+  };
+
+  Partition partition(int32_t node, const Plane& plane) {
+    const bool extents = config_.strategy == SplitStrategy::kCost;
     // Sides first (bit 0 negative, bit 1 positive, bit 2: crosses, the negative part first,
-    // bit 3: crosses, the positive part first), then both children written at once, chunk by
-    // chunk in parallel for large cells (each chunk at its own offset: the order is the same).
+    // bit 3: crosses, the positive part first), with each child's extents (NodeExtents, which
+    // its evaluation and r(PVS) need) gathered in the same pass; then both children written at
+    // once. Both passes go chunk by chunk in parallel for large cells, each chunk at its own
+    // offset and the extents joined in chunk order, so the result is the same for any threads.
     const std::vector<SegRef>& refs = refs_[node];
     const size_t n = refs.size();
-    constexpr size_t kGrain = 1 << 15;
-    const size_t chunks = std::max<size_t>(1, (n + kGrain - 1) / kGrain);
+    // Chunks of at least kGrain parts, a few per thread (the result does not depend on them).
+    constexpr size_t kGrain = 1 << 10;
+    const size_t threads = std::min<size_t>(
+        static_cast<size_t>(std::max(1, tbb::this_task_arena::max_concurrency())),
+        tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+    const size_t chunks = std::clamp<size_t>((n + kGrain - 1) / kGrain, 1, threads == 1 ? 1 : 4 * threads);
+    const size_t grain = (n + chunks - 1) / chunks;
     std::vector<uint8_t> code(n);
     std::vector<double> cut(n);  // where a crossing part is cut
     std::vector<std::array<size_t, 2>> at(chunks + 1, {0, 0});  // per chunk: its first index in each child
+    std::vector<std::array<NodeExtents, 2>> chunk_ext(extents ? chunks : 0);
     auto for_chunks = [&](auto&& f) {
       if (chunks == 1) return f(size_t{0});
       tbb::parallel_for(size_t{0}, chunks, [&](size_t c) { f(c); });
     };
     for_chunks([&](size_t c) {
       size_t count[2] = {0, 0};
-      for (size_t i = c * kGrain; i < std::min(n, (c + 1) * kGrain); ++i) {
+      std::array<ExtentSlots, 2>& slots = split_slots_.local();
+      if (extents)
+        for (ExtentSlots& sl : slots) sl.reset(r_.size());
+      for (size_t i = c * grain; i < std::min(n, (c + 1) * grain); ++i) {
         prefetch_ends(refs, i);
         const SegRef& s = refs[i];
         const SegEnds& e = ends_[s.id];
-        const int s0 = plane.side(e.at(s.t0)), s1 = plane.side(e.at(s.t1));
+        const Vec3 p0 = e.at(s.t0), p1 = e.at(s.t1);
+        const int s0 = plane.side(p0), s1 = plane.side(p1);
         int to = classify(s0, s1);
         if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) {
           // Crosses: each side gets its part (the cut point is rounded; sides stay exact).
           to |= s0 < 0 ? 4 : 8;
-          const double d0 = plane.distance(e.at(s.t0)), d1 = plane.distance(e.at(s.t1));
+          const double d0 = plane.distance(p0), d1 = plane.distance(p1);
           cut[i] = std::clamp(s.t0 + (s.t1 - s.t0) * (d0 / (d0 - d1)), s.t0, s.t1);
+          if (extents) {
+            const Vec3 mid = e.at(cut[i]);
+            const int first = s0 < 0 ? 0 : 1;
+            slots[first].add_part(p0, mid, e.object_a, e.object_b, chunk_ext[c][first]);
+            slots[1 - first].add_part(mid, p1, e.object_a, e.object_b, chunk_ext[c][1 - first]);
+          }
+        } else if (extents) {
+          for (int k = 0; k < 2; ++k)
+            if (to & (1 << k)) slots[k].add_part(p0, p1, e.object_a, e.object_b, chunk_ext[c][k]);
         }
         code[i] = static_cast<uint8_t>(to);
         count[0] += to & 1;
@@ -680,14 +786,25 @@ class Builder {
       }
       at[c + 1] = {count[0], count[1]};
     });
+    Partition out;
+    std::array<NodeExtents, 2>& ext = out.ext;
+    if (chunks == 1 && extents) {
+      ext = std::move(chunk_ext[0]);
+    } else if (extents) {
+      for (int k = 0; k < 2; ++k) {
+        ExtentSlots& slots = extent_slots_.local();
+        slots.reset(r_.size());
+        for (const auto& ce : chunk_ext) slots.merge(ce[k], ext[k]);
+      }
+    }
     for (size_t c = 0; c < chunks; ++c)
       for (int k = 0; k < 2; ++k) at[c + 1][k] += at[c][k];
-    std::vector<SegRef> side[2];
+    std::vector<SegRef>* side = out.side;
     side[0].resize(at[chunks][0]);
     side[1].resize(at[chunks][1]);
     for_chunks([&](size_t c) {
       size_t next[2] = {at[c][0], at[c][1]};
-      for (size_t i = c * kGrain; i < std::min(n, (c + 1) * kGrain); ++i) {
+      for (size_t i = c * grain; i < std::min(n, (c + 1) * grain); ++i) {
         const SegRef& s = refs[i];
         if (code[i] & 12) {
           const double t = cut[i];
@@ -700,6 +817,28 @@ class Builder {
         if (code[i] & 2) side[1][next[1]++] = s;
       }
     });
+    return out;
+  }
+
+  /// Splits `node` by `plane` (its parts divided by partition(), or taken from `ready` when
+  /// that was done ahead), unless the plane does not cut the cell or cuts off a sliver.
+  bool apply_split(int32_t node, const Plane& plane, Partition* ready) {
+    const int32_t plane_id = static_cast<int32_t>(out_.planes.size());
+    auto halves = out_.cells[node].split(plane, plane_id);
+    if (!halves) return false;
+    // A sliver (its volume rounds to nothing or below) helps no one and breaks p(i) >= 0:
+    // the cell stays whole. Candidates are filtered by the same relative size, but they see
+    // estimated volumes; this is the exact check on the cells themselves.
+    const double min_part = kMinPart * out_.nodes[node].volume;
+    if (!(halves->first.volume() > min_part && halves->second.volume() > min_part)) {
+      ++slivers_refused_;
+      return false;
+    }
+    out_.planes.push_back(plane);
+    Partition parts = ready ? std::move(*ready) : partition(node, plane);
+    std::vector<SegRef>* side = parts.side;
+    const bool extents = config_.strategy == SplitStrategy::kCost;
+    std::array<NodeExtents, 2>& ext = parts.ext;
     refs_[node].clear();
     refs_[node].shrink_to_fit();
     if (config_.strategy == SplitStrategy::kPolygonBsp) {
@@ -709,9 +848,9 @@ class Builder {
       for (uint32_t t : tris_[node]) {
         bool neg = false, pos = false;
         for (uint32_t v : scene_.triangles[t]) {
-          const int at = plane.side(scene_.vertices[v]);
-          neg |= at < 0;
-          pos |= at > 0;
+          const int where = plane.side(scene_.vertices[v]);
+          neg |= where < 0;
+          pos |= where > 0;
         }
         if (neg) tri_side[0].push_back(t);
         if (pos) tri_side[1].push_back(t);
@@ -723,10 +862,16 @@ class Builder {
     out_.cells[node] = ConvexPolyhedron();
     out_.nodes[node].plane = plane_id;
     BspNode measured[2];
-    tbb::parallel_invoke([&] { measured[0] = measure_node(node, halves->first, side[0]); },
-                         [&] { measured[1] = measure_node(node, halves->second, side[1]); });
+    const NodeExtents* known[2] = {extents ? &ext[0] : nullptr, extents ? &ext[1] : nullptr};
+    tbb::parallel_invoke([&] { measured[0] = measure_node(node, halves->first, side[0], known[0]); },
+                         [&] { measured[1] = measure_node(node, halves->second, side[1], known[1]); });
     const int32_t a = add_node(measured[0], std::move(halves->first), std::move(side[0]));
     const int32_t b = add_node(measured[1], std::move(halves->second), std::move(side[1]));
+    if (extents) {
+      pending_ext_.resize(out_.nodes.size());
+      pending_ext_[a] = std::make_unique<NodeExtents>(std::move(ext[0]));
+      pending_ext_[b] = std::make_unique<NodeExtents>(std::move(ext[1]));
+    }
     out_.nodes[node].child[0] = a;
     out_.nodes[node].child[1] = b;
     return true;
@@ -747,11 +892,14 @@ class Builder {
       case SplitStrategy::kPolygonBsp: ev.best = best_polygon_candidate(node, ev); return ev;
       default: ev.best = kd_candidate(node); ++ev.axis; return ev;
     }
+    // The extents gathered when the node was split off (the root's are measured below).
+    std::unique_ptr<NodeExtents> known;
+    if (static_cast<size_t>(node) < pending_ext_.size()) known = std::move(pending_ext_[node]);
     const std::vector<SegRef>& refs = refs_[node];
     if (refs.empty() || out_.nodes[node].pvs_cost == 0) return ev;
     RawVector<double> storage;
     const double* r = candidate_costs(node, storage);
-    const NodeExtents ext = node_extents(refs);
+    const NodeExtents& ext = known ? *known : *(known = std::make_unique<NodeExtents>(node_extents(refs)));
     Candidate results[4];
     auto task = [&](int t) {
       if (t < 3) {
@@ -857,9 +1005,18 @@ class Builder {
       DrawnSet& drawn = drawn_.local();
       drawn.reset(k);
       positions.reserve(k);
-      for (size_t draw = 0; draw < 4 * k && positions.size() < k; ++draw) {
-        const double c = part_end(refs, rng.below(ends), axis);
-        if (c > lo_b && c < hi_b && drawn.insert(c)) positions.push_back(c);
+      // Drawn a block at a time, their parts and then their segments fetched ahead (each is a
+      // cache miss); the stream is the same, and nothing else draws from it here.
+      constexpr size_t kBlock = 64;
+      size_t block[kBlock];
+      for (size_t draw = 0; draw < 4 * k && positions.size() < k;) {
+        const size_t m = std::min(kBlock, 4 * k - draw);
+        for (size_t j = 0; j < m; ++j) __builtin_prefetch(&refs[(block[j] = rng.below(ends)) >> 1]);
+        for (size_t j = 0; j < m; ++j) __builtin_prefetch(&ends_[refs[block[j] >> 1].id]);
+        for (size_t j = 0; j < m && positions.size() < k; ++j, ++draw) {
+          const double c = part_end(refs, block[j], axis);
+          if (c > lo_b && c < hi_b && drawn.insert(c)) positions.push_back(c);
+        }
       }
       std::sort(positions.begin(), positions.end());
     } else {
@@ -1142,7 +1299,7 @@ class Builder {
   double total_weight_ = 0;
   bool ga_ = false;
   std::vector<std::vector<SegRef>> refs_;
-  std::vector<SegEnds> ends_;  ///< per segment, as segs_
+  HugePageArray<SegEnds> ends_;  ///< per segment, as segs_
   std::vector<uint32_t> depth_;              ///< per node
   std::vector<std::vector<uint32_t>> tris_;  ///< BSP baseline: per node, the polygons in it
   double pvs_budget_ = 0;
@@ -1151,6 +1308,9 @@ class Builder {
   std::atomic<uint64_t> axis_evaluated_{0}, geometry_evaluated_{0}, parts_evaluated_{0};
   tbb::enumerable_thread_specific<Marks> marks_;
   tbb::enumerable_thread_specific<ExtentSlots> extent_slots_;
+  tbb::enumerable_thread_specific<std::array<ExtentSlots, 2>> split_slots_;  ///< apply_split: both sides
+  /// Per node: the extents its split gathered, until the node is evaluated.
+  std::vector<std::unique_ptr<NodeExtents>> pending_ext_;
   tbb::enumerable_thread_specific<PointMarks> point_marks_;
   tbb::enumerable_thread_specific<std::pair<Marks, Marks>> side_pair_marks_;  ///< geometry-aligned: both sides
   mutable tbb::enumerable_thread_specific<DrawnSet> drawn_;
