@@ -319,29 +319,36 @@ struct NodeExtents {
 };
 
 /// Object -> its entry in the NodeExtents being built; reset in O(1) by bumping an epoch.
+/// The ranges are kept per object id while a NodeExtents is built (no indirection, no growing
+/// array on the way) and copied into it in order by finish().
 struct ExtentSlots {
-  std::vector<uint32_t> stamp, slot;
+  std::vector<uint32_t> stamp;
+  std::vector<NodeExtents::Range> range;  ///< per object; valid where stamped
   uint32_t epoch = 0;
   void reset(size_t n) {
     if (stamp.size() < n) {
       stamp.assign(n, 0);
-      slot.resize(n);
+      range.resize(n);
     }
     if (++epoch == 0) {
       std::fill(stamp.begin(), stamp.end(), 0);
       epoch = 1;
     }
   }
-  /// The entry of object o in `into` (added, with empty ranges, the first time).
+  /// The range of object o, listed in `into` (with empty ranges) the first time.
   NodeExtents::Range& entry(uint32_t o, NodeExtents& into) {
     if (stamp[o] != epoch) {
       stamp[o] = epoch;
-      slot[o] = static_cast<uint32_t>(into.objects.size());
       into.objects.push_back(o);
-      into.ranges.emplace_back();
       into.paired.push_back(0);
+      range[o] = NodeExtents::Range();
     }
-    return into.ranges[slot[o]];
+    return range[o];
+  }
+  /// Writes the ranges of the objects listed in `into` (after adding parts or merging).
+  void finish(NodeExtents& into) const {
+    into.ranges.resize(into.objects.size());
+    for (size_t i = 0; i < into.objects.size(); ++i) into.ranges[i] = range[into.objects[i]];
   }
   /// Adds the segment part p0-p1 seen by objects a and b.
   void add_part(const Vec3& p0, const Vec3& p1, uint32_t a, uint32_t b, NodeExtents& into) {
@@ -784,6 +791,8 @@ class Builder {
         count[0] += to & 1;
         count[1] += (to >> 1) & 1;
       }
+      if (extents)
+        for (int k = 0; k < 2; ++k) slots[k].finish(chunk_ext[c][k]);
       at[c + 1] = {count[0], count[1]};
     });
     Partition out;
@@ -795,6 +804,7 @@ class Builder {
         ExtentSlots& slots = extent_slots_.local();
         slots.reset(r_.size());
         for (const auto& ce : chunk_ext) slots.merge(ce[k], ext[k]);
+        slots.finish(ext[k]);
       }
     }
     for (size_t c = 0; c < chunks; ++c)
@@ -1112,6 +1122,7 @@ class Builder {
         const SegEnds& e = ends_[s.id];
         slots.add_part(e.at(s.t0), e.at(s.t1), e.object_a, e.object_b, into);
       }
+      slots.finish(into);
     };
     constexpr size_t kGrain = 1 << 15;
     NodeExtents all;
@@ -1126,6 +1137,7 @@ class Builder {
     ExtentSlots& slots = extent_slots_.local();
     slots.reset(r_.size());
     for (const NodeExtents& c : chunks) slots.merge(c, all);
+    slots.finish(all);
     return all;
   }
 
@@ -1337,14 +1349,22 @@ Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const Cost
 
 std::vector<std::vector<uint32_t>> leaf_pvs(const Subdivision& s, const SegmentSet& segments) {
   std::vector<std::vector<uint32_t>> pvs(s.nodes.size());
-  for (int32_t leaf : s.leaves()) {
-    auto& ids = pvs[leaf];
-    for (uint32_t i : s.segments[leaf])
+  const std::vector<int32_t> leaves = s.leaves();
+  uint32_t objects = 0;  // one past the largest object id named
+  for (size_t i = 0; i < segments.size(); ++i)
+    for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
+      if (o != kNoObject) objects = std::max(objects, o + 1);
+  // Each leaf's distinct objects (first-seen marks), then sorted: each leaf alone, in parallel.
+  tbb::enumerable_thread_specific<Marks> marks;
+  tbb::parallel_for(size_t{0}, leaves.size(), [&](size_t l) {
+    Marks& m = marks.local();
+    m.reset(objects);
+    auto& ids = pvs[leaves[l]];
+    for (uint32_t i : s.segments[leaves[l]])
       for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
-        if (o != kNoObject) ids.push_back(o);
+        if (m.first(o)) ids.push_back(o);
     std::sort(ids.begin(), ids.end());
-    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  }
+  });
   return pvs;
 }
 
