@@ -4,7 +4,8 @@
 # choice), each size run with both in turn so that their ratio is measured in one run; how the
 # subdivision time grows with 0.5M, 1M, 1.5M, 2M segments; and one compare at 1.5M segments
 # that scores both subdivisions on independent evaluation samples at 1k, 10k and 50k cells; and
-# the glass city (see-through surfaces) at 1.5M segments both ways.
+# the glass city (see-through surfaces) at 1.5M segments both ways; and, on oa_shouse (a Quake 3
+# map with much water and glass), build both ways and compare with its defaults (peak memory).
 # The stagnation stop is switched off (--min-reduction 0) so that every run reaches CELLS.
 # Rewrites the subdivision section of BENCHMARKS.md. Usage: scripts/bench-subdivision.sh [SIZE] [CELLS]
 set -euo pipefail
@@ -39,6 +40,9 @@ if [ -f "$map" ]; then
     --report "$dir/build-map.json"
   peak "$dir/build-map-exact.kb" "$vc" build "$map" --samples 300000 --max-cells 1500 --seed 1 -q --no-merge \
     --exact-candidates --report "$dir/build-map-exact.json"
+  # compare on it with every default (its methods, samples and cell count): time and peak memory.
+  rm -rf "$dir/compare-map"
+  peak "$dir/compare-map.kb" "$vc" compare "$map" --seed 1 -q -o "$dir/compare-map"
 fi
 "$vc" compare "$scene" --segments 1500000 --max-cells "$cells" --min-reduction 0 --methods av-s,av-s-exact --seed 1 -q \
   -o "$dir/compare-candidates"
