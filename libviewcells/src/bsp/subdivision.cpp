@@ -540,7 +540,7 @@ class Builder {
     }
     // Box faces: -x, +x, -y, +y, -z, +z match planes 0..5.
     ConvexPolyhedron root = ConvexPolyhedron::box(b, 0);
-    std::vector<SegRef> refs(segs_.size());
+    RawVector<SegRef> refs(segs_.size());
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, static_cast<uint32_t>(segs_.size()), 1 << 14),
                       [&](const tbb::blocked_range<uint32_t>& range) {
                         for (uint32_t i = range.begin(); i < range.end(); ++i) {
@@ -657,7 +657,7 @@ class Builder {
     }
   }
 
-  double pvs_cost(const ConvexPolyhedron& cell, const std::vector<SegRef>& refs) {
+  double pvs_cost(const ConvexPolyhedron& cell, const RawVector<SegRef>& refs) {
     if (model_.pixel_term()) {
       double c = 0;
       for_each_cell_cost(cell, refs, [&](uint32_t, double r) { c += r; });
@@ -676,7 +676,7 @@ class Builder {
 
   /// A node's parts name their segments in increasing but sparse order, which the hardware does
   /// not predict: the segment a few parts ahead is fetched while this one is used.
-  void prefetch_ends(const std::vector<SegRef>& refs, size_t i) const {
+  void prefetch_ends(const RawVector<SegRef>& refs, size_t i) const {
     constexpr size_t kAhead = 48;
     if (i + kAhead < refs.size()) __builtin_prefetch(&ends_[refs[i + kAhead].id]);
   }
@@ -684,7 +684,7 @@ class Builder {
   /// With the pixel term: calls f(object, r(o) in this cell) once for every object the cell's
   /// segments see (pixels estimated from the cell's bounding box, cost_model.h).
   template <typename F>
-  void for_each_cell_cost(const ConvexPolyhedron& cell, const std::vector<SegRef>& refs, F&& f) {
+  void for_each_cell_cost(const ConvexPolyhedron& cell, const RawVector<SegRef>& refs, F&& f) {
     const std::vector<Vec3> points = pixel_estimation_points(cell.bounds());
     Marks& m = marks_.local();
     m.reset(r_.size());
@@ -705,7 +705,7 @@ class Builder {
 
   /// A node's volume, weight and r(PVS) (thread-safe: the two children are measured at once);
   /// r(PVS) from the node's extents when they are known and the costs are global.
-  BspNode measure_node(int32_t parent, const ConvexPolyhedron& cell, const std::vector<SegRef>& refs,
+  BspNode measure_node(int32_t parent, const ConvexPolyhedron& cell, const RawVector<SegRef>& refs,
                        const NodeExtents* ext) {
     BspNode node;
     node.parent = parent;
@@ -715,12 +715,12 @@ class Builder {
     return node;
   }
 
-  int32_t add_node(int32_t parent, ConvexPolyhedron cell, std::vector<SegRef> refs) {
+  int32_t add_node(int32_t parent, ConvexPolyhedron cell, RawVector<SegRef> refs) {
     const BspNode node = measure_node(parent, cell, refs, nullptr);
     return add_node(node, std::move(cell), std::move(refs));
   }
 
-  int32_t add_node(const BspNode& node, ConvexPolyhedron cell, std::vector<SegRef> refs) {
+  int32_t add_node(const BspNode& node, ConvexPolyhedron cell, RawVector<SegRef> refs) {
     const int32_t parent = node.parent;
     depth_.push_back(parent < 0 ? 0 : depth_[parent] + 1);
     out_.nodes.push_back(node);
@@ -732,7 +732,7 @@ class Builder {
   /// A node's parts divided by a plane: each child's parts and, for AV-S, extents. It reads
   /// only the node's parts, so it can run beside other work (see run()).
   struct Partition {
-    std::vector<SegRef> side[2];
+    RawVector<SegRef> side[2];
     std::array<NodeExtents, 2> ext;
   };
 
@@ -743,7 +743,7 @@ class Builder {
     // its evaluation and r(PVS) need) gathered in the same pass; then both children written at
     // once. Both passes go chunk by chunk in parallel for large cells, each chunk at its own
     // offset and the extents joined in chunk order, so the result is the same for any threads.
-    const std::vector<SegRef>& refs = refs_[node];
+    const RawVector<SegRef>& refs = refs_[node];
     const size_t n = refs.size();
     // Chunks of at least kGrain parts, a few per thread (the result does not depend on them).
     constexpr size_t kGrain = 1 << 10;
@@ -752,8 +752,8 @@ class Builder {
         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
     const size_t chunks = std::clamp<size_t>((n + kGrain - 1) / kGrain, 1, threads == 1 ? 1 : 4 * threads);
     const size_t grain = (n + chunks - 1) / chunks;
-    std::vector<uint8_t> code(n);
-    std::vector<double> cut(n);  // where a crossing part is cut
+    RawVector<uint8_t> code(n);
+    RawVector<double> cut(n);  // where a crossing part is cut
     std::vector<std::array<size_t, 2>> at(chunks + 1, {0, 0});  // per chunk: its first index in each child
     std::vector<std::array<NodeExtents, 2>> chunk_ext(extents ? chunks : 0);
     auto for_chunks = [&](auto&& f) {
@@ -809,7 +809,7 @@ class Builder {
     }
     for (size_t c = 0; c < chunks; ++c)
       for (int k = 0; k < 2; ++k) at[c + 1][k] += at[c][k];
-    std::vector<SegRef>* side = out.side;
+    RawVector<SegRef>* side = out.side;
     side[0].resize(at[chunks][0]);
     side[1].resize(at[chunks][1]);
     for_chunks([&](size_t c) {
@@ -846,7 +846,7 @@ class Builder {
     }
     out_.planes.push_back(plane);
     Partition parts = ready ? std::move(*ready) : partition(node, plane);
-    std::vector<SegRef>* side = parts.side;
+    RawVector<SegRef>* side = parts.side;
     const bool extents = config_.strategy == SplitStrategy::kCost;
     std::array<NodeExtents, 2>& ext = parts.ext;
     refs_[node].clear();
@@ -905,7 +905,7 @@ class Builder {
     // The extents gathered when the node was split off (the root's are measured below).
     std::unique_ptr<NodeExtents> known;
     if (static_cast<size_t>(node) < pending_ext_.size()) known = std::move(pending_ext_[node]);
-    const std::vector<SegRef>& refs = refs_[node];
+    const RawVector<SegRef>& refs = refs_[node];
     if (refs.empty() || out_.nodes[node].pvs_cost == 0) return ev;
     RawVector<double> storage;
     const double* r = candidate_costs(node, storage);
@@ -993,7 +993,7 @@ class Builder {
 
   /// The coordinate along `axis` of the end i of a node's segment parts: the low end of part
   /// i / 2 for even i, its high end for odd i.
-  double part_end(const std::vector<SegRef>& refs, size_t i, int axis) const {
+  double part_end(const RawVector<SegRef>& refs, size_t i, int axis) const {
     const SegRef& s = refs[i >> 1];
     const SegEnds& e = ends_[s.id];
     const double c0 = e.at(s.t0)[axis], c1 = e.at(s.t1)[axis];
@@ -1004,7 +1004,7 @@ class Builder {
   /// the cell's bounds): all segment ends when there are at most max_axis_candidates, else a
   /// random choice, reproducible per node and axis (SubdivisionConfig::exact_candidates).
   std::vector<double> axis_positions(int32_t node, int axis, double lo_b, double hi_b) const {
-    const std::vector<SegRef>& refs = refs_[node];
+    const RawVector<SegRef>& refs = refs_[node];
     const size_t k = config_.max_axis_candidates;
     Rng rng(config_.seed, (static_cast<uint64_t>(node) << 2) | static_cast<uint64_t>(axis));
     std::vector<double> positions;
@@ -1112,7 +1112,7 @@ class Builder {
 
   /// The node's parts' extents per object (NodeExtents), in one pass over its parts (in
   /// parallel chunks for large nodes, merged in order, so the result is the same).
-  NodeExtents node_extents(const std::vector<SegRef>& refs) {
+  NodeExtents node_extents(const RawVector<SegRef>& refs) {
     auto fill = [&](size_t begin, size_t end, NodeExtents& into) {
       ExtentSlots& slots = extent_slots_.local();
       slots.reset(r_.size());
@@ -1188,7 +1188,7 @@ class Builder {
 
   /// Planes of non-axis-aligned triangles hit inside the node, a random subset; each costs O(n).
   Candidate best_geometry_candidate(int32_t node, Evaluation& ev, const double* r) {
-    const std::vector<SegRef>& refs = refs_[node];
+    const RawVector<SegRef>& refs = refs_[node];
     // Triangles hit at segment ends inside this node lie (at least partly) inside it.
     std::vector<uint32_t> tris;
     for (const SegRef& s : refs) {
@@ -1311,7 +1311,7 @@ class Builder {
   double total_volume_;
   double total_weight_ = 0;
   bool ga_ = false;
-  std::vector<std::vector<SegRef>> refs_;
+  std::vector<RawVector<SegRef>> refs_;
   HugePageArray<SegEnds> ends_;  ///< per segment, as segs_
   std::vector<uint32_t> depth_;              ///< per node
   std::vector<std::vector<uint32_t>> tris_;  ///< BSP baseline: per node, the polygons in it
