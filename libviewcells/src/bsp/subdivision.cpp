@@ -470,19 +470,27 @@ class DrawnSet {
 /// determinant of (q - p, r - p, s - p) in double, evaluated as CGAL's determinant() does
 /// with s - p in the last column (so the 2x2 minors of q - p and r - p are computed once per
 /// plane), against twice the error bound of CGAL's semi-static filter for it; Plane::side
-/// where that bound does not decide.
+/// where that bound does not decide. The bound grows with |s - p|, so the bound for the corner
+/// of the points' box farthest from p holds for all of them: it is tried first, and the
+/// point's own bound only where it does not decide (the same sign either way).
 class FilteredSide {
  public:
-  explicit FilteredSide(const Plane& plane) : plane_(plane), p_(plane.points[0]) {
+  FilteredSide(const Plane& plane, const Box3& points) : plane_(plane), p_(plane.points[0]) {
     const Vec3 pq = plane.points[1] - p_, pr = plane.points[2] - p_;
     m01_ = pq.x * pr.y - pq.y * pr.x;
     m02_ = pq.x * pr.z - pq.z * pr.x;
     m12_ = pq.y * pr.z - pq.z * pr.y;
     for (int k = 0; k < 3; ++k) max_[k] = std::max(std::abs(pq[k]), std::abs(pr[k]));
+    double box_eps = 2 * 5.1107127829973299e-15;
+    for (int k = 0; k < 3; ++k)
+      box_eps *= std::max({max_[k], std::abs(points.lo[k] - p_[k]), std::abs(points.hi[k] - p_[k])});
+    if (box_eps > 1e-280 && box_eps < 1e280) box_eps_ = box_eps;  // else never decides
   }
   int operator()(const Vec3& s) const {
     const double sx = s.x - p_.x, sy = s.y - p_.y, sz = s.z - p_.z;
     const double det = m01_ * sz - m02_ * sy + m12_ * sx;
+    if (det > box_eps_) return 1;
+    if (det < -box_eps_) return -1;
     const double eps = 2 * 5.1107127829973299e-15 * std::max(max_[0], std::abs(sx)) *
                        std::max(max_[1], std::abs(sy)) * std::max(max_[2], std::abs(sz));
     if (eps > 1e-280 && eps < 1e280) {  // no underflow or overflow in the bound
@@ -497,6 +505,7 @@ class FilteredSide {
   Vec3 p_;
   double m01_, m02_, m12_;
   double max_[3];
+  double box_eps_ = INFINITY;
 };
 
 struct Candidate {
@@ -1230,14 +1239,17 @@ class Builder {
       uint32_t object_a, object_b;
     };
     std::vector<PartEnds> parts(refs.size());
+    Box3 points;
     for (size_t i = 0; i < refs.size(); ++i) {
       prefetch_ends(refs, i);
       const SegEnds& e = ends_[refs[i].id];
       parts[i] = {e.at(refs[i].t0), e.at(refs[i].t1), e.object_a, e.object_b};
+      points.extend(parts[i].p0);
+      points.extend(parts[i].p1);
     }
     // A plane's reduction from every `stride`-th part (1: exact).
     auto reduction_of = [&](const Plane& plane, double vl, size_t stride) {
-      const FilteredSide side(plane);
+      const FilteredSide side(plane, points);
       auto& [neg, pos] = side_pair_marks_.local();
       neg.reset(r_.size());
       pos.reset(r_.size());
