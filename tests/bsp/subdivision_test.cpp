@@ -1,10 +1,12 @@
 // Invariants of the AV-S subdivision on generated scenes, and the sweep against brute force.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <tuple>
 
 #include "support/test_scenes.h"
 #include "viewcells/core/error.h"
@@ -239,23 +241,31 @@ TEST(Subdivision, ReplayGivesEveryCellCount) {
 /// The sweep's best axis-aligned split equals the best found by partitioning every segment
 /// anew for every candidate, on random segments with many ties: endpoints on a coarse grid,
 /// so segments end on candidate planes and lie in them.
+/// Segments on a lattice, many lying in lattice planes or ending on them, some seen by no object
+/// at one end: the sweep's hard cases (parts that are points along an axis, parts cut exactly
+/// at a plane).
+SegmentSet lattice_segments(uint64_t seed, int count) {
+  Rng rng(seed);
+  SegmentSet segs;
+  segs.view_box = {{0, 0, 0}, {8, 8, 8}};
+  for (int i = 0; i < count; ++i) {
+    Vec3 a{double(rng.below(9)), double(rng.below(9)), double(rng.below(9))};
+    Vec3 b = a;
+    b[static_cast<int>(rng.below(3))] = double(rng.below(9));  // axis-parallel: lies in planes
+    if (i % 3 == 0) b = {double(rng.below(9)), double(rng.below(9)), double(rng.below(9))};
+    if (a == b) b.x = a.x < 8 ? a.x + 1 : a.x - 1;
+    const uint32_t oa = rng.below(3) ? static_cast<uint32_t>(rng.below(16)) : kNoObject;
+    const uint32_t ob = static_cast<uint32_t>(rng.below(16));
+    segs.push_back(a, b, oa, ob, oa == kNoObject ? kNoObject : 0, 0);
+  }
+  return segs;
+}
+
 TEST(Subdivision, SweepMatchesBruteForce) {
   const Scene scene = test::cube_grid(4);  // 16 objects of 12 triangles; only their count matters
   const std::vector<double> r = per_object_costs(scene, CostModel{});
   for (uint64_t seed = 1; seed <= 5; ++seed) {
-    Rng rng(seed);
-    SegmentSet segs;
-    segs.view_box = {{0, 0, 0}, {8, 8, 8}};
-    for (int i = 0; i < 400; ++i) {
-      Vec3 a{double(rng.below(9)), double(rng.below(9)), double(rng.below(9))};
-      Vec3 b = a;
-      b[static_cast<int>(rng.below(3))] = double(rng.below(9));  // axis-parallel: lies in planes
-      if (i % 3 == 0) b = {double(rng.below(9)), double(rng.below(9)), double(rng.below(9))};
-      if (a == b) b.x = a.x < 8 ? a.x + 1 : a.x - 1;
-      const uint32_t oa = rng.below(3) ? static_cast<uint32_t>(rng.below(16)) : kNoObject;
-      const uint32_t ob = static_cast<uint32_t>(rng.below(16));
-      segs.push_back(a, b, oa, ob, oa == kNoObject ? kNoObject : 0, 0);
-    }
+    const SegmentSet segs = lattice_segments(seed, 400);
     SubdivisionConfig config;
     config.max_cells = 2;
     config.max_axis_candidates = 1000;  // no subsampling
@@ -286,6 +296,85 @@ TEST(Subdivision, SweepMatchesBruteForce) {
       }
     }
     EXPECT_NEAR(s.splits[0].reduction, best, 1e-9 * s.initial_cost) << "seed " << seed;
+  }
+}
+
+// Every split after the first is of a cell whose parts, extents and r(PVS) came from dividing
+// its parent's parts in one pass (and, for most, ahead of time): each must still be the best
+// axis-aligned split by brute force over that cell's parts, and each leaf's r(PVS) that of the
+// objects its segments see.
+TEST(Subdivision, LaterSplitsMatchBruteForce) {
+  const Scene scene = test::cube_grid(4);
+  const std::vector<double> r = per_object_costs(scene, CostModel{});
+  for (uint64_t seed = 1; seed <= 4; ++seed) {
+    const SegmentSet segs = lattice_segments(seed, 600);
+    SubdivisionConfig config;
+    config.max_cells = 12;
+    config.max_axis_candidates = 100000;  // every end position
+    config.geometry_aligned = GeometryAlignedMode::kOff;
+    config.min_reduction = 0;
+    config.show_progress = false;
+    const Subdivision s = subdivide(scene, segs, CostModel{}, config);
+    ASSERT_GE(s.splits.size(), 4u) << "seed " << seed;
+    const double w = s.nodes[0].weight;
+    for (size_t k = 1; k < s.splits.size(); ++k) {
+      // The tree before split k: the cell split then is a leaf, its parts the segments' pieces.
+      Subdivision before = s;
+      for (size_t j = k; j < s.splits.size(); ++j) before.nodes[s.splits[j].node].plane = -1;
+      before.splits.resize(k);
+      const int32_t node = s.splits[k].node;
+      rebuild_cells(before);
+      const Box3 box = before.cells[node].bounds();
+      std::vector<std::array<Vec3, 2>> parts;
+      std::vector<std::array<uint32_t, 2>> objects;
+      std::vector<std::tuple<int32_t, double, double>> pieces, stack;
+      for (size_t i = 0; i < segs.size(); ++i) {
+        pieces.clear();
+        before.pieces_of_segment(segs.a(i), segs.b(i), pieces, stack);
+        for (const auto& [leaf, t0, t1] : pieces) {
+          if (leaf != node) continue;
+          parts.push_back({segs.a(i) * (1.0 - t0) + segs.b(i) * t0, segs.a(i) * (1.0 - t1) + segs.b(i) * t1});
+          objects.push_back({segs.object_a[i], segs.object_b[i]});
+        }
+      }
+      ASSERT_FALSE(parts.empty());
+      double best = -INFINITY;
+      const double own = s.nodes[node].weight / w * s.nodes[node].pvs_cost;
+      for (int axis = 0; axis < 3; ++axis) {
+        std::vector<double> xs;
+        for (const auto& pe : parts)
+          for (const Vec3& p : pe)
+            if (p[axis] > box.lo[axis] && p[axis] < box.hi[axis]) xs.push_back(p[axis]);
+        std::sort(xs.begin(), xs.end());
+        xs.erase(std::unique(xs.begin(), xs.end()), xs.end());
+        for (double x : xs) {
+          std::vector<char> seen[2] = {std::vector<char>(16, 0), std::vector<char>(16, 0)};
+          double cost[2] = {0, 0};
+          for (size_t i = 0; i < parts.size(); ++i) {
+            const double c0 = parts[i][0][axis], c1 = parts[i][1][axis];
+            const int s0 = c0 > x ? 1 : (c0 < x ? -1 : 0), s1 = c1 > x ? 1 : (c1 < x ? -1 : 0);
+            const bool in_plane = s0 == 0 && s1 == 0;
+            const bool to[2] = {in_plane || s0 < 0 || s1 < 0, in_plane || s0 > 0 || s1 > 0};
+            for (int side = 0; side < 2; ++side)
+              for (uint32_t o : objects[i])
+                if (to[side] && o != kNoObject && !seen[side][o]) {
+                  seen[side][o] = 1;
+                  cost[side] += r[o];
+                }
+          }
+          const double share = (x - box.lo[axis]) / (box.hi[axis] - box.lo[axis]);
+          const double v = s.nodes[node].weight / w;
+          best = std::max(best, own - v * (share * cost[0] + (1 - share) * cost[1]));
+        }
+      }
+      EXPECT_NEAR(s.splits[k].reduction, best, 1e-9 * s.initial_cost) << "seed " << seed << ", split " << k;
+    }
+    const std::vector<std::vector<uint32_t>> pvs = leaf_pvs(s, segs);
+    for (int32_t leaf : s.leaves()) {
+      double c = 0;
+      for (uint32_t o : pvs[leaf]) c += r[o];
+      EXPECT_NEAR(s.nodes[leaf].pvs_cost, c, 1e-12 * s.initial_cost) << "seed " << seed << ", leaf " << leaf;
+    }
   }
 }
 
