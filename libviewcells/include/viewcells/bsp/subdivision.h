@@ -3,9 +3,11 @@
 /// the view space refined greedily, always splitting the leaf whose best plane reduces the
 /// expected render cost c(S) the most (priority: reduction + 1% of the leaf's own cost).
 /// Axis-aligned candidates lie at the clipped segment endpoints; both sides' r(PVS) at all k
-/// positions of an axis come from one pass over the node's segments (each object's first and
-/// last position on each side, then prefix sums: O(n log k) per node); geometry-aligned candidates are
-/// planes of scene triangles hit inside the node, a random subset of at most ga_candidates.
+/// positions of an axis come from each object's lowest and highest extent in the node, which
+/// the pass that divides its parent's parts gathers (then a binary search per object and prefix
+/// sums: O(n + objects log k) per node); geometry-aligned candidates are planes of scene
+/// triangles hit inside the node, a random subset of at most ga_candidates. While a split's
+/// children are evaluated, the next cell's parts are divided ahead; splits keep the serial order.
 /// Deterministic: the same inputs and seed give the same tree for any number of threads.
 #include <cstdint>
 #include <functional>
