@@ -19,13 +19,10 @@
 #include <array>
 #include <chrono>
 #include <cmath>
-#include <cstdlib>
 #include <cstring>
 #include <map>
 #include <memory>
 #include <queue>
-
-#include <sys/mman.h>
 
 #include "viewcells/core/default_init.h"
 #include "viewcells/core/error.h"
@@ -218,33 +215,6 @@ struct alignas(64) SegEnds {
   uint32_t object_a, object_b;
   /// The point a + t (b - a), rounded the same way wherever the subdivision needs it.
   Vec3 at(double t) const { return a * (1.0 - t) + b * t; }
-};
-
-/// A fixed-size array in 2 MB pages where the system offers them (Linux transparent huge
-/// pages on request): the subdivision reads SegEnds by id at random, and with 4 kB pages
-/// nearly every read of a 100 MB array also misses the address translation cache.
-template <class T>
-class HugePageArray {
- public:
-  explicit HugePageArray(size_t n) : n_(n) {
-    constexpr size_t kHuge = size_t{2} << 20;
-    const size_t bytes = std::max<size_t>(kHuge, (n * sizeof(T) + kHuge - 1) / kHuge * kHuge);
-    data_ = static_cast<T*>(std::aligned_alloc(kHuge, bytes));
-    if (!data_) throw std::bad_alloc();
-#ifdef MADV_HUGEPAGE
-    madvise(data_, bytes, MADV_HUGEPAGE);  // a hint: without it the pages are small, not wrong
-#endif
-  }
-  ~HugePageArray() { std::free(data_); }
-  HugePageArray(const HugePageArray&) = delete;
-  HugePageArray& operator=(const HugePageArray&) = delete;
-  T& operator[](size_t i) { return data_[i]; }
-  const T& operator[](size_t i) const { return data_[i]; }
-  size_t size() const { return n_; }
-
- private:
-  T* data_ = nullptr;
-  size_t n_ = 0;
 };
 
 /// Which children a segment part goes to, from the exact sides of its two ends:
@@ -1324,7 +1294,7 @@ class Builder {
   double total_weight_ = 0;
   bool ga_ = false;
   std::vector<RawVector<SegRef>> refs_;
-  HugePageArray<SegEnds> ends_;  ///< per segment, as segs_
+  std::vector<SegEnds> ends_;  ///< per segment, as segs_
   std::vector<uint32_t> depth_;              ///< per node
   std::vector<std::vector<uint32_t>> tris_;  ///< BSP baseline: per node, the polygons in it
   double pvs_budget_ = 0;
