@@ -114,16 +114,16 @@ def subdivision(*args):
                   f"{per_candidate(me) / per_candidate(c15e):.2f} exact ({m['counts']['see_through_segments']:,} see-through "
                   f"segments; a geometry-aligned candidate costs a pass over the cell's parts, an axis-aligned one a "
                   f"share of one pass).")
-        cm, cmkb = f"{d}/compare-map/summary.json", f"{d}/compare-map.kb"
-        if os.path.exists(cm) and os.path.exists(cmkb):
-            c = json.load(open(cm))
-            st, t = c["settings"], c["timings"]
-            total = t["load_seconds"] + t["construction_sampling_seconds"] + t["evaluation_sampling_seconds"] + \
-                t["evaluation_seconds"] + sum(m["build_seconds"] for m in c["methods"])
-            print(f"\n`compare` on oa_shouse with its defaults ({st['construction_samples']:,} construction and "
-                  f"{st['evaluation_samples']:,} evaluation samples, methods {', '.join(st['methods'])}, "
-                  f"{st['max_cells']:,} cells): {total:.0f} s of loading, sampling, building and evaluating, "
-                  f"peak memory {int(open(cmkb).read().split()[-1]) / 1024 ** 2:.2f} GB (goal: under 2 GB).")
+    cm, cmkb = f"{d}/compare-map/summary.json", f"{d}/compare-map.kb"
+    if os.path.exists(cm) and os.path.exists(cmkb):
+        c = json.load(open(cm))
+        st, t = c["settings"], c["timings"]
+        total = t["load_seconds"] + t["construction_sampling_seconds"] + t["evaluation_sampling_seconds"] + \
+            t["evaluation_seconds"] + sum(m["build_seconds"] for m in c["methods"])
+        print(f"\n`compare` on oa_shouse with its defaults ({st['construction_samples']:,} construction and "
+              f"{st['evaluation_samples']:,} evaluation samples, methods {', '.join(st['methods'])}, "
+              f"{st['max_cells']:,} cells): {total:.0f} s of loading, sampling, building and evaluating, "
+              f"peak memory {int(open(cmkb).read().split()[-1]) / 1e6:.2f} GB (goal: under 2 GB).")
     path = f"{d}/compare-candidates/curves.csv"
     if os.path.exists(path):
         rows = list(csv.DictReader(open(path)))

@@ -108,6 +108,25 @@ class Tables(unittest.TestCase):
         self.assertEqual(row(t, "10,000")[3], "0.9901")
         self.assertIn("subdivision 30.0 s fast, 90.0 s exact", t)
 
+    def test_subdivision_compare_on_a_map_reports_peak_memory(self):
+        for n in (500000, 1000000, 1500000, 2000000):
+            for name in ("build", "build-exact"):
+                dump(f"{self.d}/{name}-{n}.json", {
+                    "timings": {"sampling_seconds": 1, "subdivision_seconds": 10.0},
+                    "subdivision": {"final_cost": 5, "axis_candidates_evaluated": 7,
+                                    "geometry_candidates_evaluated": 0, "segment_parts_evaluated": 9}})
+        dump(f"{self.d}/compare-map/summary.json", {
+            "settings": {"construction_samples": 1000000, "evaluation_samples": 4000000,
+                         "methods": ["av-m", "av-s"], "max_cells": 2691},
+            "timings": {"load_seconds": 1, "construction_sampling_seconds": 2, "evaluation_sampling_seconds": 3,
+                        "evaluation_seconds": 4},
+            "methods": [{"method": "av-m", "build_seconds": 10}, {"method": "av-s", "build_seconds": 20}]})
+        with open(f"{self.d}/compare-map.kb", "w") as f:
+            f.write("1048576\n")
+        t = run("subdivision", self.d, 23, 50000)
+        self.assertIn("methods av-m, av-s, 2,691 cells): 40 s of loading, sampling, building and evaluating, "
+                      "peak memory 1.05 GB (goal: under 2 GB)", t)
+
     def test_candidates_ratios_to_exact_at_200(self):
         for k, fast_cost, exact_cost, fast_s in [(50, 12.0, 11.0, 1.0), (200, 10.5, 10.0, 2.0)]:
             run_dir = f"{self.d}/city-{k}"
