@@ -552,6 +552,7 @@ class Builder {
     };
     std::priority_queue<Entry, std::vector<Entry>, decltype(lower)> queue(lower);
     best_.resize(1);
+    if (gathers_extents()) pending_ext_.push_back(std::make_unique<NodeExtents>(node_extents(refs_[0])));
     evaluate_into(0);
     if (best_[0].valid) queue.push({priority(0), 0});
 
@@ -562,9 +563,12 @@ class Builder {
     // the queue are divided by its best plane. That cell is split next unless one of the
     // children outranks it; either way its division waits here until it is split (a few at
     // most are kept). Splits happen in exactly the serial order, so the tree is the same.
-    const bool look_ahead = config_.strategy == SplitStrategy::kCost;
+    const bool look_ahead = gathers_extents();
     constexpr size_t kMaxAhead = 4;
     std::vector<std::pair<int32_t, Partition>> ahead;
+    auto divided_ahead = [&](int32_t n) {
+      return std::find_if(ahead.begin(), ahead.end(), [&](const auto& entry) { return entry.first == n; });
+    };
     out_.stats.stop_reason = "reached the maximum number of cells";
     while (out_.leaf_count() < config_.max_cells) {
       if (queue.empty()) {
@@ -583,7 +587,7 @@ class Builder {
         break;
       }
       const double before = node_cost(node);
-      auto done = std::find_if(ahead.begin(), ahead.end(), [&](const auto& entry) { return entry.first == node; });
+      const auto done = divided_ahead(node);
       const bool split = apply_split(node, cand.plane, done == ahead.end() ? nullptr : &done->second);
       if (done != ahead.end()) ahead.erase(done);
       if (!split) continue;  // degenerate after all: leave the cell whole
@@ -595,8 +599,7 @@ class Builder {
       int32_t next = -1;
       if (look_ahead && !queue.empty() && out_.leaf_count() + 1 < config_.max_cells) {
         next = queue.top().second;
-        for (const auto& entry : ahead)
-          if (entry.first == next) next = -1;
+        if (divided_ahead(next) != ahead.end()) next = -1;
       }
       Partition next_parts;
       tbb::parallel_invoke([&] { evaluate_into(c0); }, [&] { evaluate_into(c1); },
@@ -715,8 +718,11 @@ class Builder {
     std::array<NodeExtents, 2> ext;
   };
 
+  /// AV-S evaluates cells by their extents, which splits gather; the baselines need none.
+  bool gathers_extents() const { return config_.strategy == SplitStrategy::kCost; }
+
   Partition partition(int32_t node, const Plane& plane) {
-    const bool extents = config_.strategy == SplitStrategy::kCost;
+    const bool extents = gathers_extents();
     // Sides first (bit 0 negative, bit 1 positive, bit 2: crosses, the negative part first,
     // bit 3: crosses, the positive part first), with each child's extents (NodeExtents, which
     // its evaluation and r(PVS) need) gathered in the same pass; then both children written at
@@ -734,7 +740,9 @@ class Builder {
     RawVector<uint8_t> code(n);
     RawVector<double> cut(n);  // where a crossing part is cut
     std::vector<std::array<size_t, 2>> at(chunks + 1, {0, 0});  // per chunk: its first index in each child
-    std::vector<std::array<NodeExtents, 2>> chunk_ext(extents ? chunks : 0);
+    std::array<std::vector<NodeExtents>, 2> chunk_ext;  // per side, per chunk
+    if (extents)
+      for (auto& side_ext : chunk_ext) side_ext.resize(chunks);
     auto for_chunks = [&](auto&& f) {
       if (chunks == 1) return f(size_t{0});
       tbb::parallel_for(size_t{0}, chunks, [&](size_t c) { f(c); });
@@ -759,33 +767,24 @@ class Builder {
           if (extents) {
             const Vec3 mid = e.at(cut[i]);
             const int first = s0 < 0 ? 0 : 1;
-            slots[first].add_part(p0, mid, e.object_a, e.object_b, chunk_ext[c][first]);
-            slots[1 - first].add_part(mid, p1, e.object_a, e.object_b, chunk_ext[c][1 - first]);
+            slots[first].add_part(p0, mid, e.object_a, e.object_b, chunk_ext[first][c]);
+            slots[1 - first].add_part(mid, p1, e.object_a, e.object_b, chunk_ext[1 - first][c]);
           }
         } else if (extents) {
           for (int k = 0; k < 2; ++k)
-            if (to & (1 << k)) slots[k].add_part(p0, p1, e.object_a, e.object_b, chunk_ext[c][k]);
+            if (to & (1 << k)) slots[k].add_part(p0, p1, e.object_a, e.object_b, chunk_ext[k][c]);
         }
         code[i] = static_cast<uint8_t>(to);
         count[0] += to & 1;
         count[1] += (to >> 1) & 1;
       }
       if (extents)
-        for (int k = 0; k < 2; ++k) slots[k].finish(chunk_ext[c][k]);
+        for (int k = 0; k < 2; ++k) slots[k].finish(chunk_ext[k][c]);
       at[c + 1] = {count[0], count[1]};
     });
     Partition out;
-    std::array<NodeExtents, 2>& ext = out.ext;
-    if (chunks == 1 && extents) {
-      ext = std::move(chunk_ext[0]);
-    } else if (extents) {
-      for (int k = 0; k < 2; ++k) {
-        ExtentSlots& slots = extent_slots_.local();
-        slots.reset(r_.size());
-        for (const auto& ce : chunk_ext) slots.merge(ce[k], ext[k]);
-        slots.finish(ext[k]);
-      }
-    }
+    if (extents)
+      for (int k = 0; k < 2; ++k) out.ext[k] = join_extents(chunk_ext[k]);
     for (size_t c = 0; c < chunks; ++c)
       for (int k = 0; k < 2; ++k) at[c + 1][k] += at[c][k];
     RawVector<SegRef>* side = out.side;
@@ -826,7 +825,7 @@ class Builder {
     out_.planes.push_back(plane);
     Partition parts = ready ? std::move(*ready) : partition(node, plane);
     RawVector<SegRef>* side = parts.side;
-    const bool extents = config_.strategy == SplitStrategy::kCost;
+    const bool extents = gathers_extents();
     std::array<NodeExtents, 2>& ext = parts.ext;
     refs_[node].clear();
     refs_[node].shrink_to_fit();
@@ -881,18 +880,16 @@ class Builder {
       case SplitStrategy::kPolygonBsp: ev.best = best_polygon_candidate(node, ev); return ev;
       default: ev.best = kd_candidate(node); ++ev.axis; return ev;
     }
-    // The extents gathered when the node was split off (the root's are measured below).
-    std::unique_ptr<NodeExtents> known;
-    if (static_cast<size_t>(node) < pending_ext_.size()) known = std::move(pending_ext_[node]);
+    // The extents gathered when the node was split off (the root's when it was made).
+    const std::unique_ptr<NodeExtents> ext = std::move(pending_ext_[node]);
     const RawVector<SegRef>& refs = refs_[node];
     if (refs.empty() || out_.nodes[node].pvs_cost == 0) return ev;
     RawVector<double> storage;
     const double* r = candidate_costs(node, storage);
-    const NodeExtents& ext = known ? *known : *(known = std::make_unique<NodeExtents>(node_extents(refs)));
     Candidate results[4];
     auto task = [&](int t) {
       if (t < 3) {
-        results[t] = best_axis_candidate(node, t, ext, ev, r);
+        results[t] = best_axis_candidate(node, t, *ext, ev, r);
       } else if (ga_) {
         results[3] = best_geometry_candidate(node, ev, r);
       }
@@ -1091,6 +1088,17 @@ class Builder {
 
   /// The node's parts' extents per object (NodeExtents), in one pass over its parts (in
   /// parallel chunks for large nodes, merged in order, so the result is the same).
+  /// The extents of consecutive chunks of parts joined in chunk order (the first moved).
+  NodeExtents join_extents(std::vector<NodeExtents>& chunks) {
+    if (chunks.size() == 1) return std::move(chunks[0]);
+    NodeExtents all;
+    ExtentSlots& slots = extent_slots_.local();
+    slots.reset(r_.size());
+    for (const NodeExtents& c : chunks) slots.merge(c, all);
+    slots.finish(all);
+    return all;
+  }
+
   NodeExtents node_extents(const RawVector<SegRef>& refs) {
     auto fill = [&](size_t begin, size_t end, NodeExtents& into) {
       ExtentSlots& slots = extent_slots_.local();
@@ -1104,20 +1112,11 @@ class Builder {
       slots.finish(into);
     };
     constexpr size_t kGrain = 1 << 15;
-    NodeExtents all;
-    if (refs.size() <= kGrain) {
-      fill(0, refs.size(), all);
-      return all;
-    }
-    std::vector<NodeExtents> chunks((refs.size() + kGrain - 1) / kGrain);
+    std::vector<NodeExtents> chunks(std::max<size_t>(1, (refs.size() + kGrain - 1) / kGrain));
     tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t c) {
       fill(c * kGrain, std::min(refs.size(), (c + 1) * kGrain), chunks[c]);
     });
-    ExtentSlots& slots = extent_slots_.local();
-    slots.reset(r_.size());
-    for (const NodeExtents& c : chunks) slots.merge(c, all);
-    slots.finish(all);
-    return all;
+    return join_extents(chunks);
   }
 
   /// The best axis-aligned split of `node` along `axis` among its candidate positions.
