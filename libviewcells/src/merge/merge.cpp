@@ -1,17 +1,22 @@
 // View space merging (view-cell-construction paper, section 4.3) and extraction (section 5.1).
 //
-// The neighbour graph is a Boost.Graph adjacency list over merge-history node ids: merging x
-// and y adds node z with the union of their neighbours and clears x and y. The queue holds
-// (delta, x, y); an entry whose x or y has merged since is stale and skipped when popped, so
-// the queue is never rescanned. delta needs only the intersection of the two PVSs when the
-// object costs do not depend on the cell (c = 0): r(x + y) = r(x) + r(y) - r(x n y).
+// The neighbour graph is a sorted neighbour list per merge-history node id: merging x and y
+// adds node z (the largest id so far, so appending it keeps every list sorted) with the union
+// of their neighbours and clears x and y. The queue holds (delta, x, y); an entry whose x or y
+// has merged since is stale and skipped when popped, so the queue is never rescanned. delta
+// needs only the objects the two PVSs share when the object costs do not depend on the cell
+// (c = 0): r(x + y) = r(x) + r(y) - r(x n y). One cell's objects are marked with their r(o) in
+// an array over the objects, and each partner's list sums its marks in its own (ascending)
+// order, adding 0 for the objects not shared: the same additions in the same order as walking
+// the two lists together, without the walk's unpredictable branches.
 #include "viewcells/merge/merge.h"
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <boost/graph/adjacency_list.hpp>
 #include <chrono>
+#include <iterator>
 #include <queue>
 
 #include "viewcells/bsp/adjacency.h"
@@ -165,8 +170,6 @@ std::vector<uint32_t> MergeHistory::leaves_under(int32_t n) const {
 
 namespace {
 
-using Graph = boost::adjacency_list<boost::setS, boost::vecS, boost::undirectedS>;
-
 struct Entry {
   double delta;
   int32_t x, y;  // x < y
@@ -181,7 +184,8 @@ struct Later {  // min-heap on delta; ties: smaller ids first
 class Merger {
  public:
   Merger(const Scene& scene, const CellPartition& p, const CostModel& model)
-      : scene_(scene), p_(p), model_(model), r_(per_object_costs(scene, model)) {}
+      : scene_(scene), p_(p), model_(model), r_(per_object_costs(scene, model)),
+        marks_([n = scene.objects.size()] { return std::vector<double>(n, 0.0); }) {}
 
   MergeHistory run(const MergeConfig& config) {
     const auto start = std::chrono::steady_clock::now();
@@ -190,7 +194,7 @@ class Merger {
     h.leaf_count = static_cast<uint32_t>(L);
     h.nodes.resize(L);
     pvs_.resize(2 * L);
-    Graph graph(2 * L);
+    adjacent_.assign(2 * L, {});
     for (size_t i = 0; i < L; ++i) {
       MergeNode& n = h.nodes[i];
       n.weight = p_.weight[i];
@@ -205,7 +209,14 @@ class Merger {
     W_ = h.total_weight;
     for (size_t i = 0; i < L; ++i) h.initial_cost += h.nodes[i].weight / W_ * h.nodes[i].pvs_cost;
     for (const auto& [a, b] : p_.neighbours)
-      if (a != b) boost::add_edge(a, b, graph);
+      if (a != b) {
+        adjacent_[a].push_back(static_cast<int32_t>(b));
+        adjacent_[b].push_back(static_cast<int32_t>(a));
+      }
+    for (std::vector<int32_t>& list : adjacent_) {
+      std::sort(list.begin(), list.end());
+      list.erase(std::unique(list.begin(), list.end()), list.end());
+    }
 
     const size_t target = std::max<size_t>(1, config.min_cells);
     alive_ = L;
@@ -215,7 +226,7 @@ class Merger {
     for (const auto& [x, y] : config.prefix) {
       if (alive_ <= target) break;
       check_prefix_pair(h, x, y);
-      merge(h, graph, x, y, around);
+      merge(h, x, y, around);
       if (config.show_progress) progress.advance(1);
     }
     if (!config.block.empty()) {
@@ -225,13 +236,13 @@ class Merger {
       for (size_t k = L; k < h.nodes.size(); ++k) block_[k] = block_[h.nodes[k].child[0]];
     }
     constrained_ = !config.block.empty() && alive_ > config.barrier_cells;
-    std::priority_queue<Entry, std::vector<Entry>, Later> queue(Later{}, all_pairs(h, graph));
+    std::priority_queue<Entry, std::vector<Entry>, Later> queue(Later{}, all_pairs(h));
     std::vector<Entry> fresh;
     while (alive_ > target) {
       if (queue.empty()) {
         if (!constrained_) break;
         constrained_ = false;  // blocks that cannot merge further: the barrier is lifted
-        queue = decltype(queue)(Later{}, all_pairs(h, graph));
+        queue = decltype(queue)(Later{}, all_pairs(h));
         continue;
       }
       const Entry e = queue.top();
@@ -240,18 +251,18 @@ class Merger {
         ++h.stats.stale;
         continue;
       }
-      const int32_t z = merge(h, graph, e.x, e.y, around);
+      const int32_t z = merge(h, e.x, e.y, around);
       if (constrained_) block_[z] = block_[e.x];
       if (config.show_progress) progress.advance(1);
       if (constrained_ && alive_ <= config.barrier_cells) {
         constrained_ = false;  // at the barrier: every neighbouring pair from now on
-        queue = decltype(queue)(Later{}, all_pairs(h, graph));
+        queue = decltype(queue)(Later{}, all_pairs(h));
         continue;
       }
       fresh.clear();
       for (int32_t n : around)
         if (allowed(n, z)) fresh.push_back({0.0, n, z});
-      evaluate(h, fresh);
+      evaluate(h, fresh, &Entry::y);
       for (const Entry& f : fresh) queue.push(f);
     }
     if (config.show_progress) progress.finish();
@@ -263,13 +274,13 @@ class Merger {
   bool allowed(int32_t x, int32_t y) const { return !constrained_ || block_[x] == block_[y]; }
 
   /// Every allowed neighbouring pair of the current cells, evaluated.
-  std::vector<Entry> all_pairs(MergeHistory& h, const Graph& graph) {
+  std::vector<Entry> all_pairs(MergeHistory& h) {
     std::vector<Entry> entries;
     for (size_t v = 0; v < h.nodes.size(); ++v)
-      for (auto [it, end] = boost::adjacent_vertices(v, graph); it != end; ++it)
-        if (v < *it && allowed(static_cast<int32_t>(v), static_cast<int32_t>(*it)))
-          entries.push_back({0.0, static_cast<int32_t>(v), static_cast<int32_t>(*it)});
-    evaluate(h, entries);
+      for (int32_t w : adjacent_[v])
+        if (static_cast<int32_t>(v) < w && allowed(static_cast<int32_t>(v), w))
+          entries.push_back({0.0, static_cast<int32_t>(v), w});
+    evaluate(h, entries, &Entry::x);
     return entries;
   }
 
@@ -281,7 +292,7 @@ class Merger {
   }
 
   /// Merges current cells x and y into a new node z; `around` gets z's neighbours.
-  int32_t merge(MergeHistory& h, Graph& graph, int32_t x, int32_t y, std::vector<int32_t>& around) {
+  int32_t merge(MergeHistory& h, int32_t x, int32_t y, std::vector<int32_t>& around) {
     const int32_t z = static_cast<int32_t>(h.nodes.size());
     MergeNode node;
     node.child[0] = x;
@@ -301,18 +312,22 @@ class Merger {
     h.nodes[y].parent = z;
     h.cost_after.push_back(cost_);
     --alive_;
-    // z inherits the neighbours of x and y.
+    // z inherits the neighbours of x and y (both lists sorted, so their union is too).
     around.clear();
-    for (int32_t side : {x, y})
-      for (auto [it, end] = boost::adjacent_vertices(side, graph); it != end; ++it)
-        if (static_cast<int32_t>(*it) != x && static_cast<int32_t>(*it) != y) around.push_back(static_cast<int32_t>(*it));
-    std::sort(around.begin(), around.end());
-    around.erase(std::unique(around.begin(), around.end()), around.end());
-    boost::clear_vertex(x, graph);
-    boost::clear_vertex(y, graph);
+    std::set_union(adjacent_[x].begin(), adjacent_[x].end(), adjacent_[y].begin(), adjacent_[y].end(),
+                   std::back_inserter(around));
+    around.erase(std::remove_if(around.begin(), around.end(), [&](int32_t n) { return n == x || n == y; }),
+                 around.end());
+    for (int32_t n : around) {
+      std::vector<int32_t>& list = adjacent_[n];
+      list.erase(std::remove_if(list.begin(), list.end(), [&](int32_t m) { return m == x || m == y; }), list.end());
+      list.push_back(z);  // z is the largest id so far: the list stays sorted
+    }
+    adjacent_[z] = around;
+    adjacent_[x] = {};
+    adjacent_[y] = {};
     pvs_[x] = {};
     pvs_[y] = {};
-    for (int32_t n : around) boost::add_edge(n, z, graph);
     return z;
   }
 
@@ -320,52 +335,65 @@ class Merger {
     return viewcells::pvs_cost(scene_, r_, model_, pvs, bounds);
   }
 
-  /// delta(x, y) for every entry.
-  void evaluate(MergeHistory& h, std::vector<Entry>& entries) {
-    const size_t grain = entries.size() > 64 ? 16 : entries.size() + 1;  // small sets: no tasks
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, entries.size(), grain), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i < r.end(); ++i) entries[i].delta = delta(h, entries[i].x, entries[i].y);
-    });
+  /// delta(x, y) for every entry. Without the pixel term, consecutive entries that share their
+  /// `shared` side (x or y) mark its objects once and sum the other side's marks.
+  void evaluate(MergeHistory& h, std::vector<Entry>& entries, int32_t Entry::*shared) {
     h.stats.evaluations += entries.size();
+    size_t work = 0;  // list entries read: small sets run without tasks
+    for (const Entry& e : entries) work += pvs_[e.x].size() + pvs_[e.y].size();
+    const size_t grain = work > (size_t{1} << 15) ? std::max<size_t>(1, entries.size() / 64) : entries.size() + 1;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, entries.size(), grain), [&](const tbb::blocked_range<size_t>& r) {
+      if (model_.pixel_term()) {
+        for (size_t i = r.begin(); i < r.end(); ++i) entries[i].delta = delta_united(h, entries[i].x, entries[i].y);
+        return;
+      }
+      std::vector<double>& marks = marks_.local();
+      int32_t marked = -1;
+      for (size_t i = r.begin(); i < r.end(); ++i) {
+        Entry& e = entries[i];
+        const int32_t s = e.*shared, other = s == e.x ? e.y : e.x;
+        if (s != marked) {
+          if (marked >= 0) set_marks(marks, marked, false);
+          set_marks(marks, s, true);
+          marked = s;
+        }
+        double common = 0;  // r(x n y), summed over the objects in ascending order
+        for (uint32_t o : pvs_[other]) common += marks[o];
+        const MergeNode &nx = h.nodes[e.x], &ny = h.nodes[e.y];
+        e.delta = merged_delta(nx, ny, nx.pvs_cost + ny.pvs_cost - common);
+      }
+      if (marked >= 0) set_marks(marks, marked, false);
+    });
   }
 
-  double delta(const MergeHistory& h, int32_t x, int32_t y) const {
-    const MergeNode &nx = h.nodes[x], &ny = h.nodes[y];
-    const std::vector<uint32_t>&a = pvs_[x], &b = pvs_[y];
-    double merged;
-    if (!model_.pixel_term()) {
-      // r(x + y) = r(x) + r(y) - r(x n y): only the common objects need visiting.
-      double common = 0;
-      auto i = a.begin(), j = b.begin();
-      while (i != a.end() && j != b.end()) {
-        if (*i < *j) {
-          ++i;
-        } else if (*j < *i) {
-          ++j;
-        } else {
-          common += r_[*i];
-          ++i, ++j;
-        }
-      }
-      merged = nx.pvs_cost + ny.pvs_cost - common;
-    } else {
-      Box3 bounds = nx.bounds;
-      bounds.extend(ny.bounds);
-      merged = pvs_cost(unite_sorted(a, b), bounds);
-    }
+  void set_marks(std::vector<double>& marks, int32_t cell, bool on) const {
+    for (uint32_t o : pvs_[cell]) marks[o] = on ? r_[o] : 0.0;
+  }
+
+  double merged_delta(const MergeNode& nx, const MergeNode& ny, double merged) const {
     return ((nx.weight + ny.weight) * merged - nx.weight * nx.pvs_cost - ny.weight * ny.pvs_cost) / W_;
+  }
+
+  /// delta(x, y) with the pixel term: r(x + y) of the united PVS over the united bounds.
+  double delta_united(const MergeHistory& h, int32_t x, int32_t y) const {
+    const MergeNode &nx = h.nodes[x], &ny = h.nodes[y];
+    Box3 bounds = nx.bounds;
+    bounds.extend(ny.bounds);
+    return merged_delta(nx, ny, pvs_cost(unite_sorted(pvs_[x], pvs_[y]), bounds));
   }
 
   const Scene& scene_;
   const CellPartition& p_;
   const CostModel& model_;
   const std::vector<double> r_;
+  tbb::enumerable_thread_specific<std::vector<double>> marks_;  ///< r(o) of a marked cell's objects, else 0
   double W_ = 1;
   size_t alive_ = 0;
   double cost_ = 0;
   bool constrained_ = false;
   std::vector<int32_t> block_;  ///< per MHT node, with a barrier
   std::vector<std::vector<uint32_t>> pvs_;  ///< per MHT node, while it is a current cell
+  std::vector<std::vector<int32_t>> adjacent_;  ///< per MHT node, its current neighbours, sorted
 };
 
 ViewCellSet make_set(const MergeHistory& h, size_t k, std::string rule) {
