@@ -1,8 +1,10 @@
 #include "viewcells/bsp/adjacency.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <map>
 
 namespace viewcells {
 namespace {
@@ -108,20 +110,24 @@ std::vector<LeafAdjacency> leaf_adjacency(const Subdivision& s, const std::vecto
                                           double min_relative_area) {
   const double min_area = min_relative_area * s.view_box.diagonal() * s.view_box.diagonal();
   // Faces on split planes (ids >= 6; 0..5 are the view box), by plane and side.
-  std::map<int32_t, std::vector<std::pair<int32_t, size_t>>> faces[2];  // [positive side?][plane] -> (leaf, face)
+  using FaceList = std::vector<std::pair<int32_t, size_t>>;  // (leaf, face)
+  std::vector<std::array<FaceList, 2>> faces(s.planes.size());  // [plane][positive side?]
   for (int32_t leaf : leaves) {
     const auto& cell_faces = s.cells[leaf].faces();
     for (size_t f = 0; f < cell_faces.size(); ++f) {
       const PolyFace& face = cell_faces[f];
       if (face.plane < 6) continue;
       // Outward along +normal means the leaf lies on the plane's negative side.
-      faces[face.outward_positive ? 0 : 1][face.plane].push_back({leaf, f});
+      faces[face.plane][face.outward_positive ? 0 : 1].push_back({leaf, f});
     }
   }
-  std::map<std::pair<int32_t, int32_t>, double> shared;
-  for (const auto& [plane_id, neg_faces] : faces[0]) {
-    const auto it = faces[1].find(plane_id);
-    if (it == faces[1].end()) continue;
+  std::vector<int32_t> shared_planes;  // planes with faces on both sides, ascending
+  for (size_t k = 0; k < faces.size(); ++k)
+    if (!faces[k][0].empty() && !faces[k][1].empty()) shared_planes.push_back(static_cast<int32_t>(k));
+  // Each plane alone, in parallel; the pairs are then put together in plane order.
+  std::vector<std::vector<LeafAdjacency>> found(shared_planes.size());
+  tbb::parallel_for(size_t{0}, shared_planes.size(), [&](size_t k) {
+    const int32_t plane_id = shared_planes[k];
     const Plane& plane = s.planes[plane_id];
     const Vec3 n = plane.normal;
     const Vec3 u = normalize(std::abs(n.x) < 0.9 ? cross(n, Vec3{1, 0, 0}) : cross(n, Vec3{0, 1, 0}));
@@ -130,11 +136,13 @@ std::vector<LeafAdjacency> leaf_adjacency(const Subdivision& s, const std::vecto
     // faces far from the world's origin (a city at 1e5) keep their digits.
     const Vec3 centre = s.view_box.center();
     const Vec3 origin = centre - n * plane.distance(centre);
-    auto project = [&](int32_t leaf, size_t f, bool reverse) {
+    // A face's corners in the plane's frame; `sides` (the face as half-planes) only for the
+    // faces that are clipped against.
+    auto project = [&](int32_t leaf, size_t f, bool reverse, bool sides) {
       Poly2 p;
       p.leaf = leaf;
       const ConvexPolyhedron& cell = s.cells[leaf];
-      p.sides = face_sides(cell, f, s.planes, origin, u, v, reverse);
+      if (sides) p.sides = face_sides(cell, f, s.planes, origin, u, v, reverse);
       for (uint32_t id : cell.faces()[f].vertices) {
         const Vec3 d = cell.vertices()[id] - origin;
         p.pts.push_back({dot(d, u), dot(d, v)});
@@ -151,21 +159,39 @@ std::vector<LeafAdjacency> leaf_adjacency(const Subdivision& s, const std::vecto
     // Faces of leaves on the negative side point along +n (counter-clockwise about +n already);
     // those on the positive side point along -n, so reverse them.
     std::vector<Poly2> a, b;
-    for (const auto& [leaf, f] : neg_faces) a.push_back(project(leaf, f, false));
-    for (const auto& [leaf, f] : it->second) b.push_back(project(leaf, f, true));
+    for (const auto& [leaf, f] : faces[plane_id][0]) a.push_back(project(leaf, f, false, false));
+    for (const auto& [leaf, f] : faces[plane_id][1]) b.push_back(project(leaf, f, true, true));
     std::sort(b.begin(), b.end(), [](const Poly2& x, const Poly2& y) { return x.xmin < y.xmin; });
+    // reach[i]: the largest xmax of b[0..i]. The faces before the first whose reach passes
+    // p.xmin all end left of p.
+    std::vector<double> reach(b.size());
+    for (size_t i = 0; i < b.size(); ++i) reach[i] = std::max(b[i].xmax, i ? reach[i - 1] : -INFINITY);
     for (const Poly2& p : a) {
-      for (const Poly2& q : b) {
+      const size_t first = static_cast<size_t>(
+          std::upper_bound(reach.begin(), reach.end(), p.xmin) - reach.begin());
+      for (size_t i = first; i < b.size(); ++i) {
+        const Poly2& q = b[i];
         if (q.xmin >= p.xmax) break;
         if (q.xmax <= p.xmin || q.ymin >= p.ymax || q.ymax <= p.ymin) continue;
         const double area = overlap_area(p.pts, q.sides);
-        if (area > min_area) shared[{std::min(p.leaf, q.leaf), std::max(p.leaf, q.leaf)}] += area;
+        if (area > min_area) found[k].push_back({std::min(p.leaf, q.leaf), std::max(p.leaf, q.leaf), area});
       }
     }
-  }
+  });
+  // One entry per pair; a pair met on more than one plane sums its areas in plane order.
   std::vector<LeafAdjacency> out;
-  out.reserve(shared.size());
-  for (const auto& [pair, area] : shared) out.push_back({pair.first, pair.second, area});
+  for (const std::vector<LeafAdjacency>& f : found) out.insert(out.end(), f.begin(), f.end());
+  std::stable_sort(out.begin(), out.end(),
+                   [](const LeafAdjacency& x, const LeafAdjacency& y) { return x.a != y.a ? x.a < y.a : x.b < y.b; });
+  size_t kept = 0;
+  for (size_t i = 0; i < out.size(); ++i) {
+    if (kept && out[kept - 1].a == out[i].a && out[kept - 1].b == out[i].b) {
+      out[kept - 1].area += out[i].area;
+    } else {
+      out[kept++] = out[i];
+    }
+  }
+  out.resize(kept);
   return out;
 }
 

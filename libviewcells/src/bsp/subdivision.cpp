@@ -23,6 +23,7 @@
 #include <map>
 #include <memory>
 #include <queue>
+#include <utility>
 
 #include "viewcells/core/default_init.h"
 #include "viewcells/core/error.h"
@@ -1336,13 +1337,31 @@ std::vector<std::vector<uint32_t>> leaf_pvs(const Subdivision& s, const SegmentS
   for (size_t i = 0; i < segments.size(); ++i)
     for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
       if (o != kNoObject) objects = std::max(objects, o + 1);
-  // Each leaf's distinct objects (first-seen marks), then sorted: each leaf alone, in parallel.
+  // Each leaf's distinct objects, sorted; each leaf alone, in parallel. A leaf with many
+  // segments against the object count sets bits and reads them in order (a pass over one bit
+  // per object); one with few marks the objects it meets first and sorts them.
+  const size_t words = (objects + 63) / 64;
   tbb::enumerable_thread_specific<Marks> marks;
+  tbb::enumerable_thread_specific<std::vector<uint64_t>> bits([words] { return std::vector<uint64_t>(words, 0); });
   tbb::parallel_for(size_t{0}, leaves.size(), [&](size_t l) {
+    const std::vector<uint32_t>& in = s.segments[leaves[l]];
+    auto& ids = pvs[leaves[l]];
+    if (words <= 2 * in.size()) {
+      std::vector<uint64_t>& b = bits.local();
+      for (uint32_t i : in)
+        for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
+          if (o != kNoObject) b[o >> 6] |= uint64_t{1} << (o & 63);
+      size_t count = 0;
+      for (uint64_t x : b) count += static_cast<size_t>(__builtin_popcountll(x));
+      ids.reserve(count);
+      for (size_t w = 0; w < words; ++w)
+        for (uint64_t x = std::exchange(b[w], 0); x; x &= x - 1)
+          ids.push_back(static_cast<uint32_t>(w * 64 + static_cast<size_t>(__builtin_ctzll(x))));
+      return;
+    }
     Marks& m = marks.local();
     m.reset(objects);
-    auto& ids = pvs[leaves[l]];
-    for (uint32_t i : s.segments[leaves[l]])
+    for (uint32_t i : in)
       for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
         if (m.first(o)) ids.push_back(o);
     std::sort(ids.begin(), ids.end());

@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <iterator>
 #include <queue>
 
@@ -184,7 +185,7 @@ struct Later {  // min-heap on delta; ties: smaller ids first
 class Merger {
  public:
   Merger(const Scene& scene, const CellPartition& p, const CostModel& model)
-      : scene_(scene), p_(p), model_(model), r_(per_object_costs(scene, model)),
+      : scene_(scene), p_(p), model_(model), r_(per_object_costs(scene, model)), whole_costs_(whole_and_small(r_)),
         marks_([n = scene.objects.size()] { return std::vector<double>(n, 0.0); }) {}
 
   MergeHistory run(const MergeConfig& config) {
@@ -357,13 +358,46 @@ class Merger {
           set_marks(marks, s, true);
           marked = s;
         }
-        double common = 0;  // r(x n y), summed over the objects in ascending order
-        for (uint32_t o : pvs_[other]) common += marks[o];
+        const double common = shared_cost(marks, pvs_[other]);
         const MergeNode &nx = h.nodes[e.x], &ny = h.nodes[e.y];
         e.delta = merged_delta(nx, ny, nx.pvs_cost + ny.pvs_cost - common);
       }
       if (marked >= 0) set_marks(marks, marked, false);
     });
+  }
+
+  /// r(x n y): the marks of x summed over y's objects. In ascending order, one addition after
+  /// the other; or, when every r(o) is a whole number and their total is below 2^53 (the default
+  /// model: max(a, b t_o) with whole a and b), in four running sums, which is then exact and so
+  /// bitwise the same, without waiting on each addition.
+  double shared_cost(const std::vector<double>& marks, const std::vector<uint32_t>& list) const {
+    const size_t n = list.size();
+    const uint32_t* o = list.data();
+    const double* m = marks.data();
+    if (!whole_costs_) {
+      double sum = 0;
+      for (size_t i = 0; i < n; ++i) sum += m[o[i]];
+      return sum;
+    }
+    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    size_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+      s0 += m[o[i]];
+      s1 += m[o[i + 1]];
+      s2 += m[o[i + 2]];
+      s3 += m[o[i + 3]];
+    }
+    for (; i < n; ++i) s0 += m[o[i]];
+    return (s0 + s1) + (s2 + s3);
+  }
+
+  static bool whole_and_small(const std::vector<double>& r) {
+    double total = 0;
+    for (double x : r) {
+      if (!(x >= 0) || x != std::floor(x)) return false;
+      total += x;
+    }
+    return total < 0x1p53;
   }
 
   void set_marks(std::vector<double>& marks, int32_t cell, bool on) const {
@@ -386,6 +420,7 @@ class Merger {
   const CellPartition& p_;
   const CostModel& model_;
   const std::vector<double> r_;
+  const bool whole_costs_;  ///< every r(o) whole and their total below 2^53: sums are exact in any order
   tbb::enumerable_thread_specific<std::vector<double>> marks_;  ///< r(o) of a marked cell's objects, else 0
   double W_ = 1;
   size_t alive_ = 0;
