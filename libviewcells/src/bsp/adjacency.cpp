@@ -32,9 +32,11 @@ double area2(const std::vector<std::pair<double, double>>& p) {
 }
 
 /// Area of the intersection of a convex polygon with a convex region given by half-planes
-/// (Sutherland-Hodgman).
-double overlap_area(const std::vector<std::pair<double, double>>& subject, const std::vector<HalfPlane>& clip) {
-  std::vector<std::pair<double, double>> out = subject, in;
+/// (Sutherland-Hodgman). `out` and `in` are scratch space, reused between calls.
+double overlap_area(const std::vector<std::pair<double, double>>& subject, const std::vector<HalfPlane>& clip,
+                    std::vector<std::pair<double, double>>& out, std::vector<std::pair<double, double>>& in) {
+  out.assign(subject.begin(), subject.end());
+  in.clear();
   for (size_t i = 0; i < clip.size() && !out.empty(); ++i) {
     const HalfPlane h = clip[i];
     auto inside = [&](const std::pair<double, double>& p) { return -(h.a * p.first + h.b * p.second + h.c); };
@@ -166,6 +168,7 @@ std::vector<LeafAdjacency> leaf_adjacency(const Subdivision& s, const std::vecto
     // p.xmin all end left of p.
     std::vector<double> reach(b.size());
     for (size_t i = 0; i < b.size(); ++i) reach[i] = std::max(b[i].xmax, i ? reach[i - 1] : -INFINITY);
+    std::vector<std::pair<double, double>> clipped, scratch;
     for (const Poly2& p : a) {
       const size_t first = static_cast<size_t>(
           std::upper_bound(reach.begin(), reach.end(), p.xmin) - reach.begin());
@@ -173,7 +176,7 @@ std::vector<LeafAdjacency> leaf_adjacency(const Subdivision& s, const std::vecto
         const Poly2& q = b[i];
         if (q.xmin >= p.xmax) break;
         if (q.xmax <= p.xmin || q.ymin >= p.ymax || q.ymax <= p.ymin) continue;
-        const double area = overlap_area(p.pts, q.sides);
+        const double area = overlap_area(p.pts, q.sides, clipped, scratch);
         if (area > min_area) found[k].push_back({std::min(p.leaf, q.leaf), std::max(p.leaf, q.leaf), area});
       }
     }

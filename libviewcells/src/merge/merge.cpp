@@ -2,13 +2,14 @@
 //
 // The neighbour graph is a sorted neighbour list per merge-history node id: merging x and y
 // adds node z (the largest id so far, so appending it keeps every list sorted) with the union
-// of their neighbours and clears x and y. The queue holds (delta, x, y); an entry whose x or y
-// has merged since is stale and skipped when popped, so the queue is never rescanned. delta
-// needs only the objects the two PVSs share when the object costs do not depend on the cell
-// (c = 0): r(x + y) = r(x) + r(y) - r(x n y). One cell's objects are marked with their r(o) in
-// an array over the objects, and each partner's list sums its marks in its own (ascending)
-// order, adding 0 for the objects not shared: the same additions in the same order as walking
-// the two lists together, without the walk's unpredictable branches.
+// of their neighbours and clears x and y. The queue (PairQueue) gives the least (delta, x, y)
+// among the pairs of current neighbours; pairs whose x or y has merged since are dropped when
+// met, so nothing is ever rescanned. delta needs only the objects the two PVSs share when the
+// object costs do not depend on the cell (c = 0): r(x + y) = r(x) + r(y) - r(x n y). One
+// cell's objects are marked with their r(o) in an array over the objects, and each partner's
+// list sums its marks, adding 0 for the objects not shared: in ascending order the same
+// additions as walking the two lists together, without the walk's unpredictable branches; with
+// whole costs, integer sums that are exact (Merger::shared_cost).
 #include "viewcells/merge/merge.h"
 
 #include <tbb/enumerable_thread_specific.h>
@@ -18,7 +19,8 @@
 #include <chrono>
 #include <cmath>
 #include <iterator>
-#include <queue>
+#include <limits>
+#include <optional>
 
 #include "viewcells/bsp/adjacency.h"
 #include "viewcells/core/error.h"
@@ -174,6 +176,9 @@ namespace {
 struct Entry {
   double delta;
   int32_t x, y;  // x < y
+  /// r(x + y) as evaluated, when it is bitwise what summing the united PVS gives (whole costs,
+  /// or the pixel term, which sums the united PVS itself); else NaN.
+  double merged = std::numeric_limits<double>::quiet_NaN();
 };
 struct Later {  // min-heap on delta; ties: smaller ids first
   bool operator()(const Entry& p, const Entry& q) const {
@@ -182,11 +187,93 @@ struct Later {  // min-heap on delta; ties: smaller ids first
   }
 };
 
+/// The pairs that may merge next, kept in groups of pairs that share a cell (the pairs one
+/// merge created, all with the new cell; or a cell's pairs with the cells of larger ids). The
+/// heap holds one entry per group, its least pair when it was pushed: as pairs never change
+/// cost, only die when a side merges, that entry is at most every live pair of its group. A
+/// popped entry whose pair has died sends its group back with its least live pair; one whose
+/// pair lives is the least live pair of all, the pair the one heap of every pair would give
+/// (ties broken alike), and merging it kills the rest of its group. The heap thus holds about
+/// one entry per cell, not one per pair ever evaluated.
+class PairQueue {
+ public:
+  void clear() {
+    heap_.clear();
+    pool_.clear();
+    groups_.clear();
+  }
+  /// Adds evaluated pairs that all share one cell.
+  void add(const std::vector<Entry>& pairs, size_t begin, size_t end) {
+    if (begin == end) return;
+    const size_t group = groups_.size();
+    groups_.push_back({pool_.size(), pool_.size() + (end - begin)});
+    pool_.insert(pool_.end(), pairs.begin() + static_cast<std::ptrdiff_t>(begin),
+                 pairs.begin() + static_cast<std::ptrdiff_t>(end));
+    push_least(group, [](int32_t) { return true; });
+  }
+
+  /// Adds evaluated pairs sorted by their first cell: a group per first cell.
+  void add_by_first(const std::vector<Entry>& pairs) {
+    for (size_t b = 0, e = 0; b < pairs.size(); b = e) {
+      for (e = b; e < pairs.size() && pairs[e].x == pairs[b].x; ++e) {
+      }
+      add(pairs, b, e);
+    }
+  }
+
+  /// The least pair whose two cells `alive` accepts, if any; `stale` counts the dead pairs
+  /// popped on the way.
+  template <class Alive>
+  std::optional<Entry> pop(const Alive& alive, uint64_t& stale) {
+    while (!heap_.empty()) {
+      std::pop_heap(heap_.begin(), heap_.end(), later_top);
+      const Top top = heap_.back();
+      heap_.pop_back();
+      if (alive(top.pair.x) && alive(top.pair.y)) return top.pair;
+      ++stale;
+      push_least(top.group, alive);
+    }
+    return std::nullopt;
+  }
+
+ private:
+  struct Top {
+    Entry pair;
+    size_t group;
+  };
+  static bool later_top(const Top& p, const Top& q) { return Later{}(p.pair, q.pair); }
+
+  /// Drops the group's dead pairs and pushes its least live one, if any.
+  template <class Alive>
+  void push_least(size_t group, const Alive& alive) {
+    auto& [begin, end] = groups_[group];
+    size_t kept = begin;
+    for (size_t i = begin; i < end; ++i)
+      if (alive(pool_[i].x) && alive(pool_[i].y)) pool_[kept++] = pool_[i];
+    end = kept;
+    if (begin == end) return;
+    size_t least = begin;
+    for (size_t i = begin + 1; i < end; ++i)
+      if (Later{}(pool_[least], pool_[i])) least = i;
+    heap_.push_back({pool_[least], group});
+    std::push_heap(heap_.begin(), heap_.end(), later_top);
+  }
+
+  std::vector<Top> heap_;
+  std::vector<Entry> pool_;                         ///< every group's pairs, one group after another
+  std::vector<std::pair<size_t, size_t>> groups_;  ///< [begin, end) of each group's live pairs in pool_
+};
+
+/// r(o) of a marked cell's objects, else 0: whole numbers, or doubles (see Merger::shared_cost).
+struct Marks {
+  std::vector<uint32_t> whole;
+  std::vector<double> cost;
+};
+
 class Merger {
  public:
   Merger(const Scene& scene, const CellPartition& p, const CostModel& model)
-      : scene_(scene), p_(p), model_(model), r_(per_object_costs(scene, model)), whole_costs_(whole_and_small(r_)),
-        marks_([n = scene.objects.size()] { return std::vector<double>(n, 0.0); }) {}
+      : scene_(scene), p_(p), model_(model), r_(per_object_costs(scene, model)), whole_costs_(whole_and_small(r_)) {}
 
   MergeHistory run(const MergeConfig& config) {
     const auto start = std::chrono::steady_clock::now();
@@ -201,9 +288,8 @@ class Merger {
       n.weight = p_.weight[i];
       n.volume = p_.volume[i];
       n.bounds = p_.bounds[i];
-      pvs_[i] = p_.pvs[i];
-      n.pvs_cost = pvs_cost(pvs_[i], n.bounds);
-      n.pvs_size = static_cast<uint32_t>(pvs_[i].size());
+      n.pvs_cost = pvs_cost(p_.pvs[i], n.bounds);
+      n.pvs_size = static_cast<uint32_t>(p_.pvs[i].size());
       h.total_weight += n.weight;
     }
     if (!(h.total_weight > 0)) throw Error("the cells to merge have no weight");
@@ -227,7 +313,7 @@ class Merger {
     for (const auto& [x, y] : config.prefix) {
       if (alive_ <= target) break;
       check_prefix_pair(h, x, y);
-      merge(h, x, y, around);
+      merge(h, x, y, around, std::numeric_limits<double>::quiet_NaN());
       if (config.show_progress) progress.advance(1);
     }
     if (!config.block.empty()) {
@@ -237,34 +323,34 @@ class Merger {
       for (size_t k = L; k < h.nodes.size(); ++k) block_[k] = block_[h.nodes[k].child[0]];
     }
     constrained_ = !config.block.empty() && alive_ > config.barrier_cells;
-    std::priority_queue<Entry, std::vector<Entry>, Later> queue(Later{}, all_pairs(h));
+    PairQueue queue;
+    queue.add_by_first(all_pairs(h));
+    auto alive = [&h](int32_t n) { return h.nodes[n].parent < 0; };
     std::vector<Entry> fresh;
     while (alive_ > target) {
-      if (queue.empty()) {
+      const std::optional<Entry> next = queue.pop(alive, h.stats.stale);
+      if (!next) {
         if (!constrained_) break;
         constrained_ = false;  // blocks that cannot merge further: the barrier is lifted
-        queue = decltype(queue)(Later{}, all_pairs(h));
+        queue.clear();
+        queue.add_by_first(all_pairs(h));
         continue;
       }
-      const Entry e = queue.top();
-      queue.pop();
-      if (h.nodes[e.x].parent >= 0 || h.nodes[e.y].parent >= 0) {
-        ++h.stats.stale;
-        continue;
-      }
-      const int32_t z = merge(h, e.x, e.y, around);
+      const Entry& e = *next;
+      const int32_t z = merge(h, e.x, e.y, around, e.merged);
       if (constrained_) block_[z] = block_[e.x];
       if (config.show_progress) progress.advance(1);
       if (constrained_ && alive_ <= config.barrier_cells) {
         constrained_ = false;  // at the barrier: every neighbouring pair from now on
-        queue = decltype(queue)(Later{}, all_pairs(h));
+        queue.clear();
+        queue.add_by_first(all_pairs(h));
         continue;
       }
       fresh.clear();
       for (int32_t n : around)
         if (allowed(n, z)) fresh.push_back({0.0, n, z});
       evaluate(h, fresh, &Entry::y);
-      for (const Entry& f : fresh) queue.push(f);
+      queue.add(fresh, 0, fresh.size());
     }
     if (config.show_progress) progress.finish();
     h.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -292,8 +378,9 @@ class Merger {
                   std::to_string(y) + ")");
   }
 
-  /// Merges current cells x and y into a new node z; `around` gets z's neighbours.
-  int32_t merge(MergeHistory& h, int32_t x, int32_t y, std::vector<int32_t>& around) {
+  /// Merges current cells x and y into a new node z; `around` gets z's neighbours. `merged`:
+  /// r(z) if already known exactly (see Entry), else NaN.
+  int32_t merge(MergeHistory& h, int32_t x, int32_t y, std::vector<int32_t>& around, double merged) {
     const int32_t z = static_cast<int32_t>(h.nodes.size());
     MergeNode node;
     node.child[0] = x;
@@ -302,8 +389,8 @@ class Merger {
     node.volume = h.nodes[x].volume + h.nodes[y].volume;
     node.bounds = h.nodes[x].bounds;
     node.bounds.extend(h.nodes[y].bounds);
-    pvs_[z] = unite_sorted(pvs_[x], pvs_[y]);
-    node.pvs_cost = pvs_cost(pvs_[z], node.bounds);
+    pvs_[z] = unite_sorted(list(x), list(y));
+    node.pvs_cost = std::isnan(merged) ? pvs_cost(pvs_[z], node.bounds) : merged;
     node.pvs_size = static_cast<uint32_t>(pvs_[z].size());
     // The recorded cost uses the merged cell's actual r(PVS), not the queued estimate.
     cost_ += (node.weight * node.pvs_cost - h.nodes[x].weight * h.nodes[x].pvs_cost -
@@ -327,29 +414,49 @@ class Merger {
     adjacent_[z] = around;
     adjacent_[x] = {};
     adjacent_[y] = {};
-    pvs_[x] = {};
+    pvs_[x] = {};  // (the elementary cells' lists stay the partition's)
     pvs_[y] = {};
     return z;
+  }
+
+  /// The PVS of current cell n: an elementary cell's is the partition's own.
+  const std::vector<uint32_t>& list(int32_t n) const {
+    return static_cast<size_t>(n) < p_.size() ? p_.pvs[static_cast<size_t>(n)] : pvs_[static_cast<size_t>(n)];
   }
 
   double pvs_cost(const std::vector<uint32_t>& pvs, const Box3& bounds) const {
     return viewcells::pvs_cost(scene_, r_, model_, pvs, bounds);
   }
 
-  /// delta(x, y) for every entry. Without the pixel term, consecutive entries that share their
-  /// `shared` side (x or y) mark its objects once and sum the other side's marks.
+  /// delta(x, y) for every entry. Without the pixel term, the cell on the entries' `shared`
+  /// side (x or y) has its objects marked once per run of entries that share it, and the
+  /// other side sums the marks. When every entry shares that cell (the pairs of a merge's new
+  /// cell), it is marked once, in marks that the tasks share.
   void evaluate(MergeHistory& h, std::vector<Entry>& entries, int32_t Entry::*shared) {
     h.stats.evaluations += entries.size();
+    if (entries.empty()) return;
     size_t work = 0;  // list entries read: small sets run without tasks
-    for (const Entry& e : entries) work += pvs_[e.x].size() + pvs_[e.y].size();
-    const size_t grain = work > (size_t{1} << 15) ? std::max<size_t>(1, entries.size() / 64) : entries.size() + 1;
+    for (const Entry& e : entries) work += list(e.x).size() + list(e.y).size();
+    const size_t grain = work > (size_t{1} << 13) ? std::max<size_t>(1, entries.size() / 4) : entries.size() + 1;
+    const int32_t first = entries.front().*shared;
+    const bool one_cell =
+        std::all_of(entries.begin(), entries.end(), [&](const Entry& e) { return e.*shared == first; });
+    const bool marking = !model_.pixel_term();
+    if (marking && one_cell) set_marks(one_cell_marks_, first, true);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, entries.size(), grain), [&](const tbb::blocked_range<size_t>& r) {
-      if (model_.pixel_term()) {
-        for (size_t i = r.begin(); i < r.end(); ++i) entries[i].delta = delta_united(h, entries[i].x, entries[i].y);
+      if (!marking) {
+        for (size_t i = r.begin(); i < r.end(); ++i) {
+          Entry& e = entries[i];
+          const MergeNode &nx = h.nodes[e.x], &ny = h.nodes[e.y];
+          Box3 bounds = nx.bounds;
+          bounds.extend(ny.bounds);
+          e.merged = pvs_cost(unite_sorted(list(e.x), list(e.y)), bounds);
+          e.delta = merged_delta(nx, ny, e.merged);
+        }
         return;
       }
-      std::vector<double>& marks = marks_.local();
-      int32_t marked = -1;
+      Marks& marks = one_cell ? one_cell_marks_ : marks_.local();
+      int32_t marked = one_cell ? first : -1;
       for (size_t i = r.begin(); i < r.end(); ++i) {
         Entry& e = entries[i];
         const int32_t s = e.*shared, other = s == e.x ? e.y : e.x;
@@ -358,76 +465,70 @@ class Merger {
           set_marks(marks, s, true);
           marked = s;
         }
-        const double common = shared_cost(marks, pvs_[other]);
+        const double common = shared_cost(marks, list(other));
         const MergeNode &nx = h.nodes[e.x], &ny = h.nodes[e.y];
-        e.delta = merged_delta(nx, ny, nx.pvs_cost + ny.pvs_cost - common);
+        const double merged = nx.pvs_cost + ny.pvs_cost - common;
+        e.delta = merged_delta(nx, ny, merged);
+        if (whole_costs_) e.merged = merged;  // exact
       }
-      if (marked >= 0) set_marks(marks, marked, false);
+      if (!one_cell && marked >= 0) set_marks(marks, marked, false);
     });
+    if (marking && one_cell) set_marks(one_cell_marks_, first, false);
   }
 
-  /// r(x n y): the marks of x summed over y's objects. In ascending order, one addition after
-  /// the other; or, when every r(o) is a whole number and their total is below 2^53 (the default
-  /// model: max(a, b t_o) with whole a and b), in four running sums, which is then exact and so
-  /// bitwise the same, without waiting on each addition.
-  double shared_cost(const std::vector<double>& marks, const std::vector<uint32_t>& list) const {
-    const size_t n = list.size();
-    const uint32_t* o = list.data();
-    const double* m = marks.data();
-    if (!whole_costs_) {
-      double sum = 0;
-      for (size_t i = 0; i < n; ++i) sum += m[o[i]];
-      return sum;
+  /// r(x n y): the marks of x summed over y's objects. When every r(o) is a whole number below
+  /// 2^32 and their total is below 2^53 (the default model: max(a, b t_o) with whole a and b),
+  /// the marks are integers and their sum is exact, so it is bitwise the sum in any order;
+  /// otherwise the doubles are added in ascending object order, one after the other.
+  double shared_cost(const Marks& marks, const std::vector<uint32_t>& list) const {
+    if (whole_costs_) {
+      const uint32_t* m = marks.whole.data();
+      uint64_t sum = 0;
+      for (uint32_t o : list) sum += m[o];
+      return static_cast<double>(sum);
     }
-    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-    size_t i = 0;
-    for (; i + 4 <= n; i += 4) {
-      s0 += m[o[i]];
-      s1 += m[o[i + 1]];
-      s2 += m[o[i + 2]];
-      s3 += m[o[i + 3]];
-    }
-    for (; i < n; ++i) s0 += m[o[i]];
-    return (s0 + s1) + (s2 + s3);
+    const double* m = marks.cost.data();
+    double sum = 0;
+    for (uint32_t o : list) sum += m[o];
+    return sum;
   }
 
   static bool whole_and_small(const std::vector<double>& r) {
     double total = 0;
     for (double x : r) {
-      if (!(x >= 0) || x != std::floor(x)) return false;
+      if (!(x >= 0) || x != std::floor(x) || x >= 0x1p32) return false;
       total += x;
     }
     return total < 0x1p53;
   }
 
-  void set_marks(std::vector<double>& marks, int32_t cell, bool on) const {
-    for (uint32_t o : pvs_[cell]) marks[o] = on ? r_[o] : 0.0;
+  void set_marks(Marks& marks, int32_t cell, bool on) const {
+    if (whole_costs_) {
+      if (marks.whole.empty()) marks.whole.assign(r_.size(), 0);
+      for (uint32_t o : list(cell)) marks.whole[o] = on ? static_cast<uint32_t>(r_[o]) : 0;
+    } else {
+      if (marks.cost.empty()) marks.cost.assign(r_.size(), 0.0);
+      for (uint32_t o : list(cell)) marks.cost[o] = on ? r_[o] : 0.0;
+    }
   }
 
   double merged_delta(const MergeNode& nx, const MergeNode& ny, double merged) const {
     return ((nx.weight + ny.weight) * merged - nx.weight * nx.pvs_cost - ny.weight * ny.pvs_cost) / W_;
   }
 
-  /// delta(x, y) with the pixel term: r(x + y) of the united PVS over the united bounds.
-  double delta_united(const MergeHistory& h, int32_t x, int32_t y) const {
-    const MergeNode &nx = h.nodes[x], &ny = h.nodes[y];
-    Box3 bounds = nx.bounds;
-    bounds.extend(ny.bounds);
-    return merged_delta(nx, ny, pvs_cost(unite_sorted(pvs_[x], pvs_[y]), bounds));
-  }
-
   const Scene& scene_;
   const CellPartition& p_;
   const CostModel& model_;
   const std::vector<double> r_;
-  const bool whole_costs_;  ///< every r(o) whole and their total below 2^53: sums are exact in any order
-  tbb::enumerable_thread_specific<std::vector<double>> marks_;  ///< r(o) of a marked cell's objects, else 0
+  const bool whole_costs_;  ///< every r(o) whole, below 2^32, their total below 2^53: exact sums
+  tbb::enumerable_thread_specific<Marks> marks_;
+  Marks one_cell_marks_;
   double W_ = 1;
   size_t alive_ = 0;
   double cost_ = 0;
   bool constrained_ = false;
   std::vector<int32_t> block_;  ///< per MHT node, with a barrier
-  std::vector<std::vector<uint32_t>> pvs_;  ///< per MHT node, while it is a current cell
+  std::vector<std::vector<uint32_t>> pvs_;  ///< per merged MHT node, while it is a current cell
   std::vector<std::vector<int32_t>> adjacent_;  ///< per MHT node, its current neighbours, sorted
 };
 
