@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 #include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/core/error.h"
@@ -146,6 +147,89 @@ TEST(Merge, EachMergeIsTheCheapestNeighbouringPair) {
     const double done = h.cost_after[k] - h.cost_with(h.leaf_count - k);
     EXPECT_NEAR(done, best, 1e-9 * h.initial_cost) << "merge " << k;
   }
+}
+
+/// Greedy merging done the slow way: every step evaluates every pair of neighbouring current
+/// cells, r(x + y) summed over the united PVS in ascending order, and takes the least
+/// (delta, x, y). Returns the merges as (child 0, child 1) in order. Without the pixel term.
+std::vector<std::pair<int32_t, int32_t>> brute_force_merges(const Scene& scene, const CellPartition& p,
+                                                             const CostModel& model) {
+  const std::vector<double> r = per_object_costs(scene, model);
+  auto rcost = [&](const std::vector<uint32_t>& pvs) {
+    double c = 0;
+    for (uint32_t o : pvs) c += r[o];
+    return c;
+  };
+  const size_t L = p.size();
+  std::vector<std::vector<uint32_t>> pvs(p.pvs.begin(), p.pvs.end());
+  std::vector<double> weight(p.weight.begin(), p.weight.end()), cost;
+  double W = 0;
+  for (double w : weight) W += w;
+  for (const auto& list : pvs) cost.push_back(rcost(list));
+  std::vector<int32_t> owner(L);  // elementary cell -> current cell
+  for (size_t i = 0; i < L; ++i) owner[i] = static_cast<int32_t>(i);
+  std::vector<std::pair<int32_t, int32_t>> merges;
+  for (;;) {
+    double best = INFINITY;
+    int32_t bx = -1, by = -1;
+    for (const auto& [a, b] : p.neighbours) {
+      const int32_t x = std::min(owner[a], owner[b]), y = std::max(owner[a], owner[b]);
+      if (x == y) continue;
+      std::vector<uint32_t> u;
+      std::set_union(pvs[x].begin(), pvs[x].end(), pvs[y].begin(), pvs[y].end(), std::back_inserter(u));
+      // r(x + y) = r(x) + r(y) - r(x n y), the shared objects summed in ascending order: what
+      // the merge computes, bitwise.
+      double common = 0;
+      std::vector<uint32_t> both;
+      std::set_intersection(pvs[x].begin(), pvs[x].end(), pvs[y].begin(), pvs[y].end(), std::back_inserter(both));
+      for (uint32_t o : both) common += r[o];
+      const double merged = cost[x] + cost[y] - common;
+      const double delta = ((weight[x] + weight[y]) * merged - weight[x] * cost[x] - weight[y] * cost[y]) / W;
+      if (delta < best || (delta == best && std::make_pair(x, y) < std::make_pair(bx, by))) {
+        best = delta;
+        bx = x;
+        by = y;
+      }
+    }
+    if (bx < 0) break;
+    const int32_t z = static_cast<int32_t>(pvs.size());
+    std::vector<uint32_t> u;
+    std::set_union(pvs[bx].begin(), pvs[bx].end(), pvs[by].begin(), pvs[by].end(), std::back_inserter(u));
+    pvs.push_back(u);
+    weight.push_back(weight[bx] + weight[by]);
+    cost.push_back(rcost(u));
+    for (int32_t& o : owner)
+      if (o == bx || o == by) o = z;
+    merges.emplace_back(bx, by);
+  }
+  return merges;
+}
+
+/// The merge's queue, its pair costs (marks, whole-number sums) and its neighbour lists give
+/// exactly the slow greedy's merges, ties included: on the office with the default model
+/// (whole r(o)), with fractional r(o) (sums of doubles in order), and on a grid whose cells
+/// outside the rooms have equal PVSs (many equal costs).
+TEST(Merge, SameMergesAsBruteForceGreedy) {
+  Fixture office_cells = office(50, 1, 15000);
+  Fixture grid;
+  grid.scene = generate_scene({GeneratorKind::kOffice, 1, 1});
+  grid.segs = sample(grid.scene, 15000);
+  grid.partition = grid_partition(grid.segs, 6, 6, 2);
+  size_t free_merges = 0;  // merges of equal PVSs (delta 0): many pairs tie at 0
+  for (const Fixture* f : {&office_cells, &grid})
+    for (const CostModel& model : {CostModel{}, CostModel{100.25, 0.7, 0}}) {
+      MergeConfig config;
+      config.show_progress = false;
+      const MergeHistory h = merge_cells(f->scene, f->partition, model, config);
+      const auto expected = brute_force_merges(f->scene, f->partition, model);
+      ASSERT_EQ(h.merges(), expected.size());
+      for (size_t k = 0; k < expected.size(); ++k) {
+        const MergeNode& n = h.nodes[h.leaf_count + k];
+        ASSERT_EQ(std::make_pair(n.child[0], n.child[1]), expected[k]) << "merge " << k << ", a = " << model.a;
+      }
+      for (size_t k = 1; k < h.merges(); ++k) free_merges += h.cost_after[k] == h.cost_after[k - 1];
+    }
+  EXPECT_GT(free_merges, 0u) << "the grid should give pairs of equal cost, so that the tie rule is exercised";
 }
 
 TEST(Merge, ExtractionByCountMemoryAndCostRatio) {

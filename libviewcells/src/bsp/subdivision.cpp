@@ -1334,9 +1334,13 @@ std::vector<std::vector<uint32_t>> leaf_pvs(const Subdivision& s, const SegmentS
   std::vector<std::vector<uint32_t>> pvs(s.nodes.size());
   const std::vector<int32_t> leaves = s.leaves();
   uint32_t objects = 0;  // one past the largest object id named
-  for (size_t i = 0; i < segments.size(); ++i)
-    for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
+  // Each segment's two objects side by side: a leaf reads them by segment id, one place each.
+  std::vector<std::array<uint32_t, 2>> ends(segments.size());
+  for (size_t i = 0; i < segments.size(); ++i) {
+    ends[i] = {segments.object_a[i], segments.object_b[i]};
+    for (uint32_t o : ends[i])
       if (o != kNoObject) objects = std::max(objects, o + 1);
+  }
   // Each leaf's distinct objects, sorted; each leaf alone, in parallel. A leaf with many
   // segments against the object count sets bits and reads them in order (a pass over one bit
   // per object); one with few marks the objects it meets first and sorts them.
@@ -1349,7 +1353,7 @@ std::vector<std::vector<uint32_t>> leaf_pvs(const Subdivision& s, const SegmentS
     if (words <= 2 * in.size()) {
       std::vector<uint64_t>& b = bits.local();
       for (uint32_t i : in)
-        for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
+        for (uint32_t o : ends[i])
           if (o != kNoObject) b[o >> 6] |= uint64_t{1} << (o & 63);
       size_t count = 0;
       for (uint64_t x : b) count += static_cast<size_t>(__builtin_popcountll(x));
@@ -1362,7 +1366,7 @@ std::vector<std::vector<uint32_t>> leaf_pvs(const Subdivision& s, const SegmentS
     Marks& m = marks.local();
     m.reset(objects);
     for (uint32_t i : in)
-      for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
+      for (uint32_t o : ends[i])
         if (m.first(o)) ids.push_back(o);
     std::sort(ids.begin(), ids.end());
   });

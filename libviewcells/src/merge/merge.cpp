@@ -283,6 +283,7 @@ class Merger {
     h.nodes.resize(L);
     pvs_.resize(2 * L);
     adjacent_.assign(2 * L, {});
+    has_merged_.assign(2 * L, 0);
     for (size_t i = 0; i < L; ++i) {
       MergeNode& n = h.nodes[i];
       n.weight = p_.weight[i];
@@ -325,7 +326,7 @@ class Merger {
     constrained_ = !config.block.empty() && alive_ > config.barrier_cells;
     PairQueue queue;
     queue.add_by_first(all_pairs(h));
-    auto alive = [&h](int32_t n) { return h.nodes[n].parent < 0; };
+    auto alive = [this](int32_t n) { return has_merged_[static_cast<size_t>(n)] == 0; };
     std::vector<Entry> fresh;
     while (alive_ > target) {
       const std::optional<Entry> next = queue.pop(alive, h.stats.stale);
@@ -397,6 +398,7 @@ class Merger {
               h.nodes[y].weight * h.nodes[y].pvs_cost) / W_;
     h.nodes.push_back(node);
     h.nodes[x].parent = z;
+    has_merged_[static_cast<size_t>(x)] = has_merged_[static_cast<size_t>(y)] = 1;
     h.nodes[y].parent = z;
     h.cost_after.push_back(cost_);
     --alive_;
@@ -530,6 +532,7 @@ class Merger {
   std::vector<int32_t> block_;  ///< per MHT node, with a barrier
   std::vector<std::vector<uint32_t>> pvs_;  ///< per merged MHT node, while it is a current cell
   std::vector<std::vector<int32_t>> adjacent_;  ///< per MHT node, its current neighbours, sorted
+  std::vector<uint8_t> has_merged_;  ///< per MHT node, 1 once merged: what the queue looks up
 };
 
 ViewCellSet make_set(const MergeHistory& h, size_t k, std::string rule) {
