@@ -4,11 +4,14 @@
 # compression ratios of the sampled PVSs on the office and the city at several view cell
 # counts. The city is merged twice: validated by two AGVS runs over the leaves (the default)
 # and greedy on the construction samples' PVSs (--merge-pvs samples). Times include the leaf
-# PVSs and the neighbour graph. Rewrites the merging section of BENCHMARKS.md.
+# PVSs and the neighbour graph. The neighbour graph and the greedy merge are also timed alone on
+# the greedy run's file (bench/merge_bench.cpp, fastest of 3), which the machine's drift
+# disturbs less than one run of the whole build. Rewrites the merging section of BENCHMARKS.md.
 # Usage: scripts/bench-merge.sh [CITY_SIZE] [CELLS]
 set -euo pipefail
 size="${1:-23}"
 cells="${2:-50000}"
+bench_cmake_args="-DVIEWCELLS_BUILD_BENCH=ON"
 source "$(dirname "$0")/bench-setup.sh"
 city=$(bench_scene city "$size")
 office=$(bench_scene office 4)
@@ -16,6 +19,7 @@ office=$(bench_scene office 4)
   -o "$dir/city-merge.vcells" --report "$dir/merge-city.json"
 "$vc" build "$city" --segments 1500000 --max-cells "$cells" --min-reduction 0 --seed 1 -q --merge-pvs samples \
   -o "$dir/city-merge-samples.vcells" --report "$dir/merge-city-samples.json"
+build-release/bench/viewcells_merge_bench "$city" "$dir/city-merge-samples.vcells" 3 > "$dir/merge-stage.txt"
 "$vc" build "$office" --samples 1000000 --max-cells 2000 --seed 1 -q \
   -o "$dir/office-merge.vcells" --report "$dir/merge-office.json"
 for n in "$cells" 5000 500 50; do

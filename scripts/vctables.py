@@ -149,9 +149,10 @@ def merging(*args):
     d, size, cells = argv[1], argv[2], int(argv[3])
     print(f"Merging: the city of size {size} (seed 1), 1.5M segments, {cells:,} AV-S cells merged down to one; "
           "the office of size 4, 1M samples, 2,000 cells. Threads = 2.\n")
-    print("| scene | merge PVSs | cells merged | subdivision s | leaf PVSs s | neighbour graph s | merge s | pair costs "
-          "evaluated | greedy from / barrier | cost at all cells | at 1/10 | at 1/100 |")
-    print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: |")
+    print("| scene | merge PVSs | cells merged | subdivision s | leaf PVSs s | neighbour graph s | merge s | "
+          "leaf PVSs + graph + merge s | pair costs evaluated | greedy from / barrier | cost at all cells | at 1/10 | "
+          "at 1/100 |")
+    print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- | ---: | ---: | ---: |")
     for name, report in [("city", "merge-city"), ("city", "merge-city-samples"), ("office", "merge-office")]:
         if not os.path.exists(f"{d}/{report}.json"):
             continue
@@ -162,9 +163,16 @@ def merging(*args):
             c = min(curve, key=lambda x: abs(x - k)); return f"{curve[c]:,.0f} ({c:,})"
         kind = "with AGVS" if m.get("agvs_samples") else "construction samples"
         start = f"{m.get('greedy_from_cells', n):,} / {m.get('barrier_cells') or '-'}"
-        print(f"| {name} | {kind} | {n:,} | {t['subdivision_seconds']:.1f} | {t.get('leaf_pvs_seconds', 0):.1f} | "
-              f"{t.get('neighbour_graph_seconds', 0):.2f} | {t['merge_seconds']:.2f} | {m['pair_costs_evaluated']:,} | "
-              f"{start} | {r['final_cost']:,.0f} | {near(n / 10)} | {near(n / 100)} |")
+        merging = t.get('leaf_pvs_seconds', 0) + t.get('neighbour_graph_seconds', 0) + t['merge_seconds']
+        print(f"| {name} | {kind} | {n:,} | {t['subdivision_seconds']:.1f} | {t.get('leaf_pvs_seconds', 0):.2f} | "
+              f"{t.get('neighbour_graph_seconds', 0):.2f} | {t['merge_seconds']:.2f} | {merging:.2f} | "
+              f"{m['pair_costs_evaluated']:,} | {start} | {r['final_cost']:,.0f} | {near(n / 10)} | {near(n / 100)} |")
+    stage = f"{d}/merge-stage.txt"
+    if os.path.exists(stage):
+        fastest = [l for l in open(stage).read().split("\n") if l.startswith("fastest:")]
+        if fastest:
+            print(f"\nThe city's greedy merge timed alone on its file (bench/merge_bench.cpp, fastest of 3 runs): "
+                  f"{fastest[0][len('fastest: '):]}.")
     print("\nThe construction samples' costs (\"cost at\") are not comparable between the two kinds: with AGVS the "
           "leaves' PVSs hold more of what they see. docs/results.md compares them on independent samples.")
     print("\nCompression of the sampled PVSs through the merge history (`viewcells compress`):\n")

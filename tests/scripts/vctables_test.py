@@ -218,9 +218,13 @@ class Tables(unittest.TestCase):
                     "cells": c, "objects": 10, "entries_before": 100, "entries_after": 40, "entry_ratio": 0.4,
                     "varint_bytes_before": 150, "varint_bytes_after": 60, "file_bytes": 500,
                     "flat": {"bit_row_bytes": 20, "run_length_bytes": 15}})
+        with open(f"{self.d}/merge-stage.txt", "w") as f:
+            f.write("run 0: cells 8, neighbour graph 0.300 s, merge 1.500 s\n"
+                    "fastest: neighbour graph 0.250 s, merge 1.250 s\n")
         t = run("merging", self.d, 23, 8)
+        self.assertIn("fastest of 3 runs): neighbour graph 0.250 s, merge 1.250 s.", t)
         # 8 / 10 is nearest 1
-        self.assertIn("| city | construction samples | 8 | 2.0 | 1.5 | 0.25 | 0.50 | 5 | 8 / - | 100 | 400 (1) | 400 (1) |", t)
+        self.assertIn("| city | construction samples | 8 | 2.0 | 1.50 | 0.25 | 0.50 | 2.25 | 5 | 8 / - | 100 | 400 (1) | 400 (1) |", t)
         self.assertIn("| office | 200 | 10 | 100 | 40 | 0.400 |", t)
 
     def test_compare_histogram_shares_sum_to_one(self):
