@@ -82,24 +82,37 @@ double pvs_cost(const Scene& scene, const std::vector<double>& base, const CostM
   return c;
 }
 
-std::vector<uint32_t> unite_sorted(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+namespace {
+
+template <class Id>
+std::vector<Id> unite_lists(const std::vector<Id>& a, const std::vector<Id>& b) {
   // Without branches on the comparisons (which a union of similar lists mispredicts half the
   // time), into scratch space of this thread; then copied into a vector of exactly its size.
-  thread_local std::vector<uint32_t> scratch;
+  thread_local std::vector<Id> scratch;
   if (scratch.size() < a.size() + b.size()) scratch.resize(a.size() + b.size());
-  const uint32_t *pa = a.data(), *pb = b.data();
+  const Id *pa = a.data(), *pb = b.data();
   const size_t na = a.size(), nb = b.size();
-  uint32_t* out = scratch.data();
+  Id* out = scratch.data();
   size_t i = 0, j = 0;
   while (i < na && j < nb) {
-    const uint32_t x = pa[i], y = pb[j];
+    const Id x = pa[i], y = pb[j];
     *out++ = x < y ? x : y;
     i += x <= y;
     j += y <= x;
   }
   out = std::copy(pa + i, pa + na, out);
   out = std::copy(pb + j, pb + nb, out);
-  return std::vector<uint32_t>(scratch.data(), out);
+  return std::vector<Id>(scratch.data(), out);
+}
+
+}  // namespace
+
+std::vector<uint32_t> unite_sorted(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b) {
+  return unite_lists(a, b);
+}
+
+std::vector<uint16_t> unite_sorted(const std::vector<uint16_t>& a, const std::vector<uint16_t>& b) {
+  return unite_lists(a, b);
 }
 
 }  // namespace viewcells

@@ -143,11 +143,15 @@ LeafMerge merge_leaves(const Scene& scene, const RayCaster& caster, const Subdiv
     MergeSummary& sum = out.summary;
     sum.chosen = {static_cast<uint32_t>(s.leaf_count()), 0, 0.0, 0.0};
     t.restart();
-    const CellPartition partition = partition_from_subdivision(s, base);
+    CellPartition partition = partition_from_subdivision(s, std::move(base));
     sum.neighbour_seconds = t.seconds();
+    t.restart();
     out.history = merge_cells(scene, partition, model, merge);
-    sum.merge_seconds = out.history.stats.seconds;
-    out.leaf_pvs = std::move(base);
+    sum.merge_seconds = t.seconds();
+    // The leaves' lists back, per node.
+    const std::vector<int32_t> leaves = s.leaves();
+    out.leaf_pvs.assign(s.nodes.size(), {});
+    for (size_t i = 0; i < leaves.size(); ++i) out.leaf_pvs[leaves[i]] = std::move(partition.pvs[i]);
   }
   out.summary.leaf_pvs_seconds += base_seconds;
   return out;

@@ -21,6 +21,7 @@
 #include <iterator>
 #include <limits>
 #include <optional>
+#include <type_traits>
 
 #include "viewcells/bsp/adjacency.h"
 #include "viewcells/core/error.h"
@@ -29,6 +30,11 @@
 namespace viewcells {
 
 CellPartition partition_from_subdivision(const Subdivision& s, const std::vector<std::vector<uint32_t>>& leaf_pvs) {
+  std::vector<std::vector<uint32_t>> copy = leaf_pvs;
+  return partition_from_subdivision(s, std::move(copy));
+}
+
+CellPartition partition_from_subdivision(const Subdivision& s, std::vector<std::vector<uint32_t>>&& leaf_pvs) {
   const std::vector<int32_t> leaves = s.leaves();
   if (s.cells.size() != s.nodes.size()) throw Error("the subdivision's cells are missing (rebuild them first)");
   if (leaf_pvs.size() != s.nodes.size()) throw Error("leaf PVSs do not match the subdivision");
@@ -40,7 +46,7 @@ CellPartition partition_from_subdivision(const Subdivision& s, const std::vector
     p.weight.push_back(s.nodes[n].weight);
     p.volume.push_back(s.nodes[n].volume);
     p.bounds.push_back(s.cells[n].bounds());
-    p.pvs.push_back(leaf_pvs[n]);
+    p.pvs.push_back(std::move(leaf_pvs[n]));
   }
   for (const LeafAdjacency& a : leaf_adjacency(s)) {
     const uint32_t x = index[a.a], y = index[a.b];
@@ -270,10 +276,22 @@ struct Marks {
   std::vector<double> cost;
 };
 
+/// Greedy merging with PVSs as sorted lists of Id: uint16_t halves the bytes that pair costs
+/// read when the scene has at most 65,536 objects and no pixel term (whose costs need the
+/// shared code's uint32_t lists); uint32_t otherwise. The merges are the same either way.
+template <class Id>
 class Merger {
  public:
   Merger(const Scene& scene, const CellPartition& p, const CostModel& model)
-      : scene_(scene), p_(p), model_(model), r_(per_object_costs(scene, model)), whole_costs_(whole_and_small(r_)) {}
+      : scene_(scene), p_(p), model_(model), r_(per_object_costs(scene, model)), whole_costs_(whole_and_small(r_)) {
+    if constexpr (!kWide) {
+      VC_CHECK(!model.pixel_term() && scene.objects.size() <= size_t{1} << 16);
+      leaf_lists_.resize(p.size());
+      tbb::parallel_for(size_t{0}, p.size(), [&](size_t i) {
+        leaf_lists_[i].assign(p.pvs[i].begin(), p.pvs[i].end());  // each id < 2^16: checked above
+      });
+    }
+  }
 
   MergeHistory run(const MergeConfig& config) {
     const auto start = std::chrono::steady_clock::now();
@@ -289,7 +307,7 @@ class Merger {
       n.weight = p_.weight[i];
       n.volume = p_.volume[i];
       n.bounds = p_.bounds[i];
-      n.pvs_cost = pvs_cost(p_.pvs[i], n.bounds);
+      n.pvs_cost = pvs_cost(list(static_cast<int32_t>(i)), n.bounds);
       n.pvs_size = static_cast<uint32_t>(p_.pvs[i].size());
       h.total_weight += n.weight;
     }
@@ -422,12 +440,24 @@ class Merger {
   }
 
   /// The PVS of current cell n: an elementary cell's is the partition's own.
-  const std::vector<uint32_t>& list(int32_t n) const {
-    return static_cast<size_t>(n) < p_.size() ? p_.pvs[static_cast<size_t>(n)] : pvs_[static_cast<size_t>(n)];
+  const std::vector<Id>& list(int32_t n) const {
+    const size_t i = static_cast<size_t>(n);
+    if constexpr (kWide) {
+      return i < p_.size() ? p_.pvs[i] : pvs_[i];
+    } else {
+      return i < p_.size() ? leaf_lists_[i] : pvs_[i];
+    }
   }
 
-  double pvs_cost(const std::vector<uint32_t>& pvs, const Box3& bounds) const {
-    return viewcells::pvs_cost(scene_, r_, model_, pvs, bounds);
+  /// r(PVS): viewcells::pvs_cost, or its sum without the pixel term, added in the same order.
+  double pvs_cost(const std::vector<Id>& pvs, const Box3& bounds) const {
+    if constexpr (kWide) {
+      return viewcells::pvs_cost(scene_, r_, model_, pvs, bounds);
+    } else {
+      double c = 0;
+      for (Id o : pvs) c += r_[o];
+      return c;
+    }
   }
 
   /// delta(x, y) for every entry. Without the pixel term, the cell on the entries' `shared`
@@ -482,7 +512,7 @@ class Merger {
   /// 2^32 and their total is below 2^53 (the default model: max(a, b t_o) with whole a and b),
   /// the marks are integers and their sum is exact, so it is bitwise the sum in any order;
   /// otherwise the doubles are added in ascending object order, one after the other.
-  double shared_cost(const Marks& marks, const std::vector<uint32_t>& list) const {
+  double shared_cost(const Marks& marks, const std::vector<Id>& list) const {
     if (whole_costs_) {
       const uint32_t* m = marks.whole.data();
       uint64_t sum = 0;
@@ -507,10 +537,10 @@ class Merger {
   void set_marks(Marks& marks, int32_t cell, bool on) const {
     if (whole_costs_) {
       if (marks.whole.empty()) marks.whole.assign(r_.size(), 0);
-      for (uint32_t o : list(cell)) marks.whole[o] = on ? static_cast<uint32_t>(r_[o]) : 0;
+      for (Id o : list(cell)) marks.whole[o] = on ? static_cast<uint32_t>(r_[o]) : 0;
     } else {
       if (marks.cost.empty()) marks.cost.assign(r_.size(), 0.0);
-      for (uint32_t o : list(cell)) marks.cost[o] = on ? r_[o] : 0.0;
+      for (Id o : list(cell)) marks.cost[o] = on ? r_[o] : 0.0;
     }
   }
 
@@ -530,7 +560,9 @@ class Merger {
   double cost_ = 0;
   bool constrained_ = false;
   std::vector<int32_t> block_;  ///< per MHT node, with a barrier
-  std::vector<std::vector<uint32_t>> pvs_;  ///< per merged MHT node, while it is a current cell
+  static constexpr bool kWide = std::is_same_v<Id, uint32_t>;
+  std::vector<std::vector<Id>> leaf_lists_;  ///< narrow ids only: the partition's PVSs as Id
+  std::vector<std::vector<Id>> pvs_;  ///< per merged MHT node, while it is a current cell
   std::vector<std::vector<int32_t>> adjacent_;  ///< per MHT node, its current neighbours, sorted
   std::vector<uint8_t> has_merged_;  ///< per MHT node, 1 once merged: what the queue looks up
 };
@@ -566,7 +598,9 @@ MergeHistory merge_cells(const Scene& scene, const CellPartition& partition, con
   for (const auto& [a, b] : partition.neighbours)
     if (a >= L || b >= L) throw Error("a neighbour pair names a cell that does not exist");
   model.validate();
-  return Merger(scene, partition, model).run(config);
+  if (!model.pixel_term() && scene.objects.size() <= size_t{1} << 16)
+    return Merger<uint16_t>(scene, partition, model).run(config);
+  return Merger<uint32_t>(scene, partition, model).run(config);
 }
 
 ViewCellSet extract_by_count(const MergeHistory& h, size_t count) {

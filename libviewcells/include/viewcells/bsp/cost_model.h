@@ -11,6 +11,7 @@
 /// a midpoint rule for the mean over the cell, so a cell and its halves estimate alike, where
 /// corner points would bias small cells upwards. With c = 0 (the default) nothing of this is
 /// computed and r(o) is one number per object.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -63,5 +64,6 @@ double pvs_cost(const Scene& scene, const std::vector<double>& base, const CostM
 
 /// The union of two sorted id lists, sorted.
 std::vector<uint32_t> unite_sorted(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b);
+std::vector<uint16_t> unite_sorted(const std::vector<uint16_t>& a, const std::vector<uint16_t>& b);
 
 }  // namespace viewcells

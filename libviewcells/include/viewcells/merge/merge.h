@@ -34,6 +34,8 @@ struct CellPartition {
 /// The leaves of `s` as a partition, in the order of s.leaves(); `leaf_pvs` is per node
 /// (bsp/subdivision.h: leaf_pvs). Needs the leaf cells (s.cells) for the neighbours.
 CellPartition partition_from_subdivision(const Subdivision& s, const std::vector<std::vector<uint32_t>>& leaf_pvs);
+/// The same, the leaves' lists moved into the partition rather than copied.
+CellPartition partition_from_subdivision(const Subdivision& s, std::vector<std::vector<uint32_t>>&& leaf_pvs);
 
 /// A uniform nx x ny x nz grid over segments.view_box as a partition (the simplest kD
 /// partition: a baseline, and a test that merging takes any partition). A cell's PVS is the
