@@ -214,9 +214,16 @@ struct SegRef {
 struct alignas(64) SegEnds {
   Vec3 a, b;
   uint32_t object_a, object_b;
+  uint32_t triangle_a, triangle_b;  ///< the triangles hit at a and b (kNoObject: none)
   /// The point a + t (b - a), rounded the same way wherever the subdivision needs it.
   Vec3 at(double t) const { return a * (1.0 - t) + b * t; }
 };
+
+/// The triangle hit at an end of segment i; kNoObject also where a segment set carries no
+/// triangles (built by hand, as some tests do).
+inline uint32_t triangle_of(const RawVector<uint32_t>& triangles, size_t i) {
+  return i < triangles.size() ? triangles[i] : kNoObject;
+}
 
 /// Which children a segment part goes to, from the exact sides of its two ends:
 /// bit 0 negative, bit 1 positive.
@@ -552,7 +559,8 @@ class Builder {
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, static_cast<uint32_t>(segs_.size()), 1 << 14),
                       [&](const tbb::blocked_range<uint32_t>& range) {
                         for (uint32_t i = range.begin(); i < range.end(); ++i) {
-                          ends_[i] = {segs_.a(i), segs_.b(i), segs_.object_a[i], segs_.object_b[i]};
+                          ends_[i] = {segs_.a(i), segs_.b(i), segs_.object_a[i], segs_.object_b[i],
+                                      triangle_of(segs_.triangle_a, i), triangle_of(segs_.triangle_b, i)};
                           refs[i] = {i, 0.0, 1.0};
                         }
                       });
@@ -1197,13 +1205,26 @@ class Builder {
   Candidate best_geometry_candidate(int32_t node, Evaluation& ev, const double* r) {
     const RawVector<SegRef>& refs = refs_[node];
     // Triangles hit at segment ends inside this node lie (at least partly) inside it.
-    // (Distinct ones first, by marks; then sorted: far fewer than the parts.)
+    // (Distinct ones first, by marks; then sorted: far fewer than the parts.) The same pass
+    // takes the parts' end points and objects, in order, for all the planes.
+    struct PartEnds {
+      Vec3 p0, p1;
+      uint32_t object_a, object_b;
+    };
+    std::vector<PartEnds> parts(refs.size());
+    Box3 points;
     std::vector<uint32_t> tris;
     Marks& seen = triangle_marks_.local();
     seen.reset(scene_.triangles.size());
-    for (const SegRef& s : refs) {
-      if (s.t0 == 0.0 && seen.first(segs_.triangle_a[s.id])) tris.push_back(segs_.triangle_a[s.id]);
-      if (s.t1 == 1.0 && seen.first(segs_.triangle_b[s.id])) tris.push_back(segs_.triangle_b[s.id]);
+    for (size_t i = 0; i < refs.size(); ++i) {
+      prefetch_ends(refs, i);
+      const SegRef& s = refs[i];
+      const SegEnds& e = ends_[s.id];
+      if (s.t0 == 0.0 && seen.first(e.triangle_a)) tris.push_back(e.triangle_a);
+      if (s.t1 == 1.0 && seen.first(e.triangle_b)) tris.push_back(e.triangle_b);
+      parts[i] = {e.at(s.t0), e.at(s.t1), e.object_a, e.object_b};
+      points.extend(parts[i].p0);
+      points.extend(parts[i].p1);
     }
     std::sort(tris.begin(), tris.end());
     // One candidate per distinct plane (walls are made of several triangles).
@@ -1233,20 +1254,6 @@ class Builder {
     const double volume = out_.nodes[node].volume, weight = out_.nodes[node].weight;
     const ConvexPolyhedron& cell = out_.cells[node];
     const ConvexPolyhedron part = config_.density.enabled ? config_.density.band_part(cell) : ConvexPolyhedron();
-    // The parts' end points and objects once, in order, for all the planes.
-    struct PartEnds {
-      Vec3 p0, p1;
-      uint32_t object_a, object_b;
-    };
-    std::vector<PartEnds> parts(refs.size());
-    Box3 points;
-    for (size_t i = 0; i < refs.size(); ++i) {
-      prefetch_ends(refs, i);
-      const SegEnds& e = ends_[refs[i].id];
-      parts[i] = {e.at(refs[i].t0), e.at(refs[i].t1), e.object_a, e.object_b};
-      points.extend(parts[i].p0);
-      points.extend(parts[i].p1);
-    }
     // A plane's reduction from every `stride`-th part (1: exact). With `extremes`, also each
     // object one of whose extreme part ends lies strictly on a side counts there (that end's
     // part touches the side): with the sampled parts, a subset of what all parts see on each
