@@ -400,6 +400,86 @@ double brute_force_reduction(const SegmentSet& segs, const std::vector<double>& 
   return initial_cost - share * cost[0] - (1 - share) * cost[1];
 }
 
+/// The first split of a rotated office with every axis position and every geometry-aligned
+/// plane as candidates: the builder bounds most planes from their objects' extreme part ends
+/// and evaluates on all parts only those whose bound could beat the best so far (the root has
+/// far more than the 2,048 parts from which it bounds). Its reduction must be the best that a
+/// brute-force pass over every segment gives for every one of those planes, exactly classified.
+TEST(Subdivision, GeometryAlignedBoundsKeepTheBestPlane) {
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 1});
+  const std::vector<double> r = per_object_costs(scene, CostModel{});
+  for (uint64_t seed : {1, 2}) {
+    const SegmentSet segs = sample(scene, 7000, seed);
+    ASSERT_GT(segs.size(), 2u * 2048) << "the root must have enough parts to be bounded";
+    SubdivisionConfig config;
+    config.max_cells = 2;
+    config.max_axis_candidates = 1000000;  // every end position
+    config.ga_candidates = 1000000;        // every plane
+    config.geometry_aligned = GeometryAlignedMode::kOn;
+    config.min_reduction = 0;
+    config.show_progress = false;
+    const Subdivision s = subdivide(scene, segs, CostModel{}, config);
+    ASSERT_EQ(s.splits.size(), 1u);
+    const Box3 box = s.view_box;
+    double best_axis = -INFINITY;
+    for (int axis = 0; axis < 3; ++axis) {
+      std::vector<double> xs;
+      for (size_t i = 0; i < segs.size(); ++i)
+        for (const Vec3& p : {segs.a(i), segs.b(i)})
+          if (p[axis] > box.lo[axis] && p[axis] < box.hi[axis]) xs.push_back(p[axis]);
+      std::sort(xs.begin(), xs.end());
+      xs.erase(std::unique(xs.begin(), xs.end()), xs.end());
+      for (double x : xs) best_axis = std::max(best_axis, brute_force_reduction(segs, r, s.initial_cost, box, axis, x));
+    }
+    // The builder's planes: one per distinct non-axis-aligned plane of the triangles hit, keyed
+    // as it keys them (the lowest triangle id per key).
+    std::vector<uint32_t> tris;
+    for (size_t i = 0; i < segs.size(); ++i)
+      for (uint32_t t : {segs.triangle_a[i], segs.triangle_b[i]})
+        if (t != kNoObject) tris.push_back(t);
+    std::sort(tris.begin(), tris.end());
+    tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
+    std::map<std::array<long long, 4>, uint32_t> by_plane;
+    for (uint32_t t : tris) {
+      const Vec3 n = scene.triangle_normal(t);
+      if (!(length(n) > 0)) continue;
+      const Vec3 u = n / length(n);
+      if (std::max({std::abs(u.x), std::abs(u.y), std::abs(u.z)}) > 1.0 - 1e-9) continue;
+      const double d = dot(u, scene.vertices[scene.triangles[t][0]]);
+      const double q = 1e6 / std::max(1.0, box.diagonal());
+      by_plane.emplace(std::array<long long, 4>{std::llround(u.x * 1e6), std::llround(u.y * 1e6),
+                                                std::llround(u.z * 1e6), std::llround(d * q)},
+                       t);
+    }
+    ASSERT_GT(by_plane.size(), 10u);
+    const ConvexPolyhedron cell = ConvexPolyhedron::box(box, 0);
+    const double volume = cell.volume();
+    double best_ga = -INFINITY;
+    for (const auto& [key, t] : by_plane) {
+      const auto& tri = scene.triangles[t];
+      const Plane plane = Plane::through(scene.vertices[tri[0]], scene.vertices[tri[1]], scene.vertices[tri[2]]);
+      const double vl = cell.volume_below(plane);
+      if (!(vl > 1e-9 * volume && volume - vl > 1e-9 * volume)) continue;
+      std::vector<char> seen[2] = {std::vector<char>(r.size(), 0), std::vector<char>(r.size(), 0)};
+      double cost[2] = {0, 0};
+      for (size_t i = 0; i < segs.size(); ++i) {
+        const int s0 = plane.side(segs.a(i)), s1 = plane.side(segs.b(i));
+        const bool in_plane = s0 == 0 && s1 == 0;
+        const bool to[2] = {in_plane || s0 < 0 || s1 < 0, in_plane || s0 > 0 || s1 > 0};
+        for (int side = 0; side < 2; ++side)
+          for (uint32_t o : {segs.object_a[i], segs.object_b[i]})
+            if (to[side] && o != kNoObject && !seen[side][o]) {
+              seen[side][o] = 1;
+              cost[side] += r[o];
+            }
+      }
+      best_ga = std::max(best_ga, s.initial_cost - (vl * cost[0] + (volume - vl) * cost[1]) / volume);
+    }
+    EXPECT_GT(best_ga, best_axis) << "seed " << seed << ": a geometry-aligned plane should decide this split";
+    EXPECT_NEAR(s.splits[0].reduction, std::max(best_ga, best_axis), 1e-9 * s.initial_cost) << "seed " << seed;
+  }
+}
+
 TEST(Subdivision, FastCandidatesAreSegmentEndsEvaluatedExactly) {
   // More segment ends than candidates, so the fast choice draws them: the chosen plane lies at
   // a segment end, its recorded reduction is what brute force gives for it, and no integer

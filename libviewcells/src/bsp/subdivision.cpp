@@ -249,6 +249,8 @@ struct Marks {
     stamp[o] = epoch;
     return true;
   }
+  /// True once object o has been seen (always for kNoObject): adding it gives 0.
+  bool seen(uint32_t o) const { return o == kNoObject || stamp[o] == epoch; }
   /// Cost added by seeing object o (0 if already seen or none).
   double add(uint32_t o, const double* r) {
     if (o == kNoObject || stamp[o] == epoch) return 0.0;
@@ -1254,23 +1256,18 @@ class Builder {
     const double volume = out_.nodes[node].volume, weight = out_.nodes[node].weight;
     const ConvexPolyhedron& cell = out_.cells[node];
     const ConvexPolyhedron part = config_.density.enabled ? config_.density.band_part(cell) : ConvexPolyhedron();
-    // A plane's reduction from every `stride`-th part (1: exact). With `extremes`, also each
-    // object one of whose extreme part ends lies strictly on a side counts there (that end's
-    // part touches the side): with the sampled parts, a subset of what all parts see on each
-    // side.
-    auto reduction_of = [&](const Plane& plane, double vl, size_t stride, const std::vector<ObjectExtremes>* extremes) {
+    // A plane's reduction, from all the parts (exact; each plane costs O(n)), or bounded from
+    // above by `extremes`: an object one of whose extreme part ends lies strictly on a side
+    // is seen from there (that end's part touches the side), so those objects are a subset of
+    // what each side sees, each side's r(PVS) can only grow from theirs, and the reduction can
+    // only fall.
+    auto reduction_of = [&](const Plane& plane, double vl, const std::vector<ObjectExtremes>* extremes) {
       const FilteredSide side(plane, points);
       auto& [neg, pos] = side_pair_marks_.local();
       neg.reset(r_.size());
       pos.reset(r_.size());
       double cl = 0, cr = 0;
-      for (size_t i = 0; i < parts.size(); i += stride) {
-        const PartEnds& e = parts[i];
-        const int to = classify(side(e.p0), side(e.p1));
-        if (to & 1) cl += neg.add(e.object_a, r) + neg.add(e.object_b, r);
-        if (to & 2) cr += pos.add(e.object_a, r) + pos.add(e.object_b, r);
-      }
-      if (extremes)
+      if (extremes) {
         for (const ObjectExtremes& x : *extremes) {
           bool on_neg = false, on_pos = false;
           for (int k = 0; k < 2 * ObjectExtremes::kDirections && !(on_neg && on_pos); ++k) {
@@ -1281,23 +1278,28 @@ class Builder {
           if (on_neg) cl += neg.add(x.object, r);
           if (on_pos) cr += pos.add(x.object, r);
         }
+      } else {
+        for (const PartEnds& e : parts) {
+          // A part whose objects both sides have seen adds nothing: its sides are not needed.
+          if (neg.seen(e.object_a) && neg.seen(e.object_b) && pos.seen(e.object_a) && pos.seen(e.object_b)) continue;
+          const int to = classify(side(e.p0), side(e.p1));
+          if (to & 1) cl += neg.add(e.object_a, r) + neg.add(e.object_b, r);
+          if (to & 2) cr += pos.add(e.object_a, r) + pos.add(e.object_b, r);
+        }
+      }
       const double wl = config_.density.enabled ? config_.density.weight_below(cell, part, plane) : vl;
       return own - (wl * cl + (weight - wl) * cr) / total_weight_;
     };
-    // Each plane costs O(n). In a cell of more than 4 x kGaSampleParts parts, every plane is
-    // first measured on about kGaSampleParts evenly spaced parts (512 prunes about as well as
-    // 4,096 did on oa_shouse and the rotated office, and costs an eighth): they see a subset of what all parts see, so each side's
-    // r(PVS) can only grow and that reduction bounds the plane's true one from above. Planes are
-    // then evaluated on all parts in the order of their bounds until the next bound is below the
+    // In a cell of more than kBoundedParts parts, every plane is first bounded from its
+    // objects' extreme ends (O(objects), where most objects are seen across much of the cell),
+    // then evaluated on all parts in the order of the bounds until the next bound is below the
     // best exact reduction (with a margin for rounding): the same choice as evaluating them all.
-    constexpr size_t kGaSampleParts = 512;
-    const bool bounded = parts.size() > 4 * kGaSampleParts && planes.size() > 1;
-    const size_t stride = bounded ? (parts.size() + kGaSampleParts - 1) / kGaSampleParts : 1;
-    // Per object of the cell, its parts' extreme ends along a few fixed directions, for the
-    // bounds: most objects are seen across much of the cell, and the sampled parts alone miss
-    // many of them on each side (the bounds then exceeded the best reduction for nearly every
-    // plane, and every plane was evaluated on all parts).
-    std::vector<ObjectExtremes> extremes;
+    // On oa_shouse about one plane in seven is then evaluated on all parts. (Bounds from 512
+    // evenly spaced parts, used before, missed so many objects on each side that nearly every
+    // plane was evaluated on all parts.)
+    constexpr size_t kBoundedParts = 2048;
+    const bool bounded = parts.size() > kBoundedParts && planes.size() > 1;
+    std::vector<ObjectExtremes> extremes;  // per object of the cell
     if (bounded) {
       std::vector<uint32_t> entry(r_.size(), UINT32_MAX);
       for (const PartEnds& e : parts)
@@ -1323,7 +1325,7 @@ class Builder {
       const Plane plane = Plane::through(scene_.vertices[tri[0]], scene_.vertices[tri[1]], scene_.vertices[tri[2]]);
       const double vl = volume_below[j] = cell.volume_below(plane), vr = volume - vl;
       if (!(vl > kMinPart * volume && vr > kMinPart * volume)) return;
-      results[j] = {true, plane, reduction_of(plane, vl, stride, bounded ? &extremes : nullptr)};
+      results[j] = {true, plane, reduction_of(plane, vl, bounded ? &extremes : nullptr)};
     });
     if (bounded) {
       std::vector<size_t> order;
@@ -1341,7 +1343,7 @@ class Builder {
         const size_t batch = std::min(order.size(), next + 4);
         tbb::parallel_for(next, batch, [&](size_t i) {
           Candidate& c = results[order[i]];
-          c.reduction = reduction_of(c.plane, volume_below[order[i]], 1, nullptr);
+          c.reduction = reduction_of(c.plane, volume_below[order[i]], nullptr);
         });
         for (; next < batch; ++next) {
           exact[order[next]] = 1;
