@@ -488,15 +488,15 @@ class FilteredSide {
   double box_eps_ = INFINITY;
 };
 
-/// One object's part ends that lie farthest along, and against, each of 13 fixed directions
-/// (the axes, the face diagonals and the body diagonals of a cube): real ends, so that the
+/// One object's part ends that lie farthest along, and against, each of 7 fixed directions
+/// (the axes and the body diagonals of a cube; with the 6 face diagonals too, oa_shouse's
+/// subdivision took about 2.5 s against 2.1 s, in alternating runs): real ends, so that the
 /// exact side of any of them is that of an end of one of the object's parts.
 struct ObjectExtremes {
-  static constexpr int kDirections = 13;
+  static constexpr int kDirections = 7;
   static Vec3 direction(int d) {
-    static constexpr double v[kDirections][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1},  {1, 1, 0},  {1, -1, 0},
-                                                 {1, 0, 1}, {1, 0, -1}, {0, 1, 1}, {0, 1, -1}, {1, 1, 1},
-                                                 {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}};
+    static constexpr double v[kDirections][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1},
+                                                 {1, 1, 1}, {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}};
     return {v[d][0], v[d][1], v[d][2]};
   }
   uint32_t object;
