@@ -1301,7 +1301,9 @@ class Builder {
     const bool bounded = parts.size() > kBoundedParts && planes.size() > 1;
     std::vector<ObjectExtremes> extremes;  // per object of the cell
     if (bounded) {
-      std::vector<uint32_t> entry(r_.size(), UINT32_MAX);
+      // Object -> its entry in extremes; this thread's, left all UINT32_MAX again after use.
+      std::vector<uint32_t>& entry = extreme_entry_.local();
+      if (entry.size() < r_.size()) entry.assign(r_.size(), UINT32_MAX);
       for (const PartEnds& e : parts)
         for (const Vec3& q : {e.p0, e.p1}) {
           double along[ObjectExtremes::kDirections];
@@ -1316,6 +1318,7 @@ class Builder {
             extremes[entry[o]].add(q, along);
           }
         }
+      for (const ObjectExtremes& x : extremes) entry[x.object] = UINT32_MAX;
     }
     // The planes in parallel, the best chosen in their order: ties keep the first.
     std::vector<Candidate> results(planes.size());
@@ -1385,6 +1388,7 @@ class Builder {
   tbb::enumerable_thread_specific<PointMarks> point_marks_;
   tbb::enumerable_thread_specific<std::pair<Marks, Marks>> side_pair_marks_;  ///< geometry-aligned: both sides
   tbb::enumerable_thread_specific<Marks> triangle_marks_;  ///< geometry-aligned: triangles hit in a cell
+  tbb::enumerable_thread_specific<std::vector<uint32_t>> extreme_entry_;  ///< geometry-aligned: see extremes
   mutable tbb::enumerable_thread_specific<DrawnSet> drawn_;
 };
 
