@@ -261,6 +261,34 @@ SegmentSet lattice_segments(uint64_t seed, int count) {
   return segs;
 }
 
+/// Both sides' r(PVS) of `segs` by the builder's rule, from the sides of each segment's two
+/// ends (sides(i) gives them, -1, 0 or 1): a segment is on a side when an end lies strictly
+/// on it, and on both when it lies in the plane.
+template <class Sides>
+std::array<double, 2> brute_force_side_costs(const SegmentSet& segs, const std::vector<double>& r,
+                                             const Sides& sides) {
+  std::vector<char> seen[2] = {std::vector<char>(r.size(), 0), std::vector<char>(r.size(), 0)};
+  std::array<double, 2> cost = {0, 0};
+  for (size_t i = 0; i < segs.size(); ++i) {
+    const auto [s0, s1] = sides(i);
+    const bool in_plane = s0 == 0 && s1 == 0;
+    const bool to[2] = {in_plane || s0 < 0 || s1 < 0, in_plane || s0 > 0 || s1 > 0};
+    for (int side = 0; side < 2; ++side)
+      for (uint32_t o : {segs.object_a[i], segs.object_b[i]})
+        if (to[side] && o != kNoObject && !seen[side][o]) {
+          seen[side][o] = 1;
+          cost[side] += r[o];
+        }
+  }
+  return cost;
+}
+
+/// The sides of segment i's ends against the axis-aligned plane x[axis] = x.
+std::array<int, 2> axis_sides(const SegmentSet& segs, size_t i, int axis, double x) {
+  const double c0 = segs.a(i)[axis], c1 = segs.b(i)[axis];
+  return {c0 > x ? 1 : (c0 < x ? -1 : 0), c1 > x ? 1 : (c1 < x ? -1 : 0)};
+}
+
 TEST(Subdivision, SweepMatchesBruteForce) {
   const Scene scene = test::cube_grid(4);  // 16 objects of 12 triangles; only their count matters
   const std::vector<double> r = per_object_costs(scene, CostModel{});
@@ -277,20 +305,7 @@ TEST(Subdivision, SweepMatchesBruteForce) {
     double best = -1;
     for (int axis = 0; axis < 3; ++axis) {
       for (int x = 1; x < 8; ++x) {
-        std::vector<char> seen[2] = {std::vector<char>(16, 0), std::vector<char>(16, 0)};
-        double cost[2] = {0, 0};
-        for (size_t i = 0; i < segs.size(); ++i) {
-          const double c0 = segs.a(i)[axis], c1 = segs.b(i)[axis];
-          const int s0 = c0 > x ? 1 : (c0 < x ? -1 : 0), s1 = c1 > x ? 1 : (c1 < x ? -1 : 0);
-          const bool in_plane = s0 == 0 && s1 == 0;
-          const bool to[2] = {in_plane || s0 < 0 || s1 < 0, in_plane || s0 > 0 || s1 > 0};
-          for (int side = 0; side < 2; ++side)
-            for (uint32_t o : {segs.object_a[i], segs.object_b[i]})
-              if (to[side] && o != kNoObject && !seen[side][o]) {
-                seen[side][o] = 1;
-                cost[side] += r[o];
-              }
-        }
+        const auto cost = brute_force_side_costs(segs, r, [&](size_t i) { return axis_sides(segs, i, axis, x); });
         const double reduction = s.initial_cost - (x / 8.0) * cost[0] - ((8 - x) / 8.0) * cost[1];
         best = std::max(best, reduction);
       }
@@ -382,20 +397,7 @@ TEST(Subdivision, LaterSplitsMatchBruteForce) {
 /// `box` holding all of `segs` (the first split), by the classification rule of the builder.
 double brute_force_reduction(const SegmentSet& segs, const std::vector<double>& r, double initial_cost,
                              const Box3& box, int axis, double x) {
-  std::vector<char> seen[2] = {std::vector<char>(r.size(), 0), std::vector<char>(r.size(), 0)};
-  double cost[2] = {0, 0};
-  for (size_t i = 0; i < segs.size(); ++i) {
-    const double c0 = segs.a(i)[axis], c1 = segs.b(i)[axis];
-    const int s0 = c0 > x ? 1 : (c0 < x ? -1 : 0), s1 = c1 > x ? 1 : (c1 < x ? -1 : 0);
-    const bool in_plane = s0 == 0 && s1 == 0;
-    const bool to[2] = {in_plane || s0 < 0 || s1 < 0, in_plane || s0 > 0 || s1 > 0};
-    for (int side = 0; side < 2; ++side)
-      for (uint32_t o : {segs.object_a[i], segs.object_b[i]})
-        if (to[side] && o != kNoObject && !seen[side][o]) {
-          seen[side][o] = 1;
-          cost[side] += r[o];
-        }
-  }
+  const auto cost = brute_force_side_costs(segs, r, [&](size_t i) { return axis_sides(segs, i, axis, x); });
   const double share = (x - box.lo[axis]) / (box.hi[axis] - box.lo[axis]);
   return initial_cost - share * cost[0] - (1 - share) * cost[1];
 }
@@ -460,19 +462,8 @@ TEST(Subdivision, GeometryAlignedBoundsKeepTheBestPlane) {
       const Plane plane = Plane::through(scene.vertices[tri[0]], scene.vertices[tri[1]], scene.vertices[tri[2]]);
       const double vl = cell.volume_below(plane);
       if (!(vl > 1e-9 * volume && volume - vl > 1e-9 * volume)) continue;
-      std::vector<char> seen[2] = {std::vector<char>(r.size(), 0), std::vector<char>(r.size(), 0)};
-      double cost[2] = {0, 0};
-      for (size_t i = 0; i < segs.size(); ++i) {
-        const int s0 = plane.side(segs.a(i)), s1 = plane.side(segs.b(i));
-        const bool in_plane = s0 == 0 && s1 == 0;
-        const bool to[2] = {in_plane || s0 < 0 || s1 < 0, in_plane || s0 > 0 || s1 > 0};
-        for (int side = 0; side < 2; ++side)
-          for (uint32_t o : {segs.object_a[i], segs.object_b[i]})
-            if (to[side] && o != kNoObject && !seen[side][o]) {
-              seen[side][o] = 1;
-              cost[side] += r[o];
-            }
-      }
+      const auto cost = brute_force_side_costs(
+          segs, r, [&](size_t i) { return std::array<int, 2>{plane.side(segs.a(i)), plane.side(segs.b(i))}; });
       best_ga = std::max(best_ga, s.initial_cost - (vl * cost[0] + (volume - vl) * cost[1]) / volume);
     }
     EXPECT_GT(best_ga, best_axis) << "seed " << seed << ": a geometry-aligned plane should decide this split";
