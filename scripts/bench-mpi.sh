@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # MPI (issue: bakes that outgrow one machine): what the ranks exchange and where the time goes,
 # with 1, 2 and 4 ranks of one thread each on this machine (4 ranks oversubscribe its 2 cores:
-# their compute is not faster, their traffic is what it is), for AGVS (`pvs`, 1M samples in
+# their compute is not faster, their traffic is what it is), and one rank of two threads, for AGVS (`pvs`, 1M samples in
 # batches of 20,000, seed 1) on the city of size 23 cut into 500 and 5,000 view cells, and for
 # segment sampling (`sample`, 2M samples). Then the strong-scaling model of docs/distributed.md
 # from those measurements. Prints JSON lines and Markdown tables.
@@ -17,14 +17,18 @@ mkdir -p "$out"
   -o "$out/city5000.vcells"
 lines="$out/runs.jsonl"
 : >"$lines"
+# pvs_run RANKS THREADS CELLS NAME: one AGVS run, its line in runs.jsonl.
+pvs_run() {
+  mpirun --oversubscribe -np "$1" "$vc" --threads "$2" -q pvs "$out/city5000.vcells" --scene "$scene" --cells "$3" \
+    --samples 1000000 --batch 20000 --seed 1 -o "$out/$4.pvs" --report "$out/$4.json"
+  jq -c --arg kind pvs --argjson cells "$3" --argjson ranks "$1" --argjson threads "$2" '{kind: $kind, cells: $cells,
+    ranks: $ranks, threads: $threads, samples: .samples, seconds: .seconds, phases: .phases, cluster: (.cluster //
+    {exchanges: 0, bytes_sent: 0, bytes_received: 0, exchange_seconds: 0})}' "$out/$4.json" | tee -a "$lines"
+}
+# One rank of two threads: what drawing and applying divide over a node's cores.
+for cells in 500 5000; do pvs_run 1 2 "$cells" "pvs-$cells-1t2"; done
 for n in 1 2 4; do
-  for cells in 500 5000; do
-    mpirun --oversubscribe -np "$n" "$vc" --threads 1 -q pvs "$out/city5000.vcells" --scene "$scene" --cells "$cells" \
-      --samples 1000000 --batch 20000 --seed 1 -o "$out/pvs-$cells-$n.pvs" --report "$out/pvs-$cells-$n.json"
-    jq -c --arg kind pvs --argjson cells "$cells" --argjson ranks "$n" '{kind: $kind, cells: $cells, ranks: $ranks,
-      samples: .samples, seconds: .seconds, phases: .phases, cluster: (.cluster // {exchanges: 0, bytes_sent: 0,
-      bytes_received: 0, exchange_seconds: 0})}' "$out/pvs-$cells-$n.json" | tee -a "$lines"
-  done
+  for cells in 500 5000; do pvs_run "$n" 1 "$cells" "pvs-$cells-$n"; done
   mpirun --oversubscribe -np "$n" "$vc" --threads 1 -q sample "$scene" --samples 2000000 --seed 1 \
     -o "$out/s-$n.vseg" --report "$out/sample-$n.json"
   jq -c --arg kind sample --argjson ranks "$n" '{kind: $kind, ranks: $ranks, samples: .counts.samples,
@@ -35,6 +39,7 @@ for n in 2 4; do
   cmp -s "$out/s-1.vseg" "$out/s-$n.vseg" || { echo "bench-mpi: $n ranks sampled another file" >&2; exit 1; }
   for cells in 500 5000; do
     cmp -s "$out/pvs-$cells-1.pvs" "$out/pvs-$cells-$n.pvs" || { echo "bench-mpi: $n ranks: another .pvs" >&2; exit 1; }
+    cmp -s "$out/pvs-$cells-1.pvs" "$out/pvs-$cells-1t2.pvs" || { echo "bench-mpi: 2 threads: another .pvs" >&2; exit 1; }
   done
 done
 python3 scripts/vctables.py mpi-model "$lines" | tee "$out/tables.md"

@@ -1039,20 +1039,28 @@ def mpi_model(*args):
               f"| {c['bytes_sent'] / ex / 1e3:,.0f} kB | {c['bytes_received'] / ex / 1e3:,.0f} kB "
               f"| {c['exchange_seconds']:.2f} | {100 * c['exchange_seconds'] / r['seconds']:.1f}% |")
     print()
-    # Model inputs per sample: compute from one rank of one thread; the part of applying that
-    # the ranks divide (their own cells) from two ranks: a2 = p + q / 2, a1 = p + q; bytes from
-    # two ranks (what rank 0 sent and received is the whole batch's results).
+    # Model inputs per sample, from one rank of one thread, and one rank of two threads for the
+    # parts that the cores divide: x1 = s + p, x2 = s + p / 2 for drawing (its quasi-random
+    # distributions are computed in parallel) and applying (the table's insertions, divided by
+    # cells among the cores of every rank); bytes from two ranks (what rank 0 sent and received
+    # is the whole batch's results).
+    def fit(x1, x2):
+        divided = min(max(2 * (x1 - x2), 0.0), x1)
+        return x1 - divided, divided
+
     inputs = {}
     for cells in sorted({r["cells"] for r in runs if r["kind"] == "pvs"}):
-        one = next(r for r in runs if r["kind"] == "pvs" and r["cells"] == cells and r["ranks"] == 1)
-        two = next(r for r in runs if r["kind"] == "pvs" and r["cells"] == cells and r["ranks"] == 2)
+        def run_of(ranks, threads):
+            return next(r for r in runs if r["kind"] == "pvs" and r["cells"] == cells and r["ranks"] == ranks
+                        and r.get("threads", 1) == threads)
+        one, threads2, two = run_of(1, 1), run_of(1, 2), run_of(2, 1)
         ph, n = one["phases"], one["samples"]
-        a1 = ph["apply_seconds"] / n
-        a2 = two["phases"]["apply_seconds"] / two["samples"]
-        divided = min(max(2 * (a1 - a2), 0.0), a1)
+        ph2, n2 = threads2["phases"], threads2["samples"]
+        serial_draw, divided_draw = fit(ph["draw_seconds"] / n, ph2["draw_seconds"] / n2)
+        serial_apply, divided_apply = fit(ph["apply_seconds"] / n, ph2["apply_seconds"] / n2)
         inputs[cells] = {
-            "draw": ph["draw_seconds"] / n, "cast": ph["cast_seconds"] / n, "apply": a1,
-            "serial_apply": a1 - divided, "divided_apply": divided,
+            "serial_draw": serial_draw, "divided_draw": divided_draw, "cast": ph["cast_seconds"] / n,
+            "apply": ph["apply_seconds"] / n, "serial_apply": serial_apply, "divided_apply": divided_apply,
             "bytes": (two["cluster"]["bytes_sent"] + two["cluster"]["bytes_received"]) / two["samples"],
             "pierced": ph["pierced_cells"] / max(ph["segments"], 1), "segments": ph["segments"] / n}
     if len(inputs) >= 2:
@@ -1069,12 +1077,13 @@ def mpi_model(*args):
         print(f"Pierced cells per segment grow as cells^{k:.2f} (measured at {lo:,} and {hi:,} cells); "
               f"at {big:,} cells the model extrapolates {m['pierced']:.1f} per segment, and applying in proportion.")
         print()
-    print("| cells | draw µs/sample (serial) | cast core-µs/sample | apply µs/sample: serial + divided by the ranks "
-          "| exchanged bytes/sample | pierced cells/segment |")
+    print("| cells | draw µs/sample: serial + divided by a node's cores | cast core-µs/sample "
+          "| apply µs/sample: serial + divided by all cores | exchanged bytes/sample | pierced cells/segment |")
     print("| --- | --- | --- | --- | --- | --- |")
     for cells, m in sorted(inputs.items()):
-        print(f"| {cells:,} | {1e6 * m['draw']:.2f} | {1e6 * m['cast']:.2f} | {1e6 * m['serial_apply']:.2f} + "
-              f"{1e6 * m['divided_apply']:.2f} | {m['bytes']:.0f} | {m['pierced']:.1f} |")
+        print(f"| {cells:,} | {1e6 * m['serial_draw']:.2f} + {1e6 * m['divided_draw']:.2f} | {1e6 * m['cast']:.2f} "
+              f"| {1e6 * m['serial_apply']:.2f} + {1e6 * m['divided_apply']:.2f} | {m['bytes']:.0f} "
+              f"| {m['pierced']:.1f} |")
     print()
     cores, bandwidth, latency, batch = 32, 10e9, 5e-6, 20000
     nodes = [1, 2, 4, 8, 16, 32, 64]
@@ -1084,13 +1093,16 @@ def mpi_model(*args):
         # rank) and three small reductions per batch, each a few latencies.
         exchange = ((n - 1) / n) * m["bytes"] / bandwidth + (4 * math.ceil(math.log2(n)) * latency / batch
                                                           if n > 1 else 0)
+        draw = m["serial_draw"] + m["divided_draw"]
         if all_parallel:
-            return (m["draw"] + m["apply"] + m["cast"]) / (n * cores) + exchange
-        return m["draw"] + m["serial_apply"] + m["divided_apply"] / n + m["cast"] / (n * cores) + exchange
+            return (draw + m["apply"] + m["cast"]) / (n * cores) + exchange
+        return (m["serial_draw"] + m["divided_draw"] / cores + m["serial_apply"] + m["divided_apply"] / (n * cores)
+                + m["cast"] / (n * cores) + exchange)
 
     for all_parallel in (False, True):
         what = ("if drawing and applying were spread like casting (not built: the bound from the exchange alone)"
-                if all_parallel else "as built: drawing and the ordered part of applying on every rank")
+                if all_parallel else "as built: the serial parts of drawing and applying on every rank, drawing's "
+                "divided part over each node's cores, applying's over all cores")
         print(f"{what}; batches of {batch:,} samples, {cores} cores per node, {bandwidth / 1e9:.0f} GB/s and "
               f"{latency * 1e6:.0f} µs between nodes: speed-up over one node (parallel efficiency)")
         print()

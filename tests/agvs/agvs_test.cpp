@@ -3,16 +3,21 @@
 // followed by resumed sampling, and the visibility filter.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <set>
 
+#include "../../libviewcells/src/agvs/candidates.h"
 #include "support/test_scenes.h"
 #include "viewcells/agvs/agvs.h"
 #include "viewcells/eval/frames.h"
 #include "viewcells/agvs/penumbra.h"
+#include "viewcells/bsp/subdivision.h"
+#include "viewcells/core/rng.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/binary_file.h"
@@ -33,15 +38,133 @@ AgvsConfig quiet(AgvsMethod method, uint64_t samples) {
   return c;
 }
 
+TEST(Agvs, MutationCandidatesComeLeastMutatedFirstAndTheMostMutatedAreDropped) {
+  // The buffer against its definition (a set ordered by (times taken, id)), over random adds
+  // and takes with a small cap, and through a save and load half-way.
+  using agvs_detail::Candidate;
+  using agvs_detail::CandidateBuffer;
+  constexpr size_t kCap = 40;
+  CandidateBuffer buffer;
+  std::set<std::pair<uint32_t, uint64_t>> model;
+  std::map<uint64_t, uint32_t> times_of;
+  uint64_t next = 0;
+  Rng rng(3, 7);
+  const Box3 box{{-1, -1, -1}, {1, 1, 1}};
+  for (int step = 0; step < 20000; ++step) {
+    if (step == 10000) {
+      ByteWriter w;
+      buffer.save(w);
+      const std::string bytes = w.take();
+      ByteReader r(bytes, "state");
+      buffer = CandidateBuffer::load(r, kCap, bytes.size(), box, 1u << 30);
+      ASSERT_TRUE(r.at_end());
+    }
+    if (model.empty() || rng.uniform() < 0.35) {
+      Candidate c;
+      c.object = static_cast<uint32_t>(next);  // tags the candidate with its id
+      buffer.add(c, kCap);
+      model.insert({0u, next});
+      times_of[next++] = 0;
+      if (model.size() > kCap) {
+        times_of.erase(std::prev(model.end())->second);
+        model.erase(std::prev(model.end()));
+      }
+    } else {
+      const auto [times, id] = *model.begin();
+      model.erase(model.begin());
+      model.insert({times + 1, id});
+      times_of[id] = times + 1;
+      ASSERT_EQ(buffer.take().object, id) << "step " << step;
+    }
+    ASSERT_EQ(buffer.size(), model.size());
+  }
+  // Out of order in the file: refused.
+  ByteWriter w;
+  w.put<uint64_t>(5);
+  w.put<uint64_t>(2);
+  for (uint64_t id : {3, 1}) {
+    w.put(id), w.put<uint32_t>(0);
+    w.put(Vec3{}), w.put(Vec3{}), w.put(0.0), w.put(0.0), w.put(kNoObject);
+  }
+  const std::string bad = w.take();
+  ByteReader r(bad, "state");
+  EXPECT_THROW(CandidateBuffer::load(r, kCap, bad.size(), box, 1), Error);
+}
+
+TEST(Agvs, CellsOfASegmentAreThoseOfTheLeavesItPierces) {
+  // The walk stops at subtrees that lie in one cell; it must report exactly the cells of the
+  // leaves a full walk reaches, also for segments in split planes and ending on them, and
+  // through geometry-aligned planes (the rotated office).
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 3});
+  SubdivisionConfig sc;
+  sc.max_cells = 96;
+  sc.show_progress = false;
+  sc.geometry_aligned = GeometryAlignedMode::kOn;
+  const Subdivision s = subdivide(scene, test::sample_scene(scene, 20000, 5), CostModel{}, sc);
+  const std::vector<int32_t> leaves = s.leaves();
+  ASSERT_GT(leaves.size(), 60u);
+  // Cells of whole subtrees (the leaves under each node of an earlier cut), and cells that are
+  // not (leaves dealt round), so that the walk both stops early and goes to the leaves.
+  std::vector<int32_t> by_subtree(s.nodes.size(), -1), dealt(s.nodes.size(), -1);
+  const std::vector<int32_t> earlier = s.leaves_after(12);
+  for (size_t c = 0; c < earlier.size(); ++c) {
+    std::vector<int32_t> todo{earlier[c]};
+    while (!todo.empty()) {
+      const int32_t n = todo.back();
+      todo.pop_back();
+      if (s.nodes[n].plane < 0) by_subtree[n] = static_cast<int32_t>(c);
+      else todo.insert(todo.end(), {s.nodes[n].child[0], s.nodes[n].child[1]});
+    }
+  }
+  for (size_t i = 0; i < leaves.size(); ++i) dealt[leaves[i]] = static_cast<int32_t>(i % 7);
+  const Box3 box = s.view_box;
+  const Vec3 e = box.extent();
+  std::vector<std::pair<Vec3, Vec3>> segments;
+  Rng rng(9, 1);
+  auto point = [&] { return box.lo + Vec3{e.x * rng.uniform(), e.y * rng.uniform(), e.z * rng.uniform()}; };
+  for (int k = 0; k < 3000; ++k) segments.push_back({point(), point()});
+  // In and onto axis-aligned split planes.
+  for (const SplitRecord& r : s.splits) {
+    const Plane& plane = s.planes[s.nodes[r.node].plane];
+    if (plane.axis < 0) continue;
+    Vec3 a = point(), b = point();
+    a[plane.axis] = b[plane.axis] = plane.offset;
+    segments.push_back({a, b});
+    Vec3 c = point();
+    c[plane.axis] = plane.offset;
+    segments.push_back({point(), c});
+  }
+  size_t several_leaves_a_cell = 0;
+  for (const std::vector<int32_t>* cells_of : {&by_subtree, &dealt}) {
+    const std::vector<int32_t>& leaf_cell = *cells_of;
+    const uint32_t count = 1 + static_cast<uint32_t>(*std::max_element(leaf_cell.begin(), leaf_cell.end()));
+    const CellLocator cells(s, leaf_cell, count);
+    std::vector<std::tuple<int32_t, double, double>> stack;
+    std::vector<int32_t> got, reached;
+    for (const auto& [a, b] : segments) {
+      cells.cells_of_segment(a, b, got, stack);
+      reached.clear();
+      s.leaves_of_segment(a, b, reached, stack);
+      std::vector<int32_t> want;
+      for (int32_t l : reached) want.push_back(leaf_cell[l]);
+      std::sort(want.begin(), want.end());
+      want.erase(std::unique(want.begin(), want.end()), want.end());
+      ASSERT_EQ(got, want);
+      if (cells_of == &by_subtree) several_leaves_a_cell += want.size() < reached.size();
+    }
+  }
+  EXPECT_GT(several_leaves_a_cell, 100u);  // walks that can stop above the leaves
+}
+
 TEST(Agvs, ContributionGoesToEveryPiercedCellAndNoOther) {
   const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 2});
   const CellLocator cells = office_cells(scene, 32);
   const Box3 box = cells.view_box();
   std::vector<std::tuple<int32_t, double, double>> stack;
-  std::vector<int32_t> leaves, pierced;
+  std::vector<int32_t> pierced;
   const Vec3 e = box.extent();
   const Vec3 a = box.lo + e * 0.1, b = box.lo + Vec3{0.9 * e.x, 0.7 * e.y, 0.8 * e.z};
-  cells.cells_of_segment(a, b, pierced, stack, leaves);
+  cells.cells_of_segment(a, b, pierced, stack);
   // The same cells as walking the segment in small steps.
   std::set<int32_t> walked;
   for (int k = 0; k <= 20000; ++k) walked.insert(cells.cell_at(a + (b - a) * (k / 20000.0)));

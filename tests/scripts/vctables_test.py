@@ -421,28 +421,31 @@ class MpiModelTest(unittest.TestCase):
             path = os.path.join(d, "runs.jsonl")
             lines = []
             for cells, pierced in ((500, 2000), (5000, 4000)):
-                for ranks in (1, 2):
-                    # Applying: 0.2 s on one rank, 0.15 s on two: 0.1 s serial, 0.1 s divided.
-                    lines.append({"kind": "pvs", "cells": cells, "ranks": ranks, "samples": 1000, "seconds": 2.0,
-                                  "phases": {"draw_seconds": 0.1, "cast_seconds": 1.0,
-                                             "apply_seconds": 0.2 if ranks == 1 else 0.15,
+                for ranks, threads in ((1, 1), (1, 2), (2, 1)):
+                    # Drawing: 0.1 s on one thread, 0.06 s on two: 0.02 s serial, 0.08 s divided.
+                    # Applying: 0.2 s on one thread, 0.15 s on two: 0.1 s serial, 0.1 s divided.
+                    lines.append({"kind": "pvs", "cells": cells, "ranks": ranks, "threads": threads, "samples": 1000,
+                                  "seconds": 2.0,
+                                  "phases": {"draw_seconds": 0.1 if threads == 1 else 0.06, "cast_seconds": 1.0,
+                                             "apply_seconds": 0.2 if threads == 1 else 0.15,
                                              "segments": 1000, "pierced_cells": pierced},
                                   "cluster": {"exchanges": 4 * (ranks - 1), "bytes_sent": 50000 * (ranks - 1),
                                               "bytes_received": 50000 * (ranks - 1), "exchange_seconds": 0.1}})
             with open(path, "w") as f:
                 f.write("\n".join(json.dumps(x) for x in lines) + "\n")
             out = run("mpi-model", path)
-        # Per sample: 0.1 ms drawing, 1 ms casting, 0.1 + 0.1 ms applying, 100 bytes.
+        # Per sample: 0.02 + 0.08 ms drawing, 1 ms casting, 0.1 + 0.1 ms applying, 100 bytes.
         cells = row(out, "500")
-        self.assertEqual(cells[1:5], ["100.00", "1000.00", "100.00 + 100.00", "100"])
+        self.assertEqual(cells[1:5], ["20.00 + 80.00", "1000.00", "100.00 + 100.00", "100"])
         # Pierced cells double per tenfold cells: at 50,000 cells 8 per segment, applying doubled.
         self.assertIn("cells^0.30", out)
         self.assertEqual(row(out, "50,000")[3], "200.00 + 200.00")
         rows = [l for l in out.splitlines() if l.startswith("| 500 | 1.0 (100%)")]
         self.assertEqual(len(rows), 2)
-        # As built, 2 nodes: 1e-4 + 1e-4 + 1e-4 / 2 + 1e-3 / 64 + 0.5 * 100 / 1e10 + 4 * 5e-6 / 20000.
-        one = 1e-4 + 2e-4 + 1e-3 / 32
-        two = 1e-4 + 1e-4 + 1e-4 / 2 + 1e-3 / 64 + 0.5 * 100 / 1e10 + 4 * 5e-6 / 20000
+        # As built, 2 nodes of 32 cores: drawing's divided part over 32 cores, applying's over 64.
+        fixed = 2e-5 + 8e-5 / 32 + 1e-4
+        one = fixed + 1e-4 / 32 + 1e-3 / 32
+        two = fixed + 1e-4 / 64 + 1e-3 / 64 + 0.5 * 100 / 1e10 + 4 * 5e-6 / 20000
         self.assertEqual(rows[0].split("|")[3].strip(), f"{one / two:.1f} ({100 * one / two / 2:.0f}%)")
         # All parallel, 2 nodes: (1e-4 + 2e-4 + 1e-3) / 64 + the exchange.
         one = (1e-4 + 2e-4 + 1e-3) / 32

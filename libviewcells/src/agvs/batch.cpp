@@ -6,7 +6,9 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
+#include <array>
 #include <chrono>
 #include <span>
 #include <tuple>
@@ -63,6 +65,12 @@ void AgvsSolver::Impl::draw_samples(uint64_t index, uint32_t n, const double sha
   for (int d : kOrder) {
     s.first_of[d] = static_cast<uint32_t>(s.points.size());
     const uint32_t target = want[d] + (d == kVsd ? failed : 0);
+    if (config.method != AgvsMethod::kRef && (d == kOd || d == kTp || d == kVsd)) {
+      // Quasi-random, from Halton indices alone: computed in parallel, taken in order.
+      failed += stationary_samples(d, target, s.points, s.dirs);
+      s.end_of[d] = static_cast<uint32_t>(s.points.size());
+      continue;
+    }
     for (uint32_t k = 0; k < target; ++k) {
       Vec3 p, dir;
       if (config.method == AgvsMethod::kRef) {
@@ -86,7 +94,7 @@ void AgvsSolver::Impl::draw_samples(uint64_t index, uint32_t n, const double sha
         job.u[0] = rng.uniform(), job.u[1] = rng.uniform();
         sil_jobs.push_back(job);
         continue;
-      } else if (!draw(d, rng, p, dir)) {
+      } else if (!draw_two_point_mutation(rng, p, dir)) {  // d == kTpm
         ++failed;
         continue;
       }
@@ -159,9 +167,7 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
                            std::span<const Vec3>(s.dirs.data() + c.first, c.size), c.segs, c.sample_of);
     c.pierced.assign(c.segs.size(), {});
     std::vector<std::tuple<int32_t, double, double>> stack;
-    std::vector<int32_t> leaves;
-    for (size_t i = 0; i < c.segs.size(); ++i)
-      cells.cells_of_segment(c.segs.a(i), c.segs.b(i), c.pierced[i], stack, leaves);
+    for (size_t i = 0; i < c.segs.size(); ++i) cells.cells_of_segment(c.segs.a(i), c.segs.b(i), c.pierced[i], stack);
   };
   if (cluster::size() > 1) {
     // Several ranks: each casts the chunks it owns (numbered across batches, so that the work
@@ -209,6 +215,80 @@ struct AgvsSolver::Impl::BatchCounts {
   std::vector<uint8_t> camera_rays, wrong_rays, has_segment;
 };
 
+template <class OnSegment>
+void AgvsSolver::Impl::insert_segments(const BatchSamples& s, const std::vector<BatchChunk>& chunks,
+                                       OnSegment&& on_segment, std::vector<uint32_t>& gains,
+                                       std::vector<uint8_t>& flags) {
+  const size_t total = gains.size();
+  // Per segment: its chunk and index there, and whether it is its sample's camera segment (the
+  // first of a view space-direction sample through the sample's point; a chunk holds its
+  // samples' every segment), with the cell of that point.
+  std::vector<std::pair<const BatchChunk*, uint32_t>> at(total);
+  std::vector<uint8_t> own(total, 0);
+  std::vector<int32_t> origin_cell(s.points.size(), -1);
+  tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t ci) {
+    const BatchChunk& c = chunks[ci];
+    std::vector<uint8_t> seen(c.size, 0);
+    for (size_t i = 0; i < c.segs.size(); ++i) {
+      const size_t k = c.seg_start + i;
+      at[k] = {&c, static_cast<uint32_t>(i)};
+      const uint32_t sample = c.first + c.sample_of[i];
+      if (c.dist != kVsd || seen[c.sample_of[i]] || !on_segment(c, i, sample)) continue;
+      seen[c.sample_of[i]] = 1;
+      own[k] = 1;
+      origin_cell[sample] = cells.cell_at(s.points[sample]);
+    }
+  });
+  // This rank's cells divided among parts, each inserting into its own cells in sample order
+  // (so the table, the gains and the flags do not depend on the number of parts): first the
+  // (segment, cell) pairs of each part, per block of segments, then each part's in order.
+  const uint64_t ranks = static_cast<uint64_t>(cluster::size());
+  const size_t parts = static_cast<size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
+  constexpr size_t kBlock = 4096;
+  const size_t blocks = (total + kBlock - 1) / kBlock;
+  std::vector<std::vector<std::vector<std::pair<uint32_t, int32_t>>>> pairs(
+      blocks, std::vector<std::vector<std::pair<uint32_t, int32_t>>>(parts));
+  tbb::parallel_for(size_t{0}, blocks, [&](size_t b) {
+    for (size_t k = b * kBlock; k < std::min(total, (b + 1) * kBlock); ++k)
+      for (int32_t cell : at[k].first->pierced[at[k].second])
+        if (cluster::mine(static_cast<uint64_t>(cell)))
+          pairs[b][(static_cast<uint64_t>(cell) / ranks) % parts].push_back({static_cast<uint32_t>(k), cell});
+  });
+  std::vector<std::vector<uint32_t>> part_gains(parts);
+  std::vector<std::vector<uint8_t>> part_flags(parts);
+  std::vector<uint64_t> part_entries(parts, 0);
+  tbb::parallel_for(size_t{0}, parts, [&](size_t p) {
+    std::vector<uint32_t>& g = part_gains[p];
+    std::vector<uint8_t>& f = part_flags[p];
+    g.assign(total, 0);
+    f.assign(total, 0);
+    for (size_t b = 0; b < blocks; ++b)
+      for (const auto& [k, cell] : pairs[b][p]) {
+        const BatchChunk& c = *at[k].first;
+        const uint32_t i = at[k].second;
+        const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
+        const bool origin = own[k] && cell == origin_cell[c.first + c.sample_of[i]];
+        bool contributed[2] = {false, false}, at_origin[2] = {false, false};
+        const uint32_t gain = contribute_in_cell(
+            [&](uint32_t o) { return pvs.insert_in_row(static_cast<uint32_t>(cell), o); }, objs, origin, contributed,
+            at_origin);
+        g[k] += gain;
+        part_entries[p] += gain;
+        f[k] |= static_cast<uint8_t>(contributed[0] | contributed[1] << 1 | at_origin[0] << 2 | at_origin[1] << 3);
+        if (config.filter_statistics) count_hits(cell, objs[0], objs[1]);
+      }
+  });
+  for (uint64_t n : part_entries) pvs.add_entries(n);
+  tbb::parallel_for(size_t{0}, total, [&](size_t k) {
+    for (size_t p = 0; p < parts; ++p) gains[k] += part_gains[p][k], flags[k] |= part_flags[p][k];
+    // Both ends see the same object: both rays were wrong pixels before (as contribute()).
+    const BatchChunk& c = *at[k].first;
+    const uint32_t i = at[k].second;
+    if (c.segs.object_a[i] == c.segs.object_b[i] && c.segs.object_a[i] != kNoObject)
+      flags[k] = static_cast<uint8_t>((flags[k] & ~8u) | ((flags[k] & 4u) << 1));
+  });
+}
+
 void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<BatchChunk>& chunks,
                                       BatchCounts& counts) {
   // Pass 1, in sample order: the table. On several ranks each inserts into its own cells (c
@@ -220,10 +300,6 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
   for (const BatchChunk& c : chunks) total += c.segs.size();
   std::vector<uint32_t> gains(total, 0);
   std::vector<uint8_t> flags(total, 0);  // contributed a, b; at origin a, b (REF: wrong ray)
-  std::vector<uint8_t> camera(s.points.size(), 0);
-  std::vector<int32_t> origin_cell(s.points.size(), -2);
-  std::vector<int32_t> owned;
-  const bool all_mine = cluster::size() == 1;
   // Whether the sample's point lies on this segment: its own segment (re-casts of points
   // inside solids start elsewhere; see-through companions are the first one's).
   auto on_segment = [&](const BatchChunk& c, size_t i, uint32_t sample) {
@@ -231,50 +307,42 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
     const double t = dot(s.points[sample] - a, ab);
     return t >= 0 && t <= dot(ab, ab);
   };
-  for (const BatchChunk& c : chunks) {
-    for (size_t i = 0; i < c.segs.size(); ++i) {
-      const size_t k = c.seg_start + i;
-      const uint32_t sample = c.first + c.sample_of[i];
-      const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
-      if (config.method == AgvsMethod::kRef) {
+  if (config.method == AgvsMethod::kRef) {
+    std::vector<uint8_t> camera(s.points.size(), 0);
+    for (const BatchChunk& c : chunks) {
+      for (size_t i = 0; i < c.segs.size(); ++i) {
         // Per cell: the object hit forward from the sample's point, for its cell only; one
         // camera ray, counted once per sample.
+        const size_t k = c.seg_start + i;
+        const uint32_t sample = c.first + c.sample_of[i];
         if (camera[sample] != 0 || !on_segment(c, i, sample)) continue;
         camera[sample] = 1;
         const int32_t cell = s.ref_cell[sample];
         if (!cluster::mine(static_cast<uint64_t>(cell))) continue;
-        if (config.filter_statistics) count_hits(cell, objs[1], kNoObject);
-        if (objs[1] != kNoObject && pvs.insert(static_cast<uint32_t>(cell), objs[1])) gains[k] = 1, flags[k] = 4;
-        continue;
+        const uint32_t object = c.segs.object_b[i];
+        if (config.filter_statistics) count_hits(cell, object, kNoObject);
+        if (object != kNoObject && pvs.insert(static_cast<uint32_t>(cell), object)) gains[k] = 1, flags[k] = 4;
       }
-      const bool own = c.dist == kVsd && camera[sample] == 0 && on_segment(c, i, sample);
-      if (own && origin_cell[sample] == -2) origin_cell[sample] = cells.cell_at(s.points[sample]);
-      const std::vector<int32_t>* mine = &c.pierced[i];
-      if (!all_mine) {
-        owned.clear();
-        for (int32_t cell : c.pierced[i])
-          if (cluster::mine(static_cast<uint64_t>(cell))) owned.push_back(cell);
-        mine = &owned;
-      }
-      bool contributed[2] = {false, false}, at_origin[2] = {false, false};
-      gains[k] = contribute(pvs, *mine, objs[0], objs[1], contributed, own ? origin_cell[sample] : -1, at_origin);
-      flags[k] = static_cast<uint8_t>(contributed[0] | contributed[1] << 1 | at_origin[0] << 2 | at_origin[1] << 3);
-      if (config.filter_statistics)
-        for (int32_t cell : *mine) count_hits(cell, objs[0], objs[1]);
-      if (own) camera[sample] = 2;
     }
+  } else {
+    insert_segments(s, chunks, on_segment, gains, flags);
   }
   cluster::sum(gains);
   cluster::bit_or(flags);
-  // Pass 2, in sample order: what follows from the segments besides the table.
-  for (const BatchChunk& c : chunks) {
-    counts.rays[c.dist] += c.rays;
+  // Pass 2: what follows from the segments besides the table. Per chunk in parallel (a chunk
+  // holds its samples' every segment): the counts, the estimator's camera rays, and the radii
+  // at the ends of contributing segments (point location where an end has no object); then,
+  // in sample order, the mutation candidates.
+  const bool mutations = config.method == AgvsMethod::kAgvs;
+  std::vector<uint64_t> chunk_contribution(chunks.size(), 0);
+  std::vector<std::array<double, 2>> radius(mutations ? total : 0);
+  tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t ci) {
+    const BatchChunk& c = chunks[ci];
     for (size_t i = 0; i < c.segs.size(); ++i) {
       const size_t k = c.seg_start + i;
       const uint32_t sample = c.first + c.sample_of[i];
       counts.has_segment[sample] = 1;
-      const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
-      counts.contribution[c.dist] += gains[k];
+      chunk_contribution[ci] += gains[k];
       if (config.method == AgvsMethod::kRef) {
         if (counts.camera_rays[sample] == 0 && on_segment(c, i, sample)) {
           counts.camera_rays[sample] = 1;
@@ -287,19 +355,27 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
         counts.camera_rays[sample] = 2;
         counts.wrong_rays[sample] = static_cast<uint8_t>(((flags[k] >> 2) & 1) + ((flags[k] >> 3) & 1));
       }
-      if (gains[k] > 0 && config.method == AgvsMethod::kAgvs) {
-        // A mutation candidate per end whose object contributed.
-        const Vec3 a = c.segs.a(i), b = c.segs.b(i);
-        for (int e = 0; e < 2; ++e) {
-          if (!((flags[k] >> e) & 1)) continue;
-          const Vec3& term = e ? b : a;
-          const Vec3& origin = e ? a : b;
-          add_candidate({origin, term, end_radius(objs[1 - e], origin), end_radius(objs[e], term), objs[e]});
-        }
-      }
+      if (mutations && gains[k] > 0)
+        radius[k] = {end_radius(c.segs.object_a[i], c.segs.a(i)), end_radius(c.segs.object_b[i], c.segs.b(i))};
     }
+  });
+  for (size_t ci = 0; ci < chunks.size(); ++ci) {
+    counts.rays[chunks[ci].dist] += chunks[ci].rays;
+    counts.contribution[chunks[ci].dist] += chunk_contribution[ci];
   }
-  if (all_mine) return;
+  if (mutations) {
+    for (const BatchChunk& c : chunks)
+      for (size_t i = 0; i < c.segs.size(); ++i) {
+        const size_t k = c.seg_start + i;
+        if (gains[k] == 0) continue;
+        // A mutation candidate per end whose object contributed.
+        const Vec3 ends[2] = {c.segs.a(i), c.segs.b(i)};
+        const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
+        for (int e = 0; e < 2; ++e)
+          if ((flags[k] >> e) & 1) add_candidate({ends[1 - e], ends[e], radius[k][1 - e], radius[k][e], objs[e]});
+      }
+  }
+  if (cluster::size() == 1) return;
   // The table's size over all ranks' rows (for the mean PVS of the curve and the status).
   partitioned = true;
   std::vector<uint64_t> grown{pvs.entries() - synced_entries};

@@ -2,6 +2,10 @@
 // object-direction and two-point (stationary), two-point and silhouette mutations.
 #include "solver_impl.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
 #include <numbers>
 
 namespace viewcells {
@@ -44,29 +48,65 @@ Vec3 AgvsSolver::Impl::object_point(double u0, double u1, double u2, double u3, 
   return p;
 }
 
-bool AgvsSolver::Impl::next_view_point(int d, int dim, uint64_t& i, Vec3& point) {
+void AgvsSolver::Impl::view_points(int d, int dim, uint32_t attempts, std::vector<uint64_t>& index,
+                                   std::vector<Vec3>& point) {
   const Halton& h = halton[d];
-  // Most of a map's view box may be solid: points outside the view space are skipped (a bound
-  // keeps a view space of nearly no volume from stalling the batch).
-  for (int tries = 0; tries < 10000; ++tries) {
-    i = halton_index[d]++;
-    point = view_point(h.at(i, dim), h.at(i, dim + 1), h.at(i, dim + 2));
-    if (!config.view_space || config.view_space(point)) return true;
+  index.assign(attempts, kNoIndex);
+  point.assign(attempts, Vec3{});
+  auto at = [&](uint64_t i) { return view_point(h.at(i, dim), h.at(i, dim + 1), h.at(i, dim + 2)); };
+  if (!config.view_space) {
+    const uint64_t first = halton_index[d];
+    halton_index[d] += attempts;
+    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, attempts, 256), [&](const tbb::blocked_range<uint32_t>& r) {
+      for (uint32_t k = r.begin(); k < r.end(); ++k) index[k] = first + k, point[k] = at(first + k);
+    });
+    return;
   }
-  return false;
+  // Most of a map's view box may be solid: points outside the view space are skipped, and an
+  // attempt that meets kMaxTries of them in a row fails (a view space of nearly no volume must
+  // not stall the batch). The points are tested a block at a time in parallel (blocks sized
+  // from the share inside so far: only their cost depends on it) and taken in order.
+  constexpr uint32_t kMaxTries = 10000;
+  uint32_t k = 0, tries = 0;
+  uint64_t tested = 0, inside_count = 0;
+  std::vector<Vec3> candidates;
+  std::vector<uint8_t> inside;
+  while (k < attempts) {
+    const double share = (inside_count + 1.0) / (tested + 2.0);
+    const size_t block =
+        std::clamp<size_t>(static_cast<size_t>(1.1 * (attempts - k) / share) + 64, 256, size_t{1} << 20);
+    const uint64_t first = halton_index[d];
+    candidates.resize(block);
+    inside.resize(block);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, block, 256), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t j = r.begin(); j < r.end(); ++j) {
+        candidates[j] = at(first + j);
+        inside[j] = config.view_space(candidates[j]) ? 1 : 0;
+      }
+    });
+    size_t used = 0;
+    for (; used < block && k < attempts; ++used) {
+      ++tries;
+      if (inside[used]) {
+        index[k] = first + used, point[k] = candidates[used];
+        ++k, ++inside_count, tries = 0;
+      } else if (tries == kMaxTries) {
+        ++k, tries = 0;  // this attempt fails
+      }
+    }
+    halton_index[d] = first + used;
+    tested += used;
+  }
 }
 
-bool AgvsSolver::Impl::draw(int d, Rng& rng, Vec3& point, Vec3& dir) {
+bool AgvsSolver::Impl::stationary_sample(int d, uint64_t i, const Vec3& at, Vec3& point, Vec3& dir) const {
   const Halton& h = halton[d];
   switch (d) {
-    case kVsd: {
-      uint64_t i = 0;
-      if (!next_view_point(d, 0, i, point)) return false;
+    case kVsd:
+      point = at;
       dir = sphere_direction(h.at(i, 3), h.at(i, 4));
       return true;
-    }
     case kOd: {
-      const uint64_t i = halton_index[d]++;
       Vec3 n;
       const Vec3 x = object_point(h.at(i, 0), h.at(i, 1), h.at(i, 2), h.at(i, 3), n);
       // Cosine-weighted about the normal: phi = 2 pi u, theta = acos(sqrt(v)).
@@ -79,8 +119,7 @@ bool AgvsSolver::Impl::draw(int d, Rng& rng, Vec3& point, Vec3& dir) {
       return true;
     }
     case kTp: {
-      uint64_t i = 0;
-      if (!next_view_point(d, 4, i, point)) return false;
+      point = at;
       Vec3 n;
       const Vec3 o = object_point(h.at(i, 0), h.at(i, 1), h.at(i, 2), h.at(i, 3), n);
       const Vec3 to = o - point;
@@ -88,29 +127,59 @@ bool AgvsSolver::Impl::draw(int d, Rng& rng, Vec3& point, Vec3& dir) {
       dir = normalize(to);
       return true;
     }
-    case kTpm: {
-      if (two_point.empty()) return false;
-      const Candidate& c = two_point.take();
-      const Vec3 axis = c.term - c.origin;
-      if (!(length(axis) > 0)) return false;
-      Vec3 u, v;
-      orthonormal_basis(normalize(axis), u, v);
-      auto gauss2 = [&](double sigma) {
-        // Box-Muller: two independent normals.
-        const double r = sigma * std::sqrt(-2 * std::log(std::max(1e-300, 1 - rng.uniform())));
-        const double a = 2 * std::numbers::pi * rng.uniform();
-        return u * (r * std::cos(a)) + v * (r * std::sin(a));
-      };
-      const Vec3 o2 = c.origin + gauss2(c.r_origin), t2 = c.term + gauss2(c.r_term);
-      const Vec3 d2 = t2 - o2;
-      if (!(length(d2) > eps)) return false;
-      point = (o2 + t2) * 0.5;  // the middle: away from local occlusion at either end
-      dir = normalize(d2);
-      if (!cells.view_box().contains(point)) return false;
-      return true;
-    }
   }
   return false;
+}
+
+uint32_t AgvsSolver::Impl::stationary_samples(int d, uint32_t attempts, std::vector<Vec3>& points,
+                                              std::vector<Vec3>& dirs) {
+  std::vector<uint64_t> index;
+  std::vector<Vec3> at;
+  if (d == kOd) {  // object points: every index gives a sample
+    index.resize(attempts);
+    for (uint32_t k = 0; k < attempts; ++k) index[k] = halton_index[d]++;
+    at.assign(attempts, Vec3{});
+  } else {
+    view_points(d, d == kTp ? 4 : 0, attempts, index, at);
+  }
+  std::vector<Vec3> p(attempts), dir(attempts);
+  std::vector<uint8_t> ok(attempts);
+  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, attempts, 256), [&](const tbb::blocked_range<uint32_t>& r) {
+    for (uint32_t k = r.begin(); k < r.end(); ++k)
+      ok[k] = index[k] != kNoIndex && stationary_sample(d, index[k], at[k], p[k], dir[k]);
+  });
+  uint32_t failed = 0;
+  for (uint32_t k = 0; k < attempts; ++k) {
+    if (!ok[k]) {
+      ++failed;
+      continue;
+    }
+    points.push_back(p[k]);
+    dirs.push_back(dir[k]);
+  }
+  return failed;
+}
+
+bool AgvsSolver::Impl::draw_two_point_mutation(Rng& rng, Vec3& point, Vec3& dir) {
+  if (two_point.empty()) return false;
+  const Candidate& c = two_point.take();
+  const Vec3 axis = c.term - c.origin;
+  if (!(length(axis) > 0)) return false;
+  Vec3 u, v;
+  orthonormal_basis(normalize(axis), u, v);
+  auto gauss2 = [&](double sigma) {
+    // Box-Muller: two independent normals.
+    const double r = sigma * std::sqrt(-2 * std::log(std::max(1e-300, 1 - rng.uniform())));
+    const double a = 2 * std::numbers::pi * rng.uniform();
+    return u * (r * std::cos(a)) + v * (r * std::sin(a));
+  };
+  const Vec3 o2 = c.origin + gauss2(c.r_origin), t2 = c.term + gauss2(c.r_term);
+  const Vec3 d2 = t2 - o2;
+  if (!(length(d2) > eps)) return false;
+  point = (o2 + t2) * 0.5;  // the middle: away from local occlusion at either end
+  dir = normalize(d2);
+  if (!cells.view_box().contains(point)) return false;
+  return true;
 }
 
 int AgvsSolver::Impl::silhouette_samples(const Candidate& c, const double angle_u[2], Vec3 points_out[2], Vec3 dirs_out[2],

@@ -100,8 +100,9 @@ AgvsEditStats AgvsSolver::Impl::edit(const Scene& edited, const RayCaster& rc, c
   hit_counts = std::move(next_hits);
   // Mutation candidates keep their segments; their objects follow the map.
   for (CandidateBuffer* b : {&two_point, &silhouette})
-    for (auto& [id, cand] : b->candidates)
+    b->for_each([&](Candidate& cand) {
       if (cand.object != kNoObject) cand.object = new_of_old[cand.object];
+    });
   // The estimator's rays described the old scene.
   window.clear();
   window_total = 0;

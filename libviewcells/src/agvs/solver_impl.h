@@ -24,6 +24,23 @@ namespace viewcells {
 namespace agvs_detail {
 constexpr int kDists = static_cast<int>(AgvsDistribution::kCount);
 constexpr int kVsd = 0, kOd = 1, kTp = 2, kTpm = 3, kSil = 4;
+
+/// contribute() in one cell: inserts the objects (skipping none, and b when it is a) with
+/// insert(object) -> bool (new), returns the entries added, and marks contributed[e] and,
+/// when the cell is the sample's origin cell, at_origin[e].
+template <class Insert>
+uint32_t contribute_in_cell(Insert&& insert, const uint32_t objs[2], bool origin, bool contributed[2],
+                            bool at_origin[2]) {
+  uint32_t gain = 0;
+  for (int e = 0; e < 2; ++e) {
+    if (objs[e] == kNoObject || (e == 1 && objs[1] == objs[0])) continue;
+    if (!insert(objs[e])) continue;
+    ++gain;
+    if (contributed) contributed[e] = true;
+    if (at_origin && origin) at_origin[e] = true;
+  }
+  return gain;
+}
 }  // namespace agvs_detail
 
 using namespace agvs_detail;
@@ -104,11 +121,22 @@ struct AgvsSolver::Impl {
     return {b.lo.x + e.x * u0, b.lo.y + e.y * u1, b.lo.z + e.z * u2};
   }
 
-  /// The next Halton point of distribution d (dimensions dim .. dim+2) in the view space, and
-  /// its index; false when none was found within a bound.
-  bool next_view_point(int d, int dim, uint64_t& i, Vec3& point);
-  /// Draws one sample of distribution d into (point, dir); false when it cannot (no candidate).
-  bool draw(int d, Rng& rng, Vec3& point, Vec3& dir);
+  static constexpr uint64_t kNoIndex = ~uint64_t{0};
+  /// The Halton points of distribution d (dimensions dim .. dim+2) in the view space for the
+  /// next `attempts` samples, and their indices, as taking the indices one by one gives them:
+  /// per attempt the first index whose point is in the view space, or kNoIndex when 10,000 in
+  /// a row were not (the attempt fails).
+  void view_points(int d, int dim, uint32_t attempts, std::vector<uint64_t>& index, std::vector<Vec3>& point);
+  /// Sample `i` of a stationary distribution d (view space-direction, object-direction,
+  /// two-point) into (point, dir), `at` its view point (view_points()); false when degenerate.
+  /// Thread-safe.
+  bool stationary_sample(int d, uint64_t i, const Vec3& at, Vec3& point, Vec3& dir) const;
+  /// The next `attempts` samples of stationary distribution d appended in order, computed in
+  /// parallel; returns how many attempts failed.
+  uint32_t stationary_samples(int d, uint32_t attempts, std::vector<Vec3>& points, std::vector<Vec3>& dirs);
+  /// Draws one two-point mutation sample into (point, dir); false when it cannot (no candidate,
+  /// a degenerate pair).
+  bool draw_two_point_mutation(Rng& rng, Vec3& point, Vec3& dir);
 
   void add_candidate(const Candidate& c) {
     two_point.add(c, config.mutation_buffer);
@@ -163,6 +191,12 @@ struct AgvsSolver::Impl {
   /// cells, then the gains and flags reduced over the ranks), then the counts and mutation
   /// candidates that follow from them.
   void apply_segments(const BatchSamples& s, const std::vector<BatchChunk>& chunks, BatchCounts& counts);
+  /// Pass 1 of apply_segments for every method but REF: each segment's objects into the table
+  /// of every cell it pierces (this rank's), in sample order per cell, in parallel over cells;
+  /// its gains (entries added) and flags (contributed a, b; at origin a, b).
+  template <class OnSegment>
+  void insert_segments(const BatchSamples& s, const std::vector<BatchChunk>& chunks, OnSegment&& on_segment,
+                       std::vector<uint32_t>& gains, std::vector<uint8_t>& flags);
   /// Combines the ranks' rows (and the filter's densities): afterwards every rank holds the
   /// whole table. Collective. No-op in one process.
   void sync();

@@ -27,17 +27,33 @@ CellLocator::CellLocator(Subdivision bsp, std::vector<int32_t> leaf_cell, uint32
   });
   for (uint32_t c = 0; c < cell_count_; ++c)
     if (!(volume_[c] > 0)) throw Error("view cell " + std::to_string(c) + " has no volume");
+  // Each node's cell when its whole subtree lies in one (-1 otherwise), children first: a
+  // walk down the tree stops there.
+  node_cell_.assign(bsp_.nodes.size(), -1);
+  std::vector<std::pair<int32_t, bool>> stack{{0, false}};
+  while (!stack.empty()) {
+    const auto [n, children_done] = stack.back();
+    stack.pop_back();
+    const BspNode& node = bsp_.nodes[n];
+    if (node.plane < 0) {
+      node_cell_[n] = leaf_cell_[n];
+    } else if (children_done) {
+      const int32_t c0 = node_cell_[node.child[0]], c1 = node_cell_[node.child[1]];
+      node_cell_[n] = c0 >= 0 && c0 == c1 ? c0 : -1;
+    } else {
+      stack.push_back({n, true});
+      stack.push_back({node.child[0], false});
+      stack.push_back({node.child[1], false});
+    }
+  }
 }
 
 int32_t CellLocator::cell_at(const Vec3& p) const { return locate_cell(bsp_, leaf_cell_, p); }
 
 void CellLocator::cells_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
-                                   std::vector<std::tuple<int32_t, double, double>>& stack,
-                                   std::vector<int32_t>& leaves) const {
-  leaves.clear();
-  bsp_.leaves_of_segment(a, b, leaves, stack);
+                                   std::vector<std::tuple<int32_t, double, double>>& stack) const {
   out.clear();
-  for (int32_t l : leaves) out.push_back(leaf_cell_[l]);
+  bsp_.labels_of_segment(a, b, node_cell_, out, stack);
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }

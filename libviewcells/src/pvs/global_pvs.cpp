@@ -19,11 +19,7 @@ GlobalPvs GlobalPvs::from_lists(uint32_t objects, const std::vector<std::vector<
 }
 
 bool GlobalPvs::insert(uint32_t cell, uint32_t object) {
-  uint64_t& w = bits_[size_t(cell) * words_ + object / 64];
-  const uint64_t bit = uint64_t{1} << (object % 64);
-  if (w & bit) return false;
-  w |= bit;
-  ++sizes_[cell];
+  if (!insert_in_row(cell, object)) return false;
   ++entries_;
   return true;
 }

@@ -28,8 +28,7 @@ class CellLocator {
   int32_t cell_at(const Vec3& p) const;
   /// The cells the segment a-b (inside the view box) has length in, sorted, into `out`.
   void cells_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
-                        std::vector<std::tuple<int32_t, double, double>>& stack,
-                        std::vector<int32_t>& leaves) const;
+                        std::vector<std::tuple<int32_t, double, double>>& stack) const;
   const Box3& cell_bounds(uint32_t c) const { return bounds_[c]; }
   /// Per cell, the cells sharing a part of its boundary of positive area, sorted.
   std::vector<std::vector<uint32_t>> neighbours() const;
@@ -38,6 +37,7 @@ class CellLocator {
  private:
   Subdivision bsp_;
   std::vector<int32_t> leaf_cell_;
+  std::vector<int32_t> node_cell_;  ///< per node: the cell of its whole subtree, or -1
   uint32_t cell_count_ = 0;
   std::vector<Box3> bounds_;
   std::vector<double> volume_;

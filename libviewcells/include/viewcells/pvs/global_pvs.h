@@ -25,6 +25,17 @@ class GlobalPvs {
   }
   /// Adds the entry; true when it is new.
   bool insert(uint32_t cell, uint32_t object);
+  /// insert() that leaves the table's total entries to add_entries(): threads may insert into
+  /// different cells at once.
+  bool insert_in_row(uint32_t cell, uint32_t object) {
+    uint64_t& w = bits_[size_t(cell) * words_ + object / 64];
+    const uint64_t bit = uint64_t{1} << (object % 64);
+    if (w & bit) return false;
+    w |= bit;
+    ++sizes_[cell];
+    return true;
+  }
+  void add_entries(uint64_t n) { entries_ += n; }
   /// Removes the entry (dynamic edits only); true when it was there.
   bool erase(uint32_t cell, uint32_t object);
   uint32_t size(uint32_t cell) const { return sizes_[cell]; }
