@@ -1,1 +1,1 @@
-scripts/maps-shipped.sh 1 45 aggressor am_galmevish2 am_lavactf am_mckinleyish2 am_thornish am_underworks2 cbctf1 ctf_compromise ctf_inyard czest1tourney czest3ctf dm4ish fan hydronex2 islanddm kaos2 mlctf1beta oa_bases3cl oa_bases3plus3 oa_bases7 oa_ctf2old oa_dm1 oa_dm3 oa_dm5 oa_dm7 oa_koth2 oa_pvomit oa_rpg3dm2 oa_shouse oa_thor oasago2 ps37ctf2 pul1ctf pxlfan sleekgrinder suspended oa_dm2 am_galmevish am_lavaarena
+scripts/maps-shipped.sh 1 45
