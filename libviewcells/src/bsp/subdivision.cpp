@@ -25,6 +25,7 @@
 #include <queue>
 #include <utility>
 
+#include "bsp/segment_walk.h"
 #include "viewcells/core/default_init.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/progress.h"
@@ -126,50 +127,19 @@ bool use_geometry_aligned(const Scene& scene, const SubdivisionConfig& config, s
 
 namespace {
 
-/// Walks the segment a-b down the tree of `s`: stop(n, t0, t1) is asked at every node the
-/// segment has length in (the part a + t (b - a), t in [t0, t1]), and the walk goes below n
-/// only when it returns false; it must return true at leaves. Every node visited leads to at
-/// least one leaf (a part not in a plane has an end off it), so a walk that stops early at a
-/// node reports what the walk below it would reach.
+/// A Subdivision as bsp_detail::walk_segment reads it.
+struct SubdivisionTree {
+  const Subdivision& s;
+  int axis(int32_t n) const { return s.planes[s.nodes[n].plane].axis; }
+  double offset(int32_t n) const { return s.planes[s.nodes[n].plane].offset; }
+  const Plane& plane(int32_t n) const { return s.planes[s.nodes[n].plane]; }
+  int32_t child(int32_t n, int k) const { return s.nodes[n].child[k]; }
+};
+
 template <class Stop>
 void walk_segment(const Subdivision& s, const Vec3& a, const Vec3& b,
                   std::vector<std::tuple<int32_t, double, double>>& stack, Stop&& stop) {
-  stack.clear();
-  stack.emplace_back(0, 0.0, 1.0);
-  while (!stack.empty()) {
-    const auto [n, t0, t1] = stack.back();
-    stack.pop_back();
-    if (stop(n, t0, t1)) continue;
-    const BspNode& node = s.nodes[n];
-    const Plane& plane = s.planes[node.plane];
-    int s0, s1;
-    double d0, d1;
-    if (plane.axis >= 0) {
-      // The one coordinate an axis-aligned plane reads, rounded exactly as in the whole point
-      // below; its distance is that coordinate minus the offset, as Plane::distance gives it.
-      const int axis = plane.axis;
-      const double c0 = a[axis] * (1.0 - t0) + b[axis] * t0, c1 = a[axis] * (1.0 - t1) + b[axis] * t1;
-      s0 = c0 > plane.offset ? 1 : (c0 < plane.offset ? -1 : 0);
-      s1 = c1 > plane.offset ? 1 : (c1 < plane.offset ? -1 : 0);
-      d0 = c0 - plane.offset;
-      d1 = c1 - plane.offset;
-    } else {
-      const Vec3 p0 = a * (1.0 - t0) + b * t0, p1 = a * (1.0 - t1) + b * t1;
-      s0 = plane.side(p0);
-      s1 = plane.side(p1);
-      d0 = plane.distance(p0);
-      d1 = plane.distance(p1);
-    }
-    if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) {  // as Builder::apply_split
-      const double t = std::clamp(t0 + (t1 - t0) * (d0 / (d0 - d1)), t0, t1);
-      stack.emplace_back(node.child[s0 < 0 ? 0 : 1], t0, t);
-      stack.emplace_back(node.child[s0 < 0 ? 1 : 0], t, t1);
-      continue;
-    }
-    const bool in_plane = s0 == 0 && s1 == 0;
-    if (in_plane || s0 < 0 || s1 < 0) stack.emplace_back(node.child[0], t0, t1);
-    if (in_plane || s0 > 0 || s1 > 0) stack.emplace_back(node.child[1], t0, t1);
-  }
+  bsp_detail::walk_segment(SubdivisionTree{s}, a, b, stack, std::forward<Stop>(stop));
 }
 
 }  // namespace
@@ -212,16 +182,6 @@ void Subdivision::pieces_of_segment(const Vec3& a, const Vec3& b, std::vector<st
   walk_segment(*this, a, b, stack, [&](int32_t n, double t0, double t1) {
     if (nodes[n].plane >= 0) return false;
     out.emplace_back(n, t0, t1);
-    return true;
-  });
-}
-
-void Subdivision::labels_of_segment(const Vec3& a, const Vec3& b, const std::vector<int32_t>& label,
-                                    std::vector<int32_t>& out,
-                                    std::vector<std::tuple<int32_t, double, double>>& stack) const {
-  walk_segment(*this, a, b, stack, [&](int32_t n, double, double) {
-    if (label[n] < 0) return false;
-    out.push_back(label[n]);
     return true;
   });
 }

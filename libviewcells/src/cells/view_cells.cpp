@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "bsp/segment_walk.h"
 #include "viewcells/bsp/adjacency.h"
 #include "viewcells/core/error.h"
 
@@ -27,19 +28,27 @@ CellLocator::CellLocator(Subdivision bsp, std::vector<int32_t> leaf_cell, uint32
   });
   for (uint32_t c = 0; c < cell_count_; ++c)
     if (!(volume_[c] > 0)) throw Error("view cell " + std::to_string(c) + " has no volume");
-  // Each node's cell when its whole subtree lies in one (-1 otherwise), children first: a
-  // walk down the tree stops there.
-  node_cell_.assign(bsp_.nodes.size(), -1);
+  // The tree as segments walk it, compactly: per node its plane's axis and offset (or the
+  // plane itself, for the few that are not axis-aligned), its children, and its cell when its
+  // whole subtree lies in one (-1 otherwise, found children first), where a walk stops.
+  walk_.assign(bsp_.nodes.size(), WalkNode{});
   std::vector<std::pair<int32_t, bool>> stack{{0, false}};
   while (!stack.empty()) {
     const auto [n, children_done] = stack.back();
     stack.pop_back();
     const BspNode& node = bsp_.nodes[n];
+    WalkNode& w = walk_[n];
     if (node.plane < 0) {
-      node_cell_[n] = leaf_cell_[n];
+      w.cell = leaf_cell_[n];
     } else if (children_done) {
-      const int32_t c0 = node_cell_[node.child[0]], c1 = node_cell_[node.child[1]];
-      node_cell_[n] = c0 >= 0 && c0 == c1 ? c0 : -1;
+      const Plane& plane = bsp_.planes[node.plane];
+      w.axis = plane.axis;
+      w.offset = plane.offset;
+      w.plane = node.plane;
+      w.child[0] = node.child[0];
+      w.child[1] = node.child[1];
+      const int32_t c0 = walk_[node.child[0]].cell, c1 = walk_[node.child[1]].cell;
+      w.cell = c0 >= 0 && c0 == c1 ? c0 : -1;
     } else {
       stack.push_back({n, true});
       stack.push_back({node.child[0], false});
@@ -53,7 +62,19 @@ int32_t CellLocator::cell_at(const Vec3& p) const { return locate_cell(bsp_, lea
 void CellLocator::cells_of_segment(const Vec3& a, const Vec3& b, std::vector<int32_t>& out,
                                    std::vector<std::tuple<int32_t, double, double>>& stack) const {
   out.clear();
-  bsp_.labels_of_segment(a, b, node_cell_, out, stack);
+  struct Tree {
+    const std::vector<WalkNode>& walk;
+    const std::vector<Plane>& planes;
+    int axis(int32_t n) const { return walk[n].axis; }
+    double offset(int32_t n) const { return walk[n].offset; }
+    const Plane& plane(int32_t n) const { return planes[walk[n].plane]; }
+    int32_t child(int32_t n, int k) const { return walk[n].child[k]; }
+  };
+  bsp_detail::walk_segment(Tree{walk_, bsp_.planes}, a, b, stack, [&](int32_t n, double, double) {
+    if (walk_[n].cell < 0) return false;
+    out.push_back(walk_[n].cell);
+    return true;
+  });
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }

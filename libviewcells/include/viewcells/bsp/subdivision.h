@@ -147,12 +147,6 @@ struct Subdivision {
   /// a + t (b - a), t in [t0, t1].
   void pieces_of_segment(const Vec3& a, const Vec3& b, std::vector<std::tuple<int32_t, double, double>>& out,
                          std::vector<std::tuple<int32_t, double, double>>& stack) const;
-  /// The same walk, stopped at the first node n on each path with label[n] >= 0 (every leaf
-  /// must have one): label[n] is appended to `out` for every such node the segment has length
-  /// in. With a node labelled by the one view cell its whole subtree belongs to, this gives the
-  /// cells of the leaves_of_segment() leaves without walking to them.
-  void labels_of_segment(const Vec3& a, const Vec3& b, const std::vector<int32_t>& label, std::vector<int32_t>& out,
-                         std::vector<std::tuple<int32_t, double, double>>& stack) const;
 };
 
 /// Pushes `cell` down the tree of `s` from its root (convex clipping at every node it

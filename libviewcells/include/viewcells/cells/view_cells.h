@@ -37,7 +37,14 @@ class CellLocator {
  private:
   Subdivision bsp_;
   std::vector<int32_t> leaf_cell_;
-  std::vector<int32_t> node_cell_;  ///< per node: the cell of its whole subtree, or -1
+  /// Per BSP node, what a segment's walk reads (see the constructor): 32 bytes.
+  struct WalkNode {
+    double offset = 0;
+    int32_t child[2] = {-1, -1};
+    int32_t axis = -1, plane = -1;
+    int32_t cell = -1;  ///< the cell of the node's whole subtree, or -1
+  };
+  std::vector<WalkNode> walk_;
   uint32_t cell_count_ = 0;
   std::vector<Box3> bounds_;
   std::vector<double> volume_;
