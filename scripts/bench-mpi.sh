@@ -19,17 +19,19 @@ lines="$out/runs.jsonl"
 : >"$lines"
 # pvs_run RANKS THREADS CELLS NAME: one AGVS run, its line in runs.jsonl.
 pvs_run() {
-  mpirun --oversubscribe -np "$1" "$vc" --threads "$2" -q pvs "$out/city5000.vcells" --scene "$scene" --cells "$3" \
+  mpirun --oversubscribe --bind-to none -np "$1" "$vc" --threads "$2" -q pvs "$out/city5000.vcells" --scene "$scene" --cells "$3" \
     --samples 1000000 --batch 20000 --seed 1 -o "$out/$4.pvs" --report "$out/$4.json"
   jq -c --arg kind pvs --argjson cells "$3" --argjson ranks "$1" --argjson threads "$2" '{kind: $kind, cells: $cells,
     ranks: $ranks, threads: $threads, samples: .samples, seconds: .seconds, phases: .phases, cluster: (.cluster //
     {exchanges: 0, bytes_sent: 0, bytes_received: 0, exchange_seconds: 0})}' "$out/$4.json" | tee -a "$lines"
 }
-# One rank of two threads: what drawing and applying divide over a node's cores.
+# One rank of two threads: what drawing and applying divide over a node's cores. (Ranks are not
+# bound to cores: mpirun binds one or two ranks to one core each by default, and a rank's threads
+# would then share it.)
 for cells in 500 5000; do pvs_run 1 2 "$cells" "pvs-$cells-1t2"; done
 for n in 1 2 4; do
   for cells in 500 5000; do pvs_run "$n" 1 "$cells" "pvs-$cells-$n"; done
-  mpirun --oversubscribe -np "$n" "$vc" --threads 1 -q sample "$scene" --samples 2000000 --seed 1 \
+  mpirun --oversubscribe --bind-to none -np "$n" "$vc" --threads 1 -q sample "$scene" --samples 2000000 --seed 1 \
     -o "$out/s-$n.vseg" --report "$out/sample-$n.json"
   jq -c --arg kind sample --argjson ranks "$n" '{kind: $kind, ranks: $ranks, samples: .counts.samples,
     seconds: .timings.sampling_seconds, segments: .counts.valid_segments, cluster: (.cluster // {exchanges: 0, bytes_sent: 0, bytes_received: 0,

@@ -1025,9 +1025,9 @@ def mpi_model(*args):
     """MPI: measured exchange and phase times per rank count, and the strong-scaling model (docs/distributed.md)."""
     with open(args[0]) as f:
         runs = [json.loads(line) for line in f if line.strip()]
-    print("| run | ranks | samples | seconds | draw / cast / apply s | exchanges | sent per exchange (rank 0) "
-          "| received per exchange | exchange s | exchange share |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| run | ranks | threads per rank | samples | seconds | draw / cast / apply s | exchanges "
+          "| sent per exchange (rank 0) | received per exchange | exchange s | exchange share |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for r in runs:
         c = r["cluster"]
         ex = max(c["exchanges"], 1)
@@ -1035,7 +1035,8 @@ def mpi_model(*args):
         phases = r.get("phases")
         split = (f"{phases['draw_seconds']:.2f} / {phases['cast_seconds']:.2f} / {phases['apply_seconds']:.2f}"
                  if phases else "")
-        print(f"| {name} | {r['ranks']} | {r['samples']:,} | {r['seconds']:.2f} | {split} | {c['exchanges']} "
+        print(f"| {name} | {r['ranks']} | {r.get('threads', 1)} | {r['samples']:,} | {r['seconds']:.2f} | {split} "
+              f"| {c['exchanges']} "
               f"| {c['bytes_sent'] / ex / 1e3:,.0f} kB | {c['bytes_received'] / ex / 1e3:,.0f} kB "
               f"| {c['exchange_seconds']:.2f} | {100 * c['exchange_seconds'] / r['seconds']:.1f}% |")
     print()
