@@ -1177,8 +1177,11 @@ class Builder {
       const double vl = box ? volume * (positions[j] - lo_b) / (hi_b - lo_b)
                             : cell.volume_below(Plane::axis_aligned(axis, positions[j]));
       if (!(vl > kMinPart * volume && volume - vl > kMinPart * volume)) continue;
-      const double wl = box ? box_weight_below(positions[j])
-                            : density.weight_below(cell, part, Plane::axis_aligned(axis, positions[j]));
+      // Without a density the weight below is the volume below, just computed (weight_below
+      // would clip the cell again for the same number).
+      const double wl = box                ? box_weight_below(positions[j])
+                        : density.enabled ? density.weight_below(cell, part, Plane::axis_aligned(axis, positions[j]))
+                                          : vl;
       const double wr = weight - wl;
       const double reduction = own - (wl * left[j] + wr * right[j]) / total_weight_;
       if (!found || reduction > best_reduction) {
