@@ -241,51 +241,56 @@ void AgvsSolver::Impl::insert_segments(const BatchSamples& s, const std::vector<
   });
   // This rank's cells divided among parts, each inserting into its own cells in sample order
   // (so the table, the gains and the flags do not depend on the number of parts): first the
-  // (segment, cell) pairs of each part, per block of segments, then each part's in order.
+  // (segment, cell) pairs of each part, per block of segments, then each part's in order, the
+  // outcome kept with each pair; then, per block, every pair's outcome added to its segment's.
+  struct Pair {
+    uint32_t segment;
+    int32_t cell;
+    uint32_t gain = 0;
+    uint8_t flags = 0;
+  };
   const uint64_t ranks = static_cast<uint64_t>(cluster::size());
   const size_t parts = static_cast<size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
   constexpr size_t kBlock = 4096;
   const size_t blocks = (total + kBlock - 1) / kBlock;
-  std::vector<std::vector<std::vector<std::pair<uint32_t, int32_t>>>> pairs(
-      blocks, std::vector<std::vector<std::pair<uint32_t, int32_t>>>(parts));
+  std::vector<std::vector<std::vector<Pair>>> pairs(blocks, std::vector<std::vector<Pair>>(parts));
   tbb::parallel_for(size_t{0}, blocks, [&](size_t b) {
     for (size_t k = b * kBlock; k < std::min(total, (b + 1) * kBlock); ++k)
       for (int32_t cell : at[k].first->pierced[at[k].second])
         if (cluster::mine(static_cast<uint64_t>(cell)))
           pairs[b][(static_cast<uint64_t>(cell) / ranks) % parts].push_back({static_cast<uint32_t>(k), cell});
   });
-  std::vector<std::vector<uint32_t>> part_gains(parts);
-  std::vector<std::vector<uint8_t>> part_flags(parts);
   std::vector<uint64_t> part_entries(parts, 0);
   tbb::parallel_for(size_t{0}, parts, [&](size_t p) {
-    std::vector<uint32_t>& g = part_gains[p];
-    std::vector<uint8_t>& f = part_flags[p];
-    g.assign(total, 0);
-    f.assign(total, 0);
     for (size_t b = 0; b < blocks; ++b)
-      for (const auto& [k, cell] : pairs[b][p]) {
-        const BatchChunk& c = *at[k].first;
-        const uint32_t i = at[k].second;
+      for (Pair& pair : pairs[b][p]) {
+        const BatchChunk& c = *at[pair.segment].first;
+        const uint32_t i = at[pair.segment].second;
         const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
-        const bool origin = own[k] && cell == origin_cell[c.first + c.sample_of[i]];
+        const uint32_t cell = static_cast<uint32_t>(pair.cell);
+        const bool origin = own[pair.segment] && pair.cell == origin_cell[c.first + c.sample_of[i]];
         bool contributed[2] = {false, false}, at_origin[2] = {false, false};
-        const uint32_t gain = contribute_in_cell(
-            [&](uint32_t o) { return pvs.insert_in_row(static_cast<uint32_t>(cell), o); }, objs, origin, contributed,
-            at_origin);
-        g[k] += gain;
-        part_entries[p] += gain;
-        f[k] |= static_cast<uint8_t>(contributed[0] | contributed[1] << 1 | at_origin[0] << 2 | at_origin[1] << 3);
-        if (config.filter_statistics) count_hits(cell, objs[0], objs[1]);
+        pair.gain = contribute_in_cell([&](uint32_t o) { return pvs.insert_in_row(cell, o); }, objs, origin,
+                                       contributed, at_origin);
+        pair.flags = static_cast<uint8_t>(contributed[0] | contributed[1] << 1 | at_origin[0] << 2 | at_origin[1] << 3);
+        part_entries[p] += pair.gain;
+        if (config.filter_statistics) count_hits(pair.cell, objs[0], objs[1]);
       }
   });
   for (uint64_t n : part_entries) pvs.add_entries(n);
-  tbb::parallel_for(size_t{0}, total, [&](size_t k) {
-    for (size_t p = 0; p < parts; ++p) gains[k] += part_gains[p][k], flags[k] |= part_flags[p][k];
-    // Both ends see the same object: both rays were wrong pixels before (as contribute()).
-    const BatchChunk& c = *at[k].first;
-    const uint32_t i = at[k].second;
-    if (c.segs.object_a[i] == c.segs.object_b[i] && c.segs.object_a[i] != kNoObject)
-      flags[k] = static_cast<uint8_t>((flags[k] & ~8u) | ((flags[k] & 4u) << 1));
+  tbb::parallel_for(size_t{0}, blocks, [&](size_t b) {
+    for (const std::vector<Pair>& of_part : pairs[b])
+      for (const Pair& pair : of_part) {
+        gains[pair.segment] += pair.gain;
+        flags[pair.segment] |= pair.flags;
+      }
+    for (size_t k = b * kBlock; k < std::min(total, (b + 1) * kBlock); ++k) {
+      // Both ends see the same object: both rays were wrong pixels before (as contribute()).
+      const BatchChunk& c = *at[k].first;
+      const uint32_t i = at[k].second;
+      if (c.segs.object_a[i] == c.segs.object_b[i] && c.segs.object_a[i] != kNoObject)
+        flags[k] = static_cast<uint8_t>((flags[k] & ~8u) | ((flags[k] & 4u) << 1));
+    }
   });
 }
 
