@@ -218,13 +218,13 @@ struct AgvsSolver::Impl::BatchCounts {
 template <class OnSegment>
 void AgvsSolver::Impl::insert_segments(const BatchSamples& s, const std::vector<BatchChunk>& chunks,
                                        OnSegment&& on_segment, std::vector<uint32_t>& gains,
-                                       std::vector<uint8_t>& flags) {
+                                       std::vector<uint8_t>& flags, std::vector<uint8_t>& own) {
   const size_t total = gains.size();
   // Per segment: its chunk and index there, and whether it is its sample's camera segment (the
   // first of a view space-direction sample through the sample's point; a chunk holds its
   // samples' every segment), with the cell of that point.
   std::vector<std::pair<const BatchChunk*, uint32_t>> at(total);
-  std::vector<uint8_t> own(total, 0);
+  own.assign(total, 0);
   std::vector<int32_t> origin_cell(s.points.size(), -1);
   tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t ci) {
     const BatchChunk& c = chunks[ci];
@@ -305,6 +305,7 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
   for (const BatchChunk& c : chunks) total += c.segs.size();
   std::vector<uint32_t> gains(total, 0);
   std::vector<uint8_t> flags(total, 0);  // contributed a, b; at origin a, b (REF: wrong ray)
+  std::vector<uint8_t> own;              // not REF: the segment is its sample's camera segment
   // Whether the sample's point lies on this segment: its own segment (re-casts of points
   // inside solids start elsewhere; see-through companions are the first one's).
   auto on_segment = [&](const BatchChunk& c, size_t i, uint32_t sample) {
@@ -330,7 +331,7 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
       }
     }
   } else {
-    insert_segments(s, chunks, on_segment, gains, flags);
+    insert_segments(s, chunks, on_segment, gains, flags, own);
   }
   cluster::sum(gains);
   cluster::bit_or(flags);
@@ -356,7 +357,7 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
         continue;
       }
       // The estimator's rays: a camera at the point sees along both rays of its segment.
-      if (c.dist == kVsd && counts.camera_rays[sample] == 0 && on_segment(c, i, sample)) {
+      if (own[k]) {
         counts.camera_rays[sample] = 2;
         counts.wrong_rays[sample] = static_cast<uint8_t>(((flags[k] >> 2) & 1) + ((flags[k] >> 3) & 1));
       }

@@ -193,10 +193,12 @@ struct AgvsSolver::Impl {
   void apply_segments(const BatchSamples& s, const std::vector<BatchChunk>& chunks, BatchCounts& counts);
   /// Pass 1 of apply_segments for every method but REF: each segment's objects into the table
   /// of every cell it pierces (this rank's), in sample order per cell, in parallel over cells;
-  /// its gains (entries added) and flags (contributed a, b; at origin a, b).
+  /// its gains (entries added) and flags (contributed a, b; at origin a, b), and whether it is
+  /// its sample's camera segment (the first of a view space-direction sample through the
+  /// sample's point), which the estimator counts.
   template <class OnSegment>
   void insert_segments(const BatchSamples& s, const std::vector<BatchChunk>& chunks, OnSegment&& on_segment,
-                       std::vector<uint32_t>& gains, std::vector<uint8_t>& flags);
+                       std::vector<uint32_t>& gains, std::vector<uint8_t>& flags, std::vector<uint8_t>& own);
   /// Combines the ranks' rows (and the filter's densities): afterwards every rank holds the
   /// whole table. Collective. No-op in one process.
   void sync();
