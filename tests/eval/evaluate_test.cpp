@@ -4,6 +4,7 @@
 #include "support/test_scenes.h"
 
 #include <cmath>
+#include <iostream>
 
 #include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/core/error.h"
@@ -192,6 +193,52 @@ namespace {
 /// Merging must never make a cut worse than the subdivision's own cut of the same size by more
 /// than the evaluator's own noise. On a small rotated office (where greedy merging on the
 /// construction samples alone was 1.6x AV-S at 100 cells), AV-M with its default validated
+/// The validated merge's chosen history, piece by piece (eval/validated_merge.h): pieces
+/// follow one another from the leaves down, each one ends at its barrier, where the written
+/// history's cut is exactly the subdivision's own, and the whole history scores on the held-out
+/// run at least as well as the best single candidate, each count within the allowance.
+void expect_chain_holds(const MergeSummary& v, const Subdivision& s, const MergeHistory& h) {
+  const uint32_t leaves = static_cast<uint32_t>(s.leaf_count());
+  ASSERT_FALSE(v.chain.empty());
+  EXPECT_EQ(v.chain.front().from, leaves);
+  EXPECT_EQ(v.chain.back().to, 0u);
+  const std::vector<int32_t> leaf_nodes = s.leaves();
+  for (size_t k = 0; k < v.chain.size(); ++k) {
+    const MergePiece& p = v.chain[k];
+    if (k + 1 < v.chain.size()) {
+      EXPECT_GT(p.to, 0u);
+      EXPECT_EQ(p.to, p.start.barrier);
+      EXPECT_EQ(v.chain[k + 1].from, p.to);
+      EXPECT_LE(v.chain[k + 1].start.cells, p.to);
+    }
+    // The cut at `from`: each history cell holds the leaves of one cell of the subdivision's cut.
+    std::vector<int32_t> cell_of(s.nodes.size(), -1);
+    const std::vector<int32_t> cut = s.leaves_after(p.from - 1);
+    for (size_t i = 0; i < cut.size(); ++i) cell_of[static_cast<size_t>(cut[i])] = static_cast<int32_t>(i);
+    std::vector<int32_t> subdivision_cell(leaves);
+    for (uint32_t i = 0; i < leaves; ++i) {
+      int32_t n = leaf_nodes[i];
+      while (cell_of[static_cast<size_t>(n)] < 0) n = s.nodes[static_cast<size_t>(n)].parent;
+      subdivision_cell[i] = cell_of[static_cast<size_t>(n)];
+    }
+    const std::vector<int32_t> history_cut = h.cut_after(leaves - p.from);
+    ASSERT_EQ(history_cut.size(), cut.size()) << "piece " << k;
+    for (int32_t m : history_cut) {
+      const std::vector<uint32_t> under = h.leaves_under(m);
+      ASSERT_FALSE(under.empty());
+      for (uint32_t leaf : under)
+        EXPECT_EQ(subdivision_cell[leaf], subdivision_cell[under.front()]) << "piece " << k << ", cell " << m;
+    }
+  }
+  double best_single = 0;  // AV-S's own order
+  for (const MergeStart& st : v.starts)
+    if (st.worst <= 0.01) best_single = std::min(best_single, st.score);
+  EXPECT_LE(v.chosen.score, best_single + 1e-12);
+  EXPECT_LE(v.chosen.worst, 0.01 + 1e-12);
+  std::cout << "validated merge: " << v.chain.size() << " piece(s), held-out score " << v.chosen.score
+            << " (best single candidate " << best_single << ")\n";
+}
+
 /// merge is scored against AV-S on two independent evaluation sample sets; their
 /// disagreement on AV-S's own cost is the evaluator's noise at each count.
 TEST(Evaluate, MergingIsNotWorseThanTheSubdivisionsOwnCuts) {
@@ -231,6 +278,7 @@ TEST(Evaluate, MergingIsNotWorseThanTheSubdivisionsOwnCuts) {
   EXPECT_GT(old_worse, 0) << "greedy merging on the construction samples alone passed too";
   // The history's cut at the leaf count is the leaves, whatever the merge order.
   EXPECT_NEAR(avm.evaluated.at(leaves), avs.evaluated.at(leaves), 1e-12 * avs.evaluated.at(leaves));
+  expect_chain_holds(avm.merge, *c.av_s, *c.av_m);
 }
 
 }  // namespace

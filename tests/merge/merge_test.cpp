@@ -412,6 +412,41 @@ TEST(Merge, BarrierKeepsGreedyMergesInsideTheSubdivisionsCut) {
   EXPECT_EQ(h.merges(), 89u) << "greedy merging goes on below the barrier";
 }
 
+TEST(Merge, HistoriesJoinWhereTheirCutsAgree) {
+  const Fixture f = office(90);
+  MergeConfig config;
+  config.show_progress = false;
+  config.barrier_cells = 12;
+  config.block = subdivision_blocks(f.sub, 12);
+  const MergeHistory upper = merge_cells(f.scene, f.partition, CostModel{}, config);  // AV-S's cut at 12
+  config.barrier_cells = 0;
+  config.block.clear();
+  config.prefix = subdivision_prefix(f.sub, 6);
+  const MergeHistory lower = merge_cells(f.scene, f.partition, CostModel{}, config);  // AV-S's cuts 90..6
+  ASSERT_EQ(cut_leaves(upper, 12), cut_leaves(lower, 12));
+  // upper's merges down to 12 cells, then lower's from there.
+  std::vector<std::pair<int32_t, int32_t>> joined = merges_by_least_leaf(upper);
+  const std::vector<std::pair<int32_t, int32_t>> rest = merges_by_least_leaf(lower);
+  joined.resize(90 - 12);
+  joined.insert(joined.end(), rest.begin() + (90 - 12), rest.end());
+  config.prefix = least_leaf_merges_as_prefix(joined, 90);
+  const MergeHistory h = merge_cells(f.scene, f.partition, CostModel{}, config);
+  EXPECT_EQ(h.stats.evaluations, 0u) << "every merge was given";
+  for (size_t cells = 90; cells >= 1; --cells) {
+    const MergeHistory& from = cells > 12 ? upper : lower;
+    EXPECT_EQ(cut_leaves(h, cells), cut_leaves(from, cells)) << cells << " cells";
+    EXPECT_NEAR(h.cost_with(cells), from.cost_with(cells), 1e-9 * from.cost_with(cells)) << cells << " cells";
+  }
+  // A history replays itself, node for node.
+  config.prefix = least_leaf_merges_as_prefix(merges_by_least_leaf(upper), 90);
+  const MergeHistory again = merge_cells(f.scene, f.partition, CostModel{}, config);
+  for (size_t k = 90; k < upper.nodes.size(); ++k)
+    EXPECT_EQ(again.nodes[k].child[0], upper.nodes[k].child[0]) << k;
+  // Names that are not leaves are refused.
+  EXPECT_THROW(least_leaf_merges_as_prefix({{0, 90}}, 90), Error);
+  EXPECT_THROW(least_leaf_merges_as_prefix({{3, 3}}, 90), Error);
+}
+
 TEST(Merge, PrefixAndBlocksAreChecked) {
   const Fixture f = office(20);
   MergeConfig config;

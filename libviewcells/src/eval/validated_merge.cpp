@@ -23,12 +23,33 @@ std::vector<std::vector<uint32_t>> unite(const std::vector<std::vector<uint32_t>
   return out;
 }
 
-/// Every merge of `h`, in order, as a prefix that replays it.
-std::vector<std::pair<int32_t, int32_t>> merges_of(const MergeHistory& h) {
-  std::vector<std::pair<int32_t, int32_t>> out;
-  for (size_t k = h.leaf_count; k < h.nodes.size(); ++k) out.emplace_back(h.nodes[k].child[0], h.nodes[k].child[1]);
-  return out;
+using Merges = std::vector<std::pair<int32_t, int32_t>>;
+
+/// Per leaf, the least leaf of its cell after the first `k` of `merges` (merges_by_least_leaf).
+std::vector<int32_t> cut_labels(const Merges& merges, size_t leaves, size_t k) {
+  std::vector<int32_t> up(leaves);
+  for (size_t n = 0; n < leaves; ++n) up[n] = static_cast<int32_t>(n);
+  for (size_t j = 0; j < k && j < merges.size(); ++j) {
+    const auto [a, b] = merges[j];
+    up[std::max(a, b)] = std::min(a, b);  // both name current cells: roots
+  }
+  for (size_t n = 0; n < leaves; ++n) up[n] = up[up[n]];  // parents have smaller ids: done in order
+  return up;
 }
+
+/// A candidate's scores at the counts scored (0 where its history does not reach).
+struct Scored {
+  std::vector<double> log_ratio;
+  Merges merges;              ///< by least leaf
+  bool barrier_cut = false;  ///< its cut at its barrier is AV-S's (the barrier held)
+};
+
+/// The lowest sum of log ratios for the counts at most `c`, from AV-S's cut at `c` down.
+struct Tail {
+  double sum = 0, worst = 0;
+  int candidate = -1;  ///< -1: AV-S's own order
+  bool split = false;  ///< the candidate down to its barrier, then tails[barrier]
+};
 
 }  // namespace
 
@@ -81,33 +102,97 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   };
   Progress progress("choosing where merging starts", candidates.size());
   std::atomic<uint64_t> evaluations{0}, stale{0};  // the candidates' pair costs, for the report
+  const Merges av_s_merges = merges_by_least_leaf(av_s);
+  std::vector<Scored> scored(candidates.size());
   tbb::parallel_for(size_t{0}, candidates.size(), [&](size_t i) {
     MergeStart& st = candidates[i];
     const MergeHistory h = merge_cells(scene, partition, model, config_for(st));
     evaluations += h.stats.evaluations;
     stale += h.stats.stale;
     const CostCurve held_out = evaluate_merge_history(scene, s, h, b.pvs, model);
+    Scored& sc = scored[i];
+    sc.log_ratio.assign(counts.size(), 0.0);
     st.worst = -1e300;
     size_t terms = 0;
-    for (size_t n : counts)
+    for (size_t j = 0; j < counts.size(); ++j) {
+      const size_t n = counts[j];
       if (n >= h.min_cells() && n >= av_s.min_cells()) {
         const double r = std::log(held_out.at(static_cast<uint32_t>(n)) / av_s_held_out.at(static_cast<uint32_t>(n)));
+        sc.log_ratio[j] = r;
         st.score += r;
         st.worst = std::max(st.worst, r);
         ++terms;
       }
+    }
     st.score = terms ? st.score / static_cast<double>(terms) : 0.0;
     if (!terms) st.worst = 0;
+    sc.merges = merges_by_least_leaf(h);
+    sc.barrier_cut = st.barrier && h.min_cells() <= st.barrier &&
+                     cut_labels(sc.merges, L, L - st.barrier) == cut_labels(av_s_merges, L, L - st.barrier);
     if (config.merge.show_progress) progress.advance(1);
   });
   if (config.merge.show_progress) progress.finish();
-  // The lowest mean among the starts whose worst count stays within the allowance; ties keep
-  // the earlier (AV-S's order first).
-  for (const MergeStart& st : candidates) {
-    sum.starts.push_back(st);
-    if (st.worst <= config.worst_allowed && st.score < sum.chosen.score) sum.chosen = st;
+  sum.starts.insert(sum.starts.end(), candidates.begin(), candidates.end());
+
+  // The choice, per range of counts. tails[c]: the best history below AV-S's cut at c cells,
+  // scored on the counts at most c; c runs over the barriers, upwards, and the leaves. Each
+  // candidate is taken whole (its own merges to the end) or down to its barrier, where its
+  // cut is AV-S's and the best tail there goes on. Every piece keeps each of its counts
+  // within the allowance. Ties keep the earlier option (AV-S's own order first, whole
+  // before split), and a split must gain more than rounding, so a single candidate is
+  // chosen as before unless pieces do better.
+  std::vector<uint32_t> ends{static_cast<uint32_t>(L)};
+  for (const MergeStart& st : candidates)
+    if (st.barrier) ends.push_back(st.barrier);
+  std::sort(ends.begin(), ends.end());
+  ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+  std::vector<Tail> tails(ends.size());
+  auto tail_at = [&](uint32_t c) -> const Tail& {
+    return tails[static_cast<size_t>(std::lower_bound(ends.begin(), ends.end(), c) - ends.begin())];
+  };
+  auto piece = [&](size_t i, uint32_t below, uint32_t upto) {  // sum and worst on counts in (below, upto]
+    std::pair<double, double> sum_worst{0.0, 0.0};
+    for (size_t j = 0; j < counts.size(); ++j)
+      if (counts[j] > below && counts[j] <= upto) {
+        sum_worst.first += scored[i].log_ratio[j];
+        sum_worst.second = std::max(sum_worst.second, scored[i].log_ratio[j]);
+      }
+    return sum_worst;
+  };
+  constexpr double kGain = 1e-9;  // a split must beat the whole by more than rounding
+  for (size_t e = 0; e < ends.size(); ++e) {
+    const uint32_t c = ends[e];
+    Tail best;  // AV-S's own order: 0
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      const MergeStart& st = candidates[i];
+      if (st.cells > c) continue;
+      const auto [whole, whole_worst] = piece(i, 0, c);
+      if (whole_worst <= config.worst_allowed && whole < best.sum) best = {whole, whole_worst, static_cast<int>(i), false};
+      if (!st.barrier || !scored[i].barrier_cut) continue;
+      const auto [upper, upper_worst] = piece(i, st.barrier, c);
+      const Tail& below = tail_at(st.barrier);
+      if (upper_worst <= config.worst_allowed && upper + below.sum < best.sum - kGain)
+        best = {upper + below.sum, std::max(upper_worst, below.worst), static_cast<int>(i), true};
+    }
+    tails[e] = best;
   }
-  const MergeHistory best = sum.chosen.cells == 1 ? av_s : merge_cells(scene, partition, model, config_for(sum.chosen));
+
+  // The chosen history's merges, piece by piece, named by least leaf.
+  Merges chosen;
+  for (uint32_t c = static_cast<uint32_t>(L);;) {
+    const Tail& tail = tail_at(c);
+    const Merges& m = tail.candidate < 0 ? av_s_merges : scored[static_cast<size_t>(tail.candidate)].merges;
+    const MergeStart st =
+        tail.candidate < 0 ? MergeStart{1, 0, 0.0, 0.0} : candidates[static_cast<size_t>(tail.candidate)];
+    const uint32_t to = tail.split ? st.barrier : 0;
+    const size_t first = L - c, last = tail.split ? L - to : m.size();
+    chosen.insert(chosen.end(), m.begin() + static_cast<std::ptrdiff_t>(std::min(first, m.size())),
+                  m.begin() + static_cast<std::ptrdiff_t>(std::min(last, m.size())));
+    sum.chain.push_back({st, c, to});
+    if (!tail.split) break;
+    c = to;
+  }
+  sum.chosen = sum.chain.front().start;
   sum.merge_seconds = t.seconds();
 
   // The chosen merges, replayed with every sample's PVSs.
@@ -116,15 +201,43 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   partition = partition_from_subdivision(s, out.leaf_pvs);
   sum.neighbour_seconds += t.seconds();
   t.restart();
-  mc.prefix = merges_of(best);
+  mc.prefix = least_leaf_merges_as_prefix(chosen, L);
   mc.barrier_cells = 0;
   mc.block.clear();
   mc.show_progress = config.merge.show_progress;
   out.history = merge_cells(scene, partition, model, mc);
   sum.merge_seconds += t.seconds();
+  // The whole chosen history's held-out score, as the candidates were scored.
+  const CostCurve held_out = evaluate_merge_history(scene, s, out.history, b.pvs, model);
+  sum.chosen.score = 0;
+  sum.chosen.worst = 0;
+  size_t terms = 0;
+  for (size_t n : counts)
+    if (n >= out.history.min_cells() && n >= av_s.min_cells()) {
+      const double r = std::log(held_out.at(static_cast<uint32_t>(n)) / av_s_held_out.at(static_cast<uint32_t>(n)));
+      sum.chosen.score += r;
+      sum.chosen.worst = std::max(sum.chosen.worst, r);
+      ++terms;
+    }
+  if (terms) sum.chosen.score /= static_cast<double>(terms);
   out.history.stats.seconds = sum.merge_seconds;
   out.history.stats.evaluations = evaluations.load();  // the replay itself chooses nothing
   out.history.stats.stale = stale.load();
+  return out;
+}
+
+std::string describe_chain(const MergeSummary& summary) {
+  std::string out;
+  for (const MergePiece& p : summary.chain) {
+    if (!out.empty()) out += "; from " + std::to_string(p.from) + " cells: ";
+    if (p.start.cells <= 1) {
+      out += "the subdivision's own order";
+      continue;
+    }
+    out += "greedy merging from the subdivision's own cut at " + std::to_string(p.start.cells) + " cells";
+    if (p.start.barrier)
+      out += ", within its cut at " + std::to_string(p.start.barrier) + " cells until there";
+  }
   return out;
 }
 

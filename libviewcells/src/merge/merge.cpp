@@ -71,6 +71,33 @@ std::vector<std::pair<int32_t, int32_t>> subdivision_prefix(const Subdivision& s
   return prefix;
 }
 
+std::vector<std::pair<int32_t, int32_t>> merges_by_least_leaf(const MergeHistory& h) {
+  std::vector<int32_t> least(h.nodes.size());
+  for (size_t n = 0; n < h.leaf_count; ++n) least[n] = static_cast<int32_t>(n);
+  std::vector<std::pair<int32_t, int32_t>> out;
+  for (size_t k = h.leaf_count; k < h.nodes.size(); ++k) {
+    const int32_t a = least[h.nodes[k].child[0]], b = least[h.nodes[k].child[1]];
+    least[k] = std::min(a, b);
+    out.emplace_back(a, b);
+  }
+  return out;
+}
+
+std::vector<std::pair<int32_t, int32_t>> least_leaf_merges_as_prefix(
+    const std::vector<std::pair<int32_t, int32_t>>& merges, size_t leaves) {
+  std::vector<int32_t> node(leaves);
+  for (size_t n = 0; n < leaves; ++n) node[n] = static_cast<int32_t>(n);
+  std::vector<std::pair<int32_t, int32_t>> out;
+  int32_t next = static_cast<int32_t>(leaves);
+  for (const auto& [a, b] : merges) {
+    if (a < 0 || b < 0 || static_cast<size_t>(a) >= leaves || static_cast<size_t>(b) >= leaves || a == b)
+      throw Error("a merge names a cell by a leaf that is not one (" + std::to_string(a) + ", " + std::to_string(b) + ")");
+    out.emplace_back(node[a], node[b]);
+    node[std::min(a, b)] = next++;
+  }
+  return out;
+}
+
 std::vector<int32_t> subdivision_blocks(const Subdivision& s, size_t cells) {
   const std::vector<int32_t> leaves = s.leaves();
   std::vector<int32_t> block_of(s.nodes.size(), -1);

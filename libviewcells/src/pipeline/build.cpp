@@ -69,9 +69,8 @@ void merge_leaves(const BuildConfig& config, const SamplingRun& s, const Subdivi
   file.history = std::move(m.history);
   const MergeSummary& v = out.merge_summary = std::move(m.summary);
   if (v.validated)
-    log("viewcells: greedy merging from the subdivision's own cut at " + std::to_string(v.chosen.cells) + " cells" +
-        (v.chosen.barrier ? ", within its cut at " + std::to_string(v.chosen.barrier) + " cells until there" : "") +
-        " (held-out mean log cost ratio to AV-S " + fmt(v.chosen.score, 4) + ", worst " + fmt(v.chosen.worst, 4) + ")");
+    log("viewcells: " + describe_chain(v) + " (held-out mean log cost ratio to AV-S " + fmt(v.chosen.score, 4) +
+        ", worst " + fmt(v.chosen.worst, 4) + ")");
   log("viewcells: leaf PVSs " + fmt(v.leaf_pvs_seconds, 2) + " s, neighbour graph " + fmt(v.neighbour_seconds, 2) +
       " s, merging " + fmt(v.merge_seconds, 2) + " s (" + std::to_string(file.history->stats.evaluations) +
       " pair costs, " + std::to_string(file.history->stats.stale) + " stale queue entries skipped)");

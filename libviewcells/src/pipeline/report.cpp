@@ -157,6 +157,14 @@ json starts_json(const std::vector<MergeStart>& starts) {
   return out;
 }
 
+json chain_json(const MergeSummary& v) {
+  json out = json::array();
+  for (const MergePiece& p : v.chain)
+    out.push_back({{"from_cells", p.from}, {"to_cells", p.to}, {"greedy_from_cells", p.start.cells},
+                   {"barrier_cells", p.start.barrier}});
+  return out;
+}
+
 json merge_summary(const MergeHistory& h) {
   json merged = json::array();
   for (size_t cells = 1; cells <= h.leaf_count; cells *= 2)
@@ -257,6 +265,9 @@ std::string report_json(const BuildResult& r) {
     report["merge"]["barrier_cells"] = v.chosen.barrier;
     if (v.validated) {
       report["merge"]["starts_scored"] = starts_json(v.starts);
+      report["merge"]["chain"] = chain_json(v);
+      report["merge"]["held_out"] = {{"mean_log_cost_ratio_to_av_s", v.chosen.score},
+                                     {"worst_log_cost_ratio_to_av_s", v.chosen.worst}};
       report["merge"]["agvs_samples"] = {{"merge", v.merge_agvs_samples}, {"validation", v.validation_agvs_samples}};
     }
     report["timings"]["leaf_pvs_seconds"] = v.leaf_pvs_seconds;
@@ -463,7 +474,8 @@ json compare_methods_json(const Comparison& cmp) {
                                  {"leaf_agvs_samples", v.merge_agvs_samples + v.validation_agvs_samples},
                                  {"greedy_from_cells", v.chosen.cells},
                                  {"barrier_cells", v.chosen.barrier},
-                                 {"starts_scored", starts_json(v.starts)}};
+                                 {"starts_scored", starts_json(v.starts)},
+                                 {"chain", chain_json(v)}};
     }
   }
   return methods;

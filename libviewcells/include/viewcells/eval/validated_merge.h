@@ -8,14 +8,18 @@
 ///     united with those of an AGVS run over the cells ("merge" run, A);
 ///  2. the greedy merging starts from a cut of the subdivision's own order (AV-S's, undone
 ///     split by split from the leaves), at the count chosen by a second, independent AGVS run
-///     ("validation" run, B): each candidate start, from every leaf down by halves, is scored
-///     by its mean log cost ratio to AV-S's cuts over log-spaced counts, with PVSs from B
-///     alone, which no decision has seen. Pure AV-S (score 0) is a candidate, so merging is
-///     kept only where the held-out samples say it pays.
+///     ("validation" run, B): each candidate start, from every leaf down by halves, with and
+///     without barriers, is scored by its log cost ratio to AV-S's cuts over log-spaced
+///     counts, with PVSs from B alone, which no decision has seen. Pure AV-S (ratio 0) is a
+///     candidate, so merging is kept only where the held-out samples say it pays. Where a
+///     candidate's cut is AV-S's own (at its barrier), the histories below are interchangeable,
+///     so the choice is made per range of counts: the lowest sum of log ratios over all counts
+///     (a dynamic program over the barriers), each piece within the allowance at every count.
 /// The history written has the chosen merges with PVSs from the construction samples, A and
 /// B together (what extraction and compression then store).
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "viewcells/agvs/agvs.h"
@@ -46,10 +50,24 @@ struct MergeStart {
   double worst = 0;      ///< the largest log(cost / AV-S cost) among the counts scored
 };
 
+/// One piece of the chosen history: candidate `start`'s merges from `from` cells (a cut that
+/// is AV-S's own) down to `to` cells (`start.barrier`, where its cut is AV-S's again, or the
+/// end, 0). `start.cells` 1 is AV-S's own order.
+struct MergePiece {
+  MergeStart start;
+  uint32_t from = 0, to = 0;
+};
+
 /// What a merge of the leaves chose and cost, for reports.
 struct MergeSummary {
   bool validated = false;  ///< merge_validated; else greedy on the construction samples' PVSs
-  MergeStart chosen;       ///< the start taken ({leaf count, 0}: greedy from the leaves)
+  /// The first piece's start (for a single candidate, the start taken; {leaf count, 0}: greedy
+  /// from the leaves), with the score and worst count of the whole chosen history.
+  MergeStart chosen;
+  /// The chosen history, piece by piece from the leaves down (validated only): below a
+  /// candidate's barrier, where its cut is AV-S's, the choice is made again for the counts
+  /// below (the same choice at a smaller size), so low counts can start elsewhere.
+  std::vector<MergePiece> chain;
   std::vector<MergeStart> starts;  ///< every candidate, scored (validated only)
   uint64_t merge_agvs_samples = 0, validation_agvs_samples = 0;
   /// The leaves' PVSs (AGVS runs included), the neighbour graph, and merging (the choice of
@@ -64,6 +82,10 @@ struct LeafMerge {
   std::vector<std::vector<uint32_t>> leaf_pvs;
   MergeSummary summary;
 };
+
+/// The chosen history in words, piece by piece ("greedy merging from the subdivision's own
+/// cut at 5000 cells, within its cut at 78 cells until there; from 78 cells: ...").
+std::string describe_chain(const MergeSummary& summary);
 
 /// `base`: the construction samples' leaf PVSs, per node of `s` (bsp/subdivision.h leaf_pvs);
 /// `s` needs its cells (neighbours). Deterministic for any thread count.

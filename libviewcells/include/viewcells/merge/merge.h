@@ -106,6 +106,15 @@ std::vector<std::pair<int32_t, int32_t>> subdivision_prefix(const Subdivision& s
 /// `cells` cells that holds it (MergeConfig::block).
 std::vector<int32_t> subdivision_blocks(const Subdivision& s, size_t cells);
 
+/// Every merge of `h`, in order, each cell named by the least leaf under it. A cell of a cut
+/// is a set of leaves, so these names hold across histories whose cuts agree: merges of one
+/// history down to a count where its cut equals another's, followed by the other's merges
+/// from there, form one history.
+std::vector<std::pair<int32_t, int32_t>> merges_by_least_leaf(const MergeHistory& h);
+/// Merges named by least leaf (each naming two current cells) as MergeConfig::prefix node ids.
+std::vector<std::pair<int32_t, int32_t>> least_leaf_merges_as_prefix(
+    const std::vector<std::pair<int32_t, int32_t>>& merges, size_t leaves);
+
 /// A set of view cells cut from the merge history.
 struct ViewCellSet {
   std::vector<int32_t> cells;  ///< MHT node ids, sorted
