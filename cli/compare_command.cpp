@@ -17,6 +17,7 @@ struct CompareArgs {
   bool max_cells_given = false;
   uint64_t eval_samples = 0;
   uint64_t eval_seed = 0;
+  uint32_t eval_sets = 1;
   uint32_t histogram_cells = 0;
   double cost_a = 100, cost_b = 1;
   bool no_ga = false;
@@ -37,6 +38,7 @@ int run_compare(const CompareArgs& a, const Common& c) {
   config.construction = a.sampling.sampler(c);
   config.evaluation_samples = a.eval_samples;
   config.evaluation_seed = a.eval_seed;
+  config.evaluation_sets = a.eval_sets;
   config.histogram_cells = a.histogram_cells;
   config.model.a = a.cost_a;
   config.model.b = a.cost_b;
@@ -71,6 +73,12 @@ void add_compare_command(CLI::App& app, const Common& common, Commands& commands
   cm->add_option("--eval-samples", a->eval_samples, "Evaluation samples (default: 4 x --samples)")
       ->check(whole(1, kMaxSamples));
   cm->add_option("--eval-seed", a->eval_seed, "Evaluation seed (default: --seed + 1000003)");
+  cm->add_option("--eval-sets", a->eval_sets,
+                 "Independent evaluation sets, each of --eval-samples (set K has seed --eval-seed + K - 1); every "
+                 "method is scored on each, in curves.csv's cost and cost_2, cost_3, ... columns. Their "
+                 "disagreement is the evaluator's own noise")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
   cm->add_option("--histogram-cells", a->histogram_cells, "Cell count of the cost histograms (default: --max-cells)");
   cm->add_option("--cost-a", a->cost_a, "Render cost model: minimum cost of an object")->capture_default_str();
   cm->add_option("--cost-b", a->cost_b, "Render cost model: cost per triangle")->capture_default_str();

@@ -329,6 +329,18 @@ assert avm[40] < kd[40], (avm[40], kd[40])
 assert all(float(r['ratio_to_av_m']) == 1.0 for r in rows if r['method'] == 'av-m')
 " && ok || bad "compare outputs"
 [ -s cmp/histogram.csv ] && ok || bad "compare histogram"
+# A second evaluation set: every method scored on both; set 1 is the run above's.
+expect_ok "$VC" compare office.obj --samples 20000 --max-cells 40 --methods av-s,kd-casm --eval-sets 2 -o cmp3 -q
+python3 -c "
+import csv, json
+one = {(r['method'], r['cells']): r['cost'] for r in csv.DictReader(open('cmp/curves.csv'))}
+rows = list(csv.DictReader(open('cmp3/curves.csv')))
+assert rows and all(r['cost'] == one[(r['method'], r['cells'])] for r in rows)
+assert all(float(r['cost_2']) > 0 for r in rows)
+assert any(r['cost_2'] != r['cost'] for r in rows if int(r['cells']) > 1), 'the second set is not independent'
+assert json.load(open('cmp3/summary.json'))['settings']['evaluation_sets'] == 2
+" && ok || bad "compare with two evaluation sets"
+expect_error "--eval-sets" "$VC" compare office.obj --samples 1000 --eval-sets 0 -o cmp2
 expect_error "unknown subdivision method 'kd-foo'" "$VC" compare office.obj --samples 1000 --methods av-m,kd-foo -o cmp2
 [ ! -e cmp2 ] && ok || bad "a refused compare created its output directory"
 head -c 100 office.vcells > cut.vcells

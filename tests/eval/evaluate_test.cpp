@@ -246,6 +246,7 @@ TEST(Evaluate, MergingIsNotWorseThanTheSubdivisionsOwnCuts) {
   const auto caster = make_embree_caster(scene);
   CompareConfig config = comparison({"av-m", "av-m-samples", "av-s"}, 400, 80000, 320000);
   config.keep_models = true;
+  config.evaluation_sets = 2;  // the second: the evaluator's noise
   AgvsConfig agvs;
   agvs.seed = 5;
   agvs.max_samples = 80000;
@@ -258,11 +259,16 @@ TEST(Evaluate, MergingIsNotWorseThanTheSubdivisionsOwnCuts) {
   EXPECT_GT(avm.merge.merge_agvs_samples + avm.merge.validation_agvs_samples, 2 * agvs.max_samples - 1);
   EXPECT_FALSE(avm.merge.starts.empty());
 
-  // A second, independent evaluation of AV-S: the evaluator's noise.
+  // The second, independent evaluation set (seed 3): the evaluator's noise. It is what
+  // evaluating AV-S on samples drawn with that seed gives.
+  ASSERT_EQ(avs.evaluated_more.size(), 1u);
+  const CostCurve& avs2 = avs.evaluated_more[0];
   SamplerConfig second = config.evaluation;
   second.seed = 3;
   const SegmentSet eval2 = sample_segments(scene, *caster, second).segments;
-  const CostCurve avs2 = evaluate_subdivision(scene, *c.av_s, evaluation_pvs(*c.av_s, eval2), CostModel{});
+  const CostCurve again = evaluate_subdivision(scene, *c.av_s, evaluation_pvs(*c.av_s, eval2), CostModel{});
+  EXPECT_EQ(avs2.cells, again.cells);
+  EXPECT_EQ(avs2.cost, again.cost);
   const uint32_t leaves = avs.leaves;
   int old_worse = 0;
   for (uint32_t n : report_cell_counts(leaves)) {

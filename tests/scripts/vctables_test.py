@@ -56,6 +56,32 @@ class Tables(unittest.TestCase):
     def tearDown(self):
         self.tmp.cleanup()
 
+    def test_merge_start_names_every_piece_of_the_chosen_history(self):
+        chain = [{"from_cells": 5000, "to_cells": 78, "greedy_from_cells": 5000, "barrier_cells": 78},
+                 {"from_cells": 78, "to_cells": 0, "greedy_from_cells": 39, "barrier_cells": 0}]
+        self.assertEqual(vctables.merge_start_text({"chain": chain}), "5,000 / 78, then 39 / -")
+        chain[1]["greedy_from_cells"] = 1
+        self.assertEqual(vctables.merge_start_text({"chain": chain}), "5,000 / 78, then AV-S")
+        # Reports from before the chain: the single start.
+        self.assertEqual(vctables.merge_start_text({"greedy_from_cells": 156, "barrier_cells": 39}), "156 / 39")
+        self.assertEqual(vctables.merge_start_text({}, 2000), "2,000 / -")
+
+    def test_two_evaluation_sets_give_each_ratio_the_pooled_one_and_the_spread(self):
+        rows = [{"method": m, "cells": str(c), "cost": str(a), "cost_2": str(b)} for m, c, a, b in [
+            ("av-m", 16, 102, 98), ("av-s", 16, 100, 100), ("av-m", 20, 90, 99), ("av-s", 20, 100, 100),
+            ("av-m", 8, 500, 500), ("av-s", 8, 100, 100)]]
+        sets = vctables.evaluation_sets(rows)
+        self.assertEqual(len(sets), 2)
+        self.assertEqual(sets[1]["av-m"][20], 99.0)
+        r = vctables.set_ratios(sets, "av-m", "av-s", [16, 20])  # 8 is not asked for
+        self.assertEqual(r["worst"][0], (1.02, 16))
+        self.assertEqual(r["worst"][1], (0.99, 20))
+        self.assertEqual(r["pooled"], (1.0, 16))  # (102 + 98) / 200; at 20: 189 / 200
+        self.assertAlmostEqual(r["spread"][0], 0.09)
+        self.assertEqual(r["spread"][1], 20)
+        # One set: the cost column alone.
+        self.assertEqual(len(vctables.evaluation_sets([{"method": "a", "cells": "1", "cost": "3"}])), 1)
+
     def test_replace_section_keeps_the_rest(self):
         md, table = f"{self.d}/b.md", f"{self.d}/t.md"
         open(md, "w").write("head\n<!-- x:begin -->\nold\n<!-- x:end -->\ntail\n")

@@ -42,8 +42,18 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
   Comparison out;
   SamplingResult built = sample_segments(scene, caster, config.construction);
   out.construction = built.stats;
+  if (config.evaluation_sets < 1) throw Error("at least one evaluation set is needed");
   SamplingResult eval = sample_segments(scene, caster, config.evaluation);
   out.evaluation = eval.stats;
+  std::vector<SegmentSet> more;  // evaluation sets 1, 2, ...
+  for (uint32_t k = 1; k < config.evaluation_sets; ++k) {
+    SamplerConfig e = config.evaluation;
+    e.seed += k;
+    if (e.seed == config.construction.seed) throw Error("an evaluation set's seed equals the construction seed");
+    SamplingResult m = sample_segments(scene, caster, e);
+    out.evaluation.seconds += m.stats.seconds;  // the sampling of every set
+    more.push_back(std::move(m.segments));
+  }
   const uint32_t hist_cells = config.histogram_cells ? config.histogram_cells : config.max_cells;
 
   std::optional<Subdivision> av_s;  // shared by av-s and av-m
@@ -97,6 +107,9 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
       out.evaluation_seconds -= merge_seconds;  // counted below with the evaluation otherwise
       const std::vector<double> node_cost = evaluated_merge_costs(scene, *s, h, pvs, config.model);
       r.evaluated = merge_history_curve(h, node_cost);
+      for (const SegmentSet& e : more)
+        r.evaluated_more.push_back(
+            merge_history_curve(h, evaluated_merge_costs(scene, *s, h, evaluation_pvs(*s, e), config.model)));
       for (size_t cells = h.min_cells(); cells <= h.leaf_count; ++cells) {
         r.constructed.cells.push_back(static_cast<uint32_t>(cells));
         r.constructed.cost.push_back(h.cost_with(cells));
@@ -108,6 +121,8 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
     } else {
       const std::vector<double> node_cost = evaluated_bsp_costs(scene, *s, pvs, config.model);
       r.evaluated = subdivision_curve(*s, node_cost);
+      for (const SegmentSet& e : more)
+        r.evaluated_more.push_back(subdivision_curve(*s, evaluated_bsp_costs(scene, *s, evaluation_pvs(*s, e), config.model)));
       r.constructed.cells.push_back(1);
       r.constructed.cost.push_back(s->initial_cost);
       for (size_t k = 0; k < s->splits.size(); ++k) {

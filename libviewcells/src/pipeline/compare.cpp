@@ -45,6 +45,8 @@ CompareConfig compared_config(const CompareRunConfig& c, bool& with_q3) {
   config.evaluation.target_segments = 0;
   config.evaluation.samples = c.evaluation_samples ? c.evaluation_samples : 4 * c.construction.samples;
   config.evaluation.seed = c.evaluation_seed ? c.evaluation_seed : c.construction.seed + 1'000'003;
+  if (c.evaluation_sets < 1 || c.evaluation_sets > 16) throw Error("--eval-sets must be between 1 and 16");
+  config.evaluation_sets = c.evaluation_sets;
   config.model = c.model;
   config.model.validate();
   config.subdivision = c.subdivision;
@@ -57,12 +59,16 @@ CompareConfig compared_config(const CompareRunConfig& c, bool& with_q3) {
   return config;
 }
 
-/// curves.csv: each method's evaluated cost at the report's counts and where any stopped.
+/// curves.csv: each method's evaluated cost at the report's counts and where any stopped; with
+/// several evaluation sets, a column cost_K for each further set K (2, 3, ...).
 void write_curves(const CompareRunResult& r, const std::string& path) {
   const Comparison& cmp = r.comparison();
   const MethodResult* avm = find_avm(cmp);
   const std::vector<uint32_t> counts = report_cell_counts(r.compared.max_cells);
-  std::string csv = "method,cells,cost,ratio_to_av_m,constructed_cost\n";
+  const uint32_t sets = r.compared.evaluation_sets;
+  std::string csv = "method,cells,cost,ratio_to_av_m,constructed_cost";
+  for (uint32_t k = 2; k <= sets; ++k) csv += ",cost_" + std::to_string(k);
+  csv += "\n";
   char line[256];
   for (const MethodResult& m : cmp.methods) {
     std::vector<uint32_t> at = counts;
@@ -77,9 +83,15 @@ void write_curves(const CompareRunResult& r, const std::string& path) {
       if (!has_point(m.evaluated, n)) continue;
       const double cost = m.evaluated.at(n);
       const std::string ratio = avm && has_point(avm->evaluated, n) ? fmt(cost / avm->evaluated.at(n), 6) : "";
-      std::snprintf(line, sizeof line, "%s,%u,%.6g,%s,%.6g\n", m.method.c_str(), n, cost, ratio.c_str(),
+      std::snprintf(line, sizeof line, "%s,%u,%.6g,%s,%.6g", m.method.c_str(), n, cost, ratio.c_str(),
                     m.constructed.at(n));
       csv += line;
+      for (uint32_t k = 2; k <= sets; ++k) {
+        const CostCurve* more = k - 2 < m.evaluated_more.size() ? &m.evaluated_more[k - 2] : nullptr;
+        std::snprintf(line, sizeof line, ",%.6g", more && has_point(*more, n) ? more->at(n) : 0.0);
+        csv += more && has_point(*more, n) ? std::string(line) : std::string(",");
+      }
+      csv += "\n";
     }
   }
   if (r.q3) {
@@ -87,8 +99,8 @@ void write_curves(const CompareRunResult& r, const std::string& path) {
     const uint32_t n = r.q3->cluster_count;
     const std::string ratio =
         avm && has_point(avm->evaluated, n) ? fmt(r.q3->clusters.cost / avm->evaluated.at(n), 6) : "";
-    std::snprintf(line, sizeof line, "q3-clusters,%u,%.6g,%s,\n", n, r.q3->clusters.cost, ratio.c_str());
-    csv += line;
+    std::snprintf(line, sizeof line, "q3-clusters,%u,%.6g,%s,", n, r.q3->clusters.cost, ratio.c_str());
+    csv += line + std::string(sets - 1, ',') + "\n";
   }
   write_text_file(path, csv);
 }

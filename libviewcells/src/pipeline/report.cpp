@@ -518,6 +518,7 @@ std::string report_json(const CompareRunResult& r) {
         {"construction_seed", config.construction.seed},
         {"evaluation_samples", config.evaluation.samples},
         {"evaluation_seed", config.evaluation.seed},
+        {"evaluation_sets", config.evaluation_sets},
         {"histogram_cells", config.histogram_cells ? config.histogram_cells : config.max_cells},
         {"cost_model", {{"a", config.model.a}, {"b", config.model.b}, {"c", 0}}},
         {"axis_candidates", config.subdivision.max_axis_candidates},

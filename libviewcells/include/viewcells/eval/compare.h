@@ -22,6 +22,10 @@ struct CompareConfig {
   uint32_t max_cells = 1000;
   SamplerConfig construction;  ///< samples for building
   SamplerConfig evaluation;    ///< independent samples for scoring (own seed, more of them)
+  /// Independent evaluation sets: set k (from 0) draws as `evaluation` does with seed
+  /// evaluation.seed + k. Every method is scored on each; MethodResult::evaluated is set 0's.
+  /// Their disagreement is the evaluator's own noise.
+  uint32_t evaluation_sets = 1;
   CostModel model;
   SubdivisionConfig subdivision;  ///< shared settings (strategy is set per method)
   uint32_t histogram_cells = 0;   ///< cell count of the histograms (0: max_cells)
@@ -40,6 +44,7 @@ struct CompareConfig {
 struct MethodResult {
   std::string method;
   CostCurve evaluated;          ///< c(S) on the evaluation samples along the method's order
+  std::vector<CostCurve> evaluated_more;  ///< the same on evaluation sets 1, 2, ... (evaluation_sets)
   CostCurve constructed;        ///< the method's own estimate (construction samples)
   std::vector<CellCost> cells;  ///< evaluated cells at the histogram cell count (if reached)
   uint32_t leaves = 0;          ///< cells the method produced

@@ -23,6 +23,7 @@ struct CompareRunConfig {
   SamplerConfig construction;
   uint64_t evaluation_samples = 0;  ///< 0: four times the construction samples
   uint64_t evaluation_seed = 0;     ///< 0: the construction seed + 1000003
+  uint32_t evaluation_sets = 1;     ///< independent evaluation sets (eval/compare.h)
   uint32_t histogram_cells = 0;
   CostModel model;
   SubdivisionConfig subdivision;
