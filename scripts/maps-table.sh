@@ -28,7 +28,7 @@ for map in "${maps[@]}"; do
     continue
   fi
   start=$(date +%s.%N)
-  if "$vc" compare "$map" --samples "$samples" --eval-samples "$eval_samples" --seed 1 \
+  if "$vc" compare "$map" --samples "$samples" --eval-samples "$eval_samples" --eval-sets 2 --seed 1 \
       --methods av-m,av-s,q3-clusters -o "$out/$name" -q 2> "$out/$name.err"; then
     python3 scripts/vctables.py elapsed "$start" > "$out/$name/wall_seconds"
     echo "maps: [$i/${#maps[@]}] $name: $clusters clusters, $(cat "$out/$name/wall_seconds") s"

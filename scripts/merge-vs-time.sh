@@ -25,7 +25,7 @@ for scene in office rotated-office; do
     if [ "$mode" = samples ]; then merge=(--merge-pvs samples)
     else merge=(--merge-samples "$(python3 -c "print(int($mode * $samples))")"); fi
     "$vc" compare "$path" --methods av-m,av-s,kd-casm --samples "$samples" --seed 1 --eval-seed 99 \
-      --max-cells "$cells" "${merge[@]}" -o "$out/$name" -q
+      --eval-sets 2 --max-cells "$cells" "${merge[@]}" -o "$out/$name" -q
   done
 done
 python3 scripts/vctables.py merge-vs-time "$out" "$samples" "$cells" > docs/accuracy/merge.md
