@@ -506,7 +506,8 @@ def results(*args):
           "merge history backwards for AV-M).\n")
     print("Methods (section 6.3): AV-M = AV-S's cells merged (`build`'s default: merging decided on the leaves' "
           "PVSs from the construction samples and an AGVS run over the leaves, starting from the cut of AV-S's own "
-          "order that a second, held-out AGVS run scores best, chosen again below each barrier where its cut is AV-S's; "
+          "order that held-out samples score best (a second AGVS run and as many random samples as the construction "
+          "drew, another seed), chosen again below each barrier where its cut is AV-S's; "
           "see docs/accuracy-vs-time.md); AV-M (old) = greedy "
           "merging of the leaves on the construction samples' PVSs alone, the paper's AV-M and ours until now "
           "(`--merge-pvs samples`); AV-S = our cost-driven subdivision; KD-CASM / KD-LASM = breadth-first kd-tree, "
@@ -514,8 +515,9 @@ def results(*args):
           "5% of the whole view space's alone; KD-VT* = its depth-first version (max depth 40); BSP = splits on "
           "scene polygon planes only, chosen as cell-and-portal builders do.\n")
     print("What each was given: every method the same construction samples; AV-M also the two AGVS runs over "
-          "AV-S's leaves (as many samples each as the construction samples: the row's AGVS column), which no other "
-          "method gets, and whose time is in its build seconds. The evaluator never sees any of them.\n")
+          "AV-S's leaves (as many samples each as the construction samples: the row's AGVS column) and as many "
+          "held-out random samples as the construction samples (seed 2000004), which no other method gets, and "
+          "whose time is in its build seconds. The evaluator never sees any of them.\n")
     scenes = [("office", "office (size 4, two storeys)"), ("rotated-office", "rotated office (size 4, 30 degrees)"),
               ("city", f"city (size {size}, a street grid)"), ("town", f"town (size {size}, not a grid)"),
               ("town-street", f"town at street level (size {size}, eye heights 0.5-4 m)")]
@@ -638,8 +640,9 @@ def results(*args):
     print("\nReading it. Greedy merging of 5,000 leaves on the construction samples' PVSs (AV-M (old)) fits "
           "the gaps of a few hundred samples per leaf: it picks the pairs whose sampled PVSs happen to overlap "
           "most, the construction samples rate its cuts better than AV-S's, and independent samples rate them "
-          "worse. AV-M now decides on PVSs that an AGVS run over the leaves completes, and it lets a second, "
-          "independent AGVS run choose where greedy merging starts from AV-S's own order (and within which of "
+          "worse. AV-M now decides on PVSs that an AGVS run over the leaves completes, and it lets held-out "
+          "samples (a second, independent AGVS run and random samples, each count within 1% of AV-S on both) "
+          "choose where greedy merging starts from AV-S's own order (and within which of "
           "AV-S's cells it stays until a barrier count): AV-S's order itself is a candidate, so merging is kept "
           "only where the held-out samples say it pays. At a barrier the cut is AV-S's own, so below it the "
           "choice is made again for the smaller counts (the merge table's pieces, \"then\"). The worst ratios "
@@ -732,7 +735,7 @@ def merge_vs_time(*args):
     print(f"Each scene: {samples:,} construction samples, AV-S to {cells:,} cells, evaluated on "
           f"{4 * samples:,} independent samples (seed 99); the same leaves merged four ways. \"AGVS per run\" is "
           "the samples of each of the two AGVS runs over the leaves (one to merge on, one held out to choose the "
-          "start); merge seconds are the leaf PVSs (construction samples and AGVS), the neighbour graph and "
+          "start, with as many held-out random samples as the construction's); merge seconds are the leaf PVSs (construction samples and AGVS), the neighbour graph and "
           "merging (every candidate start scored). Worst ratios are over every reported count from 16 cells up; "
           "\"both sets\", where the runs scored on a second evaluation set (seed 100), is the ratio of the costs "
           "summed over the two sets.\n")

@@ -98,7 +98,8 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
     if (merged) {
       MergeConfig mc;
       mc.show_progress = config.show_progress;
-      LeafMerge lm = merge_leaves(scene, caster, *s, built.segments, config.model,
+      LeafMerge lm = merge_leaves(scene, caster, *s, built.segments,
+                                  held_out_sampling(config.construction, built.stats.samples), config.model,
                                   method == "av-m" ? config.merge_agvs : std::nullopt, mc);
       MergeHistory h = std::move(lm.history);
       r.merge = std::move(lm.summary);

@@ -37,9 +37,51 @@ std::vector<int32_t> cut_labels(const Merges& merges, size_t leaves, size_t k) {
   return up;
 }
 
-/// A candidate's scores at the counts scored (0 where its history does not reach).
+/// A history's held-out scores at the counts scored (0 where it or AV-S does not reach): the
+/// mean over the held-out sets of log(cost / AV-S's cost), and the largest of them.
+struct CountScores {
+  std::vector<double> log_ratio, worst;
+};
+
+/// The held-out leaf PVS sets (B, and C when drawn), AV-S's costs on each, and the counts scored.
+struct HeldOut {
+  std::vector<const std::vector<std::vector<uint32_t>>*> pvs;
+  std::vector<CostCurve> av_s;
+  std::vector<size_t> counts;
+  size_t av_s_min_cells = 1;
+
+  CountScores score(const Scene& scene, const Subdivision& s, const MergeHistory& h, const CostModel& model) const {
+    CountScores out{std::vector<double>(counts.size(), 0.0), std::vector<double>(counts.size(), 0.0)};
+    for (size_t k = 0; k < pvs.size(); ++k) {
+      const CostCurve curve = evaluate_merge_history(scene, s, h, *pvs[k], model);
+      for (size_t j = 0; j < counts.size(); ++j) {
+        const auto n = static_cast<uint32_t>(counts[j]);
+        if (n < h.min_cells() || n < av_s_min_cells) continue;
+        const double r = std::log(curve.at(n) / av_s[k].at(n));
+        out.log_ratio[j] += r / static_cast<double>(pvs.size());
+        out.worst[j] = k ? std::max(out.worst[j], r) : r;
+      }
+    }
+    return out;
+  }
+  /// The mean over the counts scored, and the worst count, as MergeStart reports them.
+  void summarise(const CountScores& c, size_t min_cells, MergeStart& st) const {
+    st.score = 0;
+    st.worst = 0;
+    size_t terms = 0;
+    for (size_t j = 0; j < counts.size(); ++j)
+      if (counts[j] >= min_cells && counts[j] >= av_s_min_cells) {
+        st.score += c.log_ratio[j];
+        st.worst = terms ? std::max(st.worst, c.worst[j]) : c.worst[j];
+        ++terms;
+      }
+    if (terms) st.score /= static_cast<double>(terms);
+  }
+};
+
+/// A candidate's scores and merges.
 struct Scored {
-  std::vector<double> log_ratio;
+  CountScores at;
   Merges merges;              ///< by least leaf
   bool barrier_cut = false;  ///< its cut at its barrier is AV-S's (the barrier held)
 };
@@ -67,6 +109,14 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   const LeafPvsRun b = leaf_pvs_by_agvs(scene, caster, s, vc);
   sum.merge_agvs_samples = a.stats.samples;
   sum.validation_agvs_samples = b.stats.samples;
+  std::vector<std::vector<uint32_t>> c_pvs;
+  if (config.held_out_samples) {
+    SamplerConfig sc = *config.held_out_samples;
+    sc.show_progress = sc.show_progress && config.merge.show_progress;
+    const SamplingResult c = sample_segments(scene, caster, sc);
+    sum.held_out_samples = c.stats.samples;
+    c_pvs = evaluation_pvs(s, c.segments);  // every leaf each segment has length in
+  }
   sum.leaf_pvs_seconds = t.seconds();
 
   t.restart();
@@ -78,8 +128,12 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   MergeConfig mc = config.merge;
   mc.prefix = subdivision_prefix(s, 1);
   const MergeHistory av_s = merge_cells(scene, partition, model, mc);  // AV-S's own order
-  const CostCurve av_s_held_out = evaluate_merge_history(scene, s, av_s, b.pvs, model);
-  std::vector<size_t> counts;
+  HeldOut held_out;
+  held_out.pvs.push_back(&b.pvs);
+  if (config.held_out_samples) held_out.pvs.push_back(&c_pvs);
+  for (const auto* pvs : held_out.pvs) held_out.av_s.push_back(evaluate_merge_history(scene, s, av_s, *pvs, model));
+  held_out.av_s_min_cells = av_s.min_cells();
+  std::vector<size_t>& counts = held_out.counts;
   for (size_t n = std::min<size_t>(config.score_from, L); n <= L; n = n * 5 / 4 + 1) counts.push_back(n);
   if (counts.empty() || counts.back() != L) counts.push_back(L);
   sum.chosen = {1, 0, 0.0, 0.0};
@@ -109,23 +163,9 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
     const MergeHistory h = merge_cells(scene, partition, model, config_for(st));
     evaluations += h.stats.evaluations;
     stale += h.stats.stale;
-    const CostCurve held_out = evaluate_merge_history(scene, s, h, b.pvs, model);
     Scored& sc = scored[i];
-    sc.log_ratio.assign(counts.size(), 0.0);
-    st.worst = -1e300;
-    size_t terms = 0;
-    for (size_t j = 0; j < counts.size(); ++j) {
-      const size_t n = counts[j];
-      if (n >= h.min_cells() && n >= av_s.min_cells()) {
-        const double r = std::log(held_out.at(static_cast<uint32_t>(n)) / av_s_held_out.at(static_cast<uint32_t>(n)));
-        sc.log_ratio[j] = r;
-        st.score += r;
-        st.worst = std::max(st.worst, r);
-        ++terms;
-      }
-    }
-    st.score = terms ? st.score / static_cast<double>(terms) : 0.0;
-    if (!terms) st.worst = 0;
+    sc.at = held_out.score(scene, s, h, model);
+    held_out.summarise(sc.at, h.min_cells(), st);
     sc.merges = merges_by_least_leaf(h);
     sc.barrier_cut = st.barrier && h.min_cells() <= st.barrier &&
                      cut_labels(sc.merges, L, L - st.barrier) == cut_labels(av_s_merges, L, L - st.barrier);
@@ -154,8 +194,8 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
     std::pair<double, double> sum_worst{0.0, 0.0};
     for (size_t j = 0; j < counts.size(); ++j)
       if (counts[j] > below && counts[j] <= upto) {
-        sum_worst.first += scored[i].log_ratio[j];
-        sum_worst.second = std::max(sum_worst.second, scored[i].log_ratio[j]);
+        sum_worst.first += scored[i].at.log_ratio[j];
+        sum_worst.second = std::max(sum_worst.second, scored[i].at.worst[j]);
       }
     return sum_worst;
   };
@@ -198,6 +238,7 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   // The chosen merges, replayed with every sample's PVSs.
   t.restart();
   out.leaf_pvs = unite(a.pvs, b.pvs);
+  if (config.held_out_samples) out.leaf_pvs = unite(out.leaf_pvs, c_pvs);
   partition = partition_from_subdivision(s, out.leaf_pvs);
   sum.neighbour_seconds += t.seconds();
   t.restart();
@@ -208,22 +249,19 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   out.history = merge_cells(scene, partition, model, mc);
   sum.merge_seconds += t.seconds();
   // The whole chosen history's held-out score, as the candidates were scored.
-  const CostCurve held_out = evaluate_merge_history(scene, s, out.history, b.pvs, model);
-  sum.chosen.score = 0;
-  sum.chosen.worst = 0;
-  size_t terms = 0;
-  for (size_t n : counts)
-    if (n >= out.history.min_cells() && n >= av_s.min_cells()) {
-      const double r = std::log(held_out.at(static_cast<uint32_t>(n)) / av_s_held_out.at(static_cast<uint32_t>(n)));
-      sum.chosen.score += r;
-      sum.chosen.worst = std::max(sum.chosen.worst, r);
-      ++terms;
-    }
-  if (terms) sum.chosen.score /= static_cast<double>(terms);
+  held_out.summarise(held_out.score(scene, s, out.history, model), out.history.min_cells(), sum.chosen);
   out.history.stats.seconds = sum.merge_seconds;
   out.history.stats.evaluations = evaluations.load();  // the replay itself chooses nothing
   out.history.stats.stale = stale.load();
   return out;
+}
+
+SamplerConfig held_out_sampling(const SamplerConfig& construction, uint64_t samples_drawn) {
+  SamplerConfig c = construction;
+  c.seed = construction.seed + 2000003;
+  c.target_segments = 0;
+  c.samples = std::max<uint64_t>(samples_drawn, 1);
+  return c;
 }
 
 std::string describe_chain(const MergeSummary& summary) {
@@ -242,7 +280,8 @@ std::string describe_chain(const MergeSummary& summary) {
 }
 
 LeafMerge merge_leaves(const Scene& scene, const RayCaster& caster, const Subdivision& s, const SegmentSet& segments,
-                       const CostModel& model, const std::optional<AgvsConfig>& agvs, const MergeConfig& merge) {
+                       const SamplerConfig& held_out, const CostModel& model,
+                       const std::optional<AgvsConfig>& agvs, const MergeConfig& merge) {
   Stopwatch t;
   std::vector<std::vector<uint32_t>> base = leaf_pvs(s, segments);
   const double base_seconds = t.seconds();
@@ -251,6 +290,7 @@ LeafMerge merge_leaves(const Scene& scene, const RayCaster& caster, const Subdiv
     ValidatedMergeConfig vc;
     vc.agvs = *agvs;
     vc.merge = merge;
+    vc.held_out_samples = held_out;
     out = merge_validated(scene, caster, s, std::move(base), model, vc);
   } else {
     MergeSummary& sum = out.summary;

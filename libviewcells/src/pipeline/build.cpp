@@ -63,7 +63,8 @@ void merge_leaves(const BuildConfig& config, const SamplingRun& s, const Subdivi
   }
   MergeConfig mc;
   mc.show_progress = config.subdivision.show_progress;
-  LeafMerge m = viewcells::merge_leaves(*s.loaded.scene, *s.loaded.caster, sub, s.result.segments, config.model,
+  LeafMerge m = viewcells::merge_leaves(*s.loaded.scene, *s.loaded.caster, sub, s.result.segments,
+                                        held_out_sampling(s.config, s.result.stats.samples), config.model,
                                         config.merge_agvs, mc);
   file.leaf_pvs = std::move(m.leaf_pvs);
   file.history = std::move(m.history);

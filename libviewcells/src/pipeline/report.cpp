@@ -269,6 +269,7 @@ std::string report_json(const BuildResult& r) {
       report["merge"]["held_out"] = {{"mean_log_cost_ratio_to_av_s", v.chosen.score},
                                      {"worst_log_cost_ratio_to_av_s", v.chosen.worst}};
       report["merge"]["agvs_samples"] = {{"merge", v.merge_agvs_samples}, {"validation", v.validation_agvs_samples}};
+      report["merge"]["held_out_random_samples"] = v.held_out_samples;
     }
     report["timings"]["leaf_pvs_seconds"] = v.leaf_pvs_seconds;
     report["timings"]["neighbour_graph_seconds"] = v.neighbour_seconds;
@@ -472,6 +473,7 @@ json compare_methods_json(const Comparison& cmp) {
                                  {"neighbour_graph_seconds", v.neighbour_seconds},
                                  {"merge_seconds", v.merge_seconds},
                                  {"leaf_agvs_samples", v.merge_agvs_samples + v.validation_agvs_samples},
+                                 {"held_out_random_samples", v.held_out_samples},
                                  {"greedy_from_cells", v.chosen.cells},
                                  {"barrier_cells", v.chosen.barrier},
                                  {"starts_scored", starts_json(v.starts)},

@@ -7,16 +7,18 @@
 ///  1. the elementary cells' PVSs that merging decides on are the construction samples'
 ///     united with those of an AGVS run over the cells ("merge" run, A);
 ///  2. the greedy merging starts from a cut of the subdivision's own order (AV-S's, undone
-///     split by split from the leaves), at the count chosen by a second, independent AGVS run
-///     ("validation" run, B): each candidate start, from every leaf down by halves, with and
-///     without barriers, is scored by its log cost ratio to AV-S's cuts over log-spaced
-///     counts, with PVSs from B alone, which no decision has seen. Pure AV-S (ratio 0) is a
-///     candidate, so merging is kept only where the held-out samples say it pays. Where a
-///     candidate's cut is AV-S's own (at its barrier), the histories below are interchangeable,
-///     so the choice is made per range of counts: the lowest sum of log ratios over all counts
-///     (a dynamic program over the barriers), each piece within the allowance at every count.
-/// The history written has the chosen merges with PVSs from the construction samples, A and
-/// B together (what extraction and compression then store).
+///     split by split from the leaves), chosen on samples that no decision has seen: a
+///     second, independent AGVS run (B) and as many random samples as the construction drew,
+///     drawn the same way (C, the evaluator's kind of PVS). Each candidate,
+///     greedy from every cut by halves, with and without barriers, is scored by its log cost
+///     ratio to AV-S's cuts at log-spaced counts, on B and on C separately. Pure AV-S (ratio
+///     0) is a candidate, so merging is kept only where the held-out samples say it pays.
+///     Where a candidate's cut is AV-S's own (at its barrier), the histories below are
+///     interchangeable, so the choice is made per range of counts: the lowest sum of the mean
+///     log ratios over all counts (a dynamic program over the barriers), each piece within
+///     the allowance at every count on both B and C.
+/// The history written has the chosen merges with PVSs from the construction samples, A, B
+/// and C together (what extraction and compression then store).
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -27,6 +29,7 @@
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/merge/merge.h"
 #include "viewcells/raycast/ray_caster.h"
+#include "viewcells/sampling/sampler.h"
 #include "viewcells/sampling/segments.h"
 #include "viewcells/scene/scene.h"
 
@@ -41,6 +44,10 @@ struct ValidatedMergeConfig {
   uint32_t score_from = 16;
   /// A start is taken only when its worst count is at most this (a log ratio) above AV-S's.
   double worst_allowed = 0.01;
+  /// Random samples held out as well (drawn as the construction samples are, with their own
+  /// seed): the evaluator's kind of PVS. Each count's log ratio is then the mean of the two
+  /// held-out sets', and must be within the allowance on each. Unset: the AGVS run alone.
+  std::optional<SamplerConfig> held_out_samples;
 };
 
 struct MergeStart {
@@ -70,6 +77,7 @@ struct MergeSummary {
   std::vector<MergePiece> chain;
   std::vector<MergeStart> starts;  ///< every candidate, scored (validated only)
   uint64_t merge_agvs_samples = 0, validation_agvs_samples = 0;
+  uint64_t held_out_samples = 0;  ///< random samples held out (ValidatedMergeConfig::held_out_samples)
   /// The leaves' PVSs (AGVS runs included), the neighbour graph, and merging (the choice of
   /// the start included).
   double leaf_pvs_seconds = 0, neighbour_seconds = 0, merge_seconds = 0;
@@ -93,10 +101,15 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
                           std::vector<std::vector<uint32_t>> base, const CostModel& model,
                           const ValidatedMergeConfig& config);
 
+/// The held-out random samples of a validated merge: as many as the construction drew, drawn
+/// the same way, with seed construction.seed + 2000003 (the evaluator's default is + 1000003).
+SamplerConfig held_out_sampling(const SamplerConfig& construction, uint64_t samples_drawn);
+
 /// The leaves of `s` merged into a history from the construction samples `segments`: by
-/// merge_validated when `agvs` is set, else greedily on the construction samples' PVSs alone.
-/// What build and compare call.
+/// merge_validated when `agvs` is set (`held_out`: its random samples, held_out_sampling),
+/// else greedily on the construction samples' PVSs alone. What build and compare call.
 LeafMerge merge_leaves(const Scene& scene, const RayCaster& caster, const Subdivision& s, const SegmentSet& segments,
-                       const CostModel& model, const std::optional<AgvsConfig>& agvs, const MergeConfig& merge);
+                       const SamplerConfig& held_out, const CostModel& model,
+                       const std::optional<AgvsConfig>& agvs, const MergeConfig& merge);
 
 }  // namespace viewcells
