@@ -40,8 +40,9 @@ struct ValidatedMergeConfig {
   /// agvs.seed + 1.
   AgvsConfig agvs;
   MergeConfig merge;  ///< min_cells and progress (the prefix is chosen here)
-  /// Counts scored, log-spaced from min(16, leaves) to the leaves, factor 1.25.
-  uint32_t score_from = 16;
+  /// Counts scored, log-spaced from min(4, leaves) to the leaves, factor 1.25 (4, 6, 8, 11, 14,
+  /// 18, ...): a small map is cut to a few cells.
+  uint32_t score_from = 4;
   /// A start is taken only when its worst count is at most this (a log ratio) above AV-S's.
   double worst_allowed = 0.01;
   /// Random samples held out as well (drawn as the construction samples are, with their own
