@@ -397,12 +397,18 @@ TEST(Merge, PrefixReplaysTheSubdivisionsOwnCuts) {
   EXPECT_LE(g.cost_with(10), h.cost_with(10) * 1.5);
 }
 
-TEST(Merge, BarrierKeepsGreedyMergesInsideTheSubdivisionsCut) {
-  const Fixture f = office(90);
+/// Greedy merging that stays inside the subdivision's cut at `cells` cells until there.
+MergeConfig barrier_at(const Fixture& f, uint32_t cells) {
   MergeConfig config;
   config.show_progress = false;
-  config.barrier_cells = 12;
-  config.block = subdivision_blocks(f.sub, 12);
+  config.barrier_cells = cells;
+  config.block = subdivision_blocks(f.sub, cells);
+  return config;
+}
+
+TEST(Merge, BarrierKeepsGreedyMergesInsideTheSubdivisionsCut) {
+  const Fixture f = office(90);
+  const MergeConfig config = barrier_at(f, 12);
   const MergeHistory h = merge_cells(f.scene, f.partition, CostModel{}, config);
   // At the barrier the cut is exactly the subdivision's; above it every cell lies in a block.
   EXPECT_EQ(cut_leaves(h, 12), subdivision_cut_leaves(f.sub, 12));
@@ -414,10 +420,7 @@ TEST(Merge, BarrierKeepsGreedyMergesInsideTheSubdivisionsCut) {
 
 TEST(Merge, HistoriesJoinWhereTheirCutsAgree) {
   const Fixture f = office(90);
-  MergeConfig config;
-  config.show_progress = false;
-  config.barrier_cells = 12;
-  config.block = subdivision_blocks(f.sub, 12);
+  MergeConfig config = barrier_at(f, 12);
   const MergeHistory upper = merge_cells(f.scene, f.partition, CostModel{}, config);  // AV-S's cut at 12
   config.barrier_cells = 0;
   config.block.clear();

@@ -88,8 +88,12 @@ void write_curves(const CompareRunResult& r, const std::string& path) {
       csv += line;
       for (uint32_t k = 2; k <= sets; ++k) {
         const CostCurve* more = k - 2 < m.evaluated_more.size() ? &m.evaluated_more[k - 2] : nullptr;
-        std::snprintf(line, sizeof line, ",%.6g", more && has_point(*more, n) ? more->at(n) : 0.0);
-        csv += more && has_point(*more, n) ? std::string(line) : std::string(",");
+        if (more && has_point(*more, n)) {
+          std::snprintf(line, sizeof line, ",%.6g", more->at(n));
+          csv += line;
+        } else {
+          csv += ",";
+        }
       }
       csv += "\n";
     }
