@@ -29,7 +29,6 @@
 #include "bsp/segment_walk.h"
 #include "viewcells/core/default_init.h"
 #include "viewcells/core/error.h"
-#include "viewcells/core/huge_pages.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/core/rng.h"
 
@@ -1424,9 +1423,7 @@ class Builder {
   double total_weight_ = 0;
   bool ga_ = false;
   std::vector<RawVector<SegRef>> refs_;
-  /// Per segment, as segs_; read at random once per part (2 MB pages: about 1.25x faster
-  /// subdivision on one thread of this machine, from fewer TLB misses).
-  std::vector<SegEnds, HugePageAllocator<SegEnds>> ends_;
+  std::vector<SegEnds> ends_;  ///< per segment, as segs_
   std::vector<uint32_t> depth_;              ///< per node
   std::vector<std::vector<uint32_t>> tris_;  ///< BSP baseline: per node, the polygons in it
   double pvs_budget_ = 0;
