@@ -6,8 +6,9 @@
 /// positions of an axis come from each object's lowest and highest extent in the node, which
 /// the pass that divides its parent's parts gathers (then a binary search per object and prefix
 /// sums: O(n + objects log k) per node); geometry-aligned candidates are planes of scene
-/// triangles hit inside the node, a random subset of at most ga_candidates. While a split's
-/// children are evaluated, the next cell's parts are divided ahead; splits keep the serial order.
+/// triangles hit inside the node, a random subset of at most ga_candidates. Splits go in rounds:
+/// the first cells of the queue are divided and their children evaluated in parallel, then the
+/// serial order is replayed (a cell that a new child outranks goes back to the queue).
 /// Deterministic: the same inputs and seed give the same tree for any number of threads.
 #include <cstdint>
 #include <functional>
