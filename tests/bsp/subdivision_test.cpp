@@ -191,6 +191,78 @@ TEST(Subdivision, IdenticalForOneAndTwoThreads) {
   expect_same_for_one_and_two_threads(scene, sample(scene, 15000), 80);
 }
 
+// Splits go in rounds whose children are evaluated before their order is confirmed; where a
+// child outranks a cell taken later in the round, the rest of the round is undone. The tree,
+// and what was evaluated for it, must be the serial loop's (a round of one cell) for any
+// round size, with the stagnation stop falling inside a round too.
+void expect_same_tree(const Subdivision& a, const Subdivision& b) {
+  ASSERT_EQ(a.splits.size(), b.splits.size());
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  ASSERT_EQ(a.planes.size(), b.planes.size());
+  for (size_t k = 0; k < a.splits.size(); ++k) {
+    EXPECT_EQ(a.splits[k].node, b.splits[k].node) << "split " << k;
+    EXPECT_EQ(a.splits[k].cost_after, b.splits[k].cost_after) << "split " << k;
+  }
+  for (size_t p = 0; p < a.planes.size(); ++p) {
+    EXPECT_EQ(a.planes[p].offset, b.planes[p].offset) << "plane " << p;
+    EXPECT_EQ(a.planes[p].axis, b.planes[p].axis) << "plane " << p;
+  }
+  for (size_t n = 0; n < a.nodes.size(); ++n) {
+    EXPECT_EQ(a.nodes[n].plane, b.nodes[n].plane) << "node " << n;
+    EXPECT_EQ(a.nodes[n].pvs_cost, b.nodes[n].pvs_cost) << "node " << n;
+  }
+  for (int32_t leaf : a.leaves()) EXPECT_EQ(a.segments[leaf], b.segments[leaf]) << "leaf " << leaf;
+  EXPECT_EQ(a.stats.axis_candidates, b.stats.axis_candidates);
+  EXPECT_EQ(a.stats.geometry_candidates, b.stats.geometry_candidates);
+  EXPECT_EQ(a.stats.parts_evaluated, b.stats.parts_evaluated);
+  EXPECT_EQ(a.stats.slivers_refused, b.stats.slivers_refused);
+  EXPECT_EQ(a.stats.stop_reason, b.stats.stop_reason);
+}
+
+TEST(Subdivision, TreeDoesNotDependOnTheRoundOfSplits) {
+  struct Case {
+    const char* name;
+    Scene scene;
+    uint64_t samples;
+    uint32_t cells;
+    double min_reduction;
+  };
+  std::vector<Case> cases;
+  // Geometry-aligned candidates on (the new faces must name planes that exist when children
+  // are evaluated), then an office whose stagnation stop ends the run mid-way.
+  cases.push_back({"rotated office", generate_scene({GeneratorKind::kRotatedOffice, 3, 1}), 15000, 300, 0});
+  cases.push_back({"office, stagnation stop", generate_scene({GeneratorKind::kOffice, 1, 2}), 20000, 5000, 2e-4});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const SegmentSet segs = sample(c.scene, c.samples);
+    SubdivisionConfig config;
+    config.max_cells = c.cells;
+    config.min_reduction = c.min_reduction;
+    config.stagnation_steps = 5;
+    config.show_progress = false;
+    config.split_round = 1;
+    const Subdivision serial = subdivide(c.scene, segs, CostModel{}, config);
+    EXPECT_EQ(serial.stats.splits_undone, 0u);
+    uint64_t undone = 0;
+    for (uint32_t round : {2u, 16u, 64u}) {
+      SCOPED_TRACE("round of " + std::to_string(round));
+      config.split_round = round;
+      const Subdivision s = subdivide(c.scene, segs, CostModel{}, config);
+      expect_same_tree(serial, s);
+      undone += s.stats.splits_undone;
+    }
+    EXPECT_GT(undone, 0u) << "no round was undone: the replay is not exercised";
+    if (c.min_reduction > 0) {
+      EXPECT_LT(serial.leaf_count(), c.cells);
+      EXPECT_NE(serial.stats.stop_reason.find("threshold"), std::string::npos) << serial.stats.stop_reason;
+    }
+  }
+  SubdivisionConfig bad;
+  bad.split_round = 0;
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
+  EXPECT_THROW(subdivide(scene, sample(scene, 1000), CostModel{}, bad), Error);
+}
+
 TEST(Subdivision, ViewpointDensityConcentratesCellsInTheBand) {
   // A two-storey office; viewpoints mostly at eye height on the ground floor.
   const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 4});

@@ -255,6 +255,7 @@ std::string report_json(const BuildResult& r) {
                            {"geometry_candidates_evaluated", sub.stats.geometry_candidates},
                            {"segment_parts_evaluated", sub.stats.parts_evaluated},
                            {"sliver_splits_refused", sub.stats.slivers_refused},
+                           {"splits_undone", sub.stats.splits_undone},
                            {"stop_reason", sub.stats.stop_reason}};
   report["final_cost"] = sub.cost();
   if (r.file.history) {

@@ -88,6 +88,9 @@ struct SubdivisionConfig {
   double min_reduction = 1e-6;
   uint32_t stagnation_steps = 50;
   uint64_t seed = 1;
+  /// Cells divided, and their children evaluated, at once (see subdivide()); at least 1. The
+  /// tree does not depend on it: 1 is the serial loop, one split at a time.
+  uint32_t split_round = 16;
   bool show_progress = true;
   HeightBandDensity density;  ///< uniform (p(i) = V_i / V) unless enabled
 };
@@ -116,6 +119,9 @@ struct SubdivisionStats {
   /// lies in every cell it crosses, so this grows faster than the segments).
   uint64_t parts_evaluated = 0;
   uint64_t slivers_refused = 0;      ///< chosen splits left undone: a part would be a sliver
+  /// Cells taken in a round of splits and put back, because a child split off before them in
+  /// the round outranked them (their division and their children's evaluation were redone).
+  uint64_t splits_undone = 0;
   bool geometry_aligned = false;
   std::string geometry_aligned_reason;
   std::string stop_reason;
