@@ -597,7 +597,10 @@ class Builder {
     // stats.splits_undone). What a cell's split and its children's evaluations give depends
     // only on the cell, its id and its plane's id, so the tree is the serial loop's, for any
     // round size and thread count.
-    const size_t round_size = config_.split_round;
+    // Depth-first (KD-VT*) splits the newest cell first, so a child always outranks the next
+    // cell of a round and every round but its first cell would be undone: one cell at a time.
+    const size_t round_size =
+        config_.strategy == SplitStrategy::kKdVisibilityDepthFirst ? 1 : static_cast<size_t>(config_.split_round);
     std::vector<PendingSplit> round;
     out_.stats.stop_reason = "reached the maximum number of cells";
     bool stopped = false;
