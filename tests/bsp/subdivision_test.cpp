@@ -166,35 +166,7 @@ TEST(Subdivision, GeometryAlignedPlanesHelpTheRotatedOffice) {
   expect_invariants(scene, segs, ga);
 }
 
-/// Builds `cells` cells with one and with two threads; both trees must be the same.
-void expect_same_for_one_and_two_threads(const Scene& scene, const SegmentSet& segs, uint32_t cells) {
-  Subdivision one, two;
-  {
-    ThreadLimit t(1);
-    one = build(scene, segs, cells);
-  }
-  {
-    ThreadLimit t(2);
-    two = build(scene, segs, cells);
-  }
-  ASSERT_EQ(one.splits.size(), two.splits.size());
-  for (size_t k = 0; k < one.splits.size(); ++k) {
-    EXPECT_EQ(one.splits[k].node, two.splits[k].node);
-    EXPECT_EQ(one.splits[k].cost_after, two.splits[k].cost_after);
-  }
-  for (size_t p = 0; p < one.planes.size(); ++p) EXPECT_EQ(one.planes[p].offset, two.planes[p].offset);
-  for (int32_t leaf : one.leaves()) EXPECT_EQ(one.segments[leaf], two.segments[leaf]);
-}
-
-TEST(Subdivision, IdenticalForOneAndTwoThreads) {
-  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 3, 1});
-  expect_same_for_one_and_two_threads(scene, sample(scene, 15000), 80);
-}
-
-// Splits go in rounds whose children are evaluated before their order is confirmed; where a
-// child outranks a cell taken later in the round, the rest of the round is undone. The tree,
-// and what was evaluated for it, must be the serial loop's (a round of one cell) for any
-// round size, with the stagnation stop falling inside a round too.
+/// The same tree: splits, planes, nodes, leaf segments and what was evaluated for them.
 void expect_same_tree(const Subdivision& a, const Subdivision& b) {
   ASSERT_EQ(a.splits.size(), b.splits.size());
   ASSERT_EQ(a.nodes.size(), b.nodes.size());
@@ -219,6 +191,29 @@ void expect_same_tree(const Subdivision& a, const Subdivision& b) {
   EXPECT_EQ(a.stats.stop_reason, b.stats.stop_reason);
 }
 
+/// Builds `cells` cells with one and with two threads; both trees must be the same.
+void expect_same_for_one_and_two_threads(const Scene& scene, const SegmentSet& segs, uint32_t cells) {
+  Subdivision one, two;
+  {
+    ThreadLimit t(1);
+    one = build(scene, segs, cells);
+  }
+  {
+    ThreadLimit t(2);
+    two = build(scene, segs, cells);
+  }
+  expect_same_tree(one, two);
+}
+
+TEST(Subdivision, IdenticalForOneAndTwoThreads) {
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 3, 1});
+  expect_same_for_one_and_two_threads(scene, sample(scene, 15000), 80);
+}
+
+// Splits go in rounds whose children are evaluated before their order is confirmed; where a
+// child outranks a cell taken later in the round, the rest of the round is undone. The tree,
+// and what was evaluated for it, must be the serial loop's (a round of one cell) for any
+// round size, with the stagnation stop falling inside a round too.
 TEST(Subdivision, TreeDoesNotDependOnTheRoundOfSplits) {
   struct Case {
     const char* name;

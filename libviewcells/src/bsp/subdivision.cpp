@@ -582,7 +582,9 @@ class Builder {
     std::priority_queue<Entry, std::vector<Entry>, decltype(lower)> queue(lower);
     best_.resize(1);
     if (gathers_extents()) pending_ext_.push_back(std::make_unique<NodeExtents>(node_extents(refs_[0])));
-    evaluate_into(0);
+    const Evaluation first = evaluate(0);
+    best_[0] = first.best;
+    count_evaluation(0, first);
     if (best_[0].valid) queue.push({priority(0), 0});
 
     Progress progress("subdividing", config_.max_cells);
@@ -663,12 +665,7 @@ class Builder {
         const double before = node_cost(p.node);
         commit_split(p, static_cast<int32_t>(next_child));
         const int32_t c0 = static_cast<int32_t>(next_child), c1 = c0 + 1;
-        for (int32_t c : {c0, c1}) {
-          const Evaluation& e = evaluations[static_cast<size_t>(c) - first_child];
-          axis_evaluated_ += e.axis;
-          parts_evaluated_ += refs_[c].size();
-          geometry_evaluated_ += e.geometry;
-        }
+        for (int32_t c : {c0, c1}) count_evaluation(c, evaluations[static_cast<size_t>(c) - first_child]);
         next_child += 2;
         const double after = node_cost(c0) + node_cost(c1);
         cost += after - before;
@@ -957,9 +954,9 @@ class Builder {
     if (tris_.size() > n) tris_.resize(n);
   }
 
-  void evaluate_into(int32_t node) {
-    const Evaluation e = evaluate(node);
-    best_[node] = e.best;
+  /// Adds what evaluating a node of the tree took to the statistics (counted once the node is
+  /// in the tree: evaluations of a round's undone children are not).
+  void count_evaluation(int32_t node, const Evaluation& e) {
     axis_evaluated_ += e.axis;
     parts_evaluated_ += refs_[node].size();
     geometry_evaluated_ += e.geometry;
