@@ -18,7 +18,7 @@ namespace {
 struct AgvsOptions {
   double pixel_error = 0, seconds = 0;
   uint64_t samples = 0, seed = 1;
-  uint32_t batch = 20000;
+  uint32_t batch = 20000, lanes = 1;
   double min_share = 0.25;
   std::string method = "agvs";
 
@@ -27,6 +27,7 @@ struct AgvsOptions {
     a.method = parse_agvs_method(method);
     a.seed = seed;
     a.batch_size = batch;
+    a.mutation_lanes = lanes;
     a.min_share = min_share;
     a.max_samples = samples;
     a.max_seconds = seconds;
@@ -48,6 +49,13 @@ void add_agvs_options(CLI::App* cmd, AgvsOptions& a, bool with_method, const std
     cmd->add_option("--method", a.method, "agvs (adaptive mixture), sgvs (view space-direction only) or ref (per cell)")
         ->capture_default_str();
   cmd->add_option("--batch", a.batch, "Samples per batch")->capture_default_str()->check(whole(1, 100'000'000));
+  cmd->add_option("--mutation-lanes", a.lanes,
+                  "AGVS: independent lanes of mutation candidates, each with its own random stream and its share of "
+                  "the buffer. Lanes are drawn and fed in parallel, on a cluster each by its own rank: give at least "
+                  "as many as the cores of all nodes for a bake that scales. The result depends on it, not on the "
+                  "threads or ranks")
+      ->capture_default_str()
+      ->check(whole(1, 65536));
   cmd->add_option("--min-share", a.min_share,
                   "AGVS: share of every batch kept for view space-direction samples whatever their weight; they are "
                   "the pixel error estimator's camera rays (more: a finer estimate, fewer samples for the mutations)")

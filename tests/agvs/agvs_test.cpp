@@ -257,21 +257,29 @@ TEST(Agvs, IdenticalForOneAndTwoThreads) {
   const Scene scene = generate_scene({GeneratorKind::kOffice, 2, 4});
   const CellLocator cells = office_cells(scene, 30);
   const auto caster = make_embree_caster(scene);
-  for (AgvsMethod m : {AgvsMethod::kAgvs, AgvsMethod::kSgvs, AgvsMethod::kRef}) {
+  // AGVS also with mutation lanes, which draw and take their candidates in parallel.
+  for (const auto& [m, lanes] : {std::pair{AgvsMethod::kAgvs, 1u}, std::pair{AgvsMethod::kAgvs, 7u},
+                                 std::pair{AgvsMethod::kSgvs, 1u}, std::pair{AgvsMethod::kRef, 1u}}) {
+    AgvsConfig config = quiet(m, 30000);
+    config.mutation_lanes = lanes;
     GlobalPvs one, two;
+    uint64_t rays[2] = {};
     {
       ThreadLimit limit(1);
-      AgvsSolver s(scene, *caster, cells, quiet(m, 30000));
+      AgvsSolver s(scene, *caster, cells, config);
       s.run();
       one = s.pvs();
+      rays[0] = s.stats().rays;
     }
     {
       ThreadLimit limit(2);
-      AgvsSolver s(scene, *caster, cells, quiet(m, 30000));
+      AgvsSolver s(scene, *caster, cells, config);
       s.run();
       two = s.pvs();
+      rays[1] = s.stats().rays;
     }
-    EXPECT_TRUE(one == two) << to_string(m);
+    EXPECT_TRUE(one == two) << to_string(m) << ", " << lanes << " lanes";
+    EXPECT_EQ(rays[0], rays[1]) << to_string(m) << ", " << lanes << " lanes";
     EXPECT_GT(one.entries(), 0u);
   }
 }
@@ -398,6 +406,49 @@ TEST(Agvs, SavedStateResumesExactly) {
   EXPECT_THROW(second.load(path, 42), Error);
 }
 
+/// Mutation lanes: every lane is fed and drawn from (the mutations keep their share of the
+/// samples), a state resumes exactly with its lanes, and a state of other lanes is refused.
+TEST(Agvs, MutationLanesAreFedDrawnAndResumed) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 2, 5});
+  const CellLocator cells = office_cells(scene, 30);
+  const auto caster = make_embree_caster(scene);
+  const std::string path = test::temp_path("lanes.vagvs");
+  auto config = [](uint32_t lanes, uint64_t samples) {
+    AgvsConfig c = quiet(AgvsMethod::kAgvs, samples);
+    c.mutation_lanes = lanes;
+    c.mutation_buffer = 700;  // 100 a lane: some lanes fill and drop their most mutated
+    return c;
+  };
+  AgvsSolver whole(scene, *caster, cells, config(7, 40000));
+  whole.run();
+  const AgvsStats& st = whole.stats();
+  EXPECT_LE(st.mutation_candidates, 700u) << "each lane keeps at most its 100";
+  EXPECT_GT(st.mutation_candidates, 600u) << "lanes are fed evenly: most are full";
+  AgvsSolver single(scene, *caster, cells, config(1, 40000));
+  single.run();
+  for (const int d : {static_cast<int>(AgvsDistribution::kTwoPointMutation),
+                      static_cast<int>(AgvsDistribution::kSilhouetteMutation)}) {
+    // The mutations get samples with lanes as without (the mixture's weights decide; a lane
+    // without candidates would hand its share to the view space-direction samples).
+    EXPECT_GT(st.dist_samples[d], 0u) << to_string(AgvsDistribution(d));
+    EXPECT_GT(double(st.dist_samples[d]), 0.5 * double(single.stats().dist_samples[d]))
+        << to_string(AgvsDistribution(d));
+  }
+  {
+    AgvsSolver first(scene, *caster, cells, config(7, 20000));
+    first.run();
+    first.save(path, 42);
+  }
+  AgvsSolver other(scene, *caster, cells, config(3, 40000));
+  EXPECT_THROW(other.load(path, 42), Error) << "another number of lanes";
+  AgvsSolver second(scene, *caster, cells, config(7, 40000));
+  second.load(path, 42);
+  second.run();
+  EXPECT_TRUE(second.pvs() == whole.pvs()) << "resuming continues exactly where the run stopped";
+  EXPECT_EQ(second.stats().rays, whole.stats().rays);
+  EXPECT_EQ(second.stats().mutation_candidates, st.mutation_candidates);
+}
+
 TEST(Agvs, BadInput) {
   const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
   const CellLocator cells = office_cells(scene, 8);
@@ -408,6 +459,12 @@ TEST(Agvs, BadInput) {
   AgvsConfig bad = quiet(AgvsMethod::kAgvs, 10);
   bad.window_p = 1.5;
   EXPECT_THROW(AgvsSolver(scene, *caster, cells, bad), Error);
+  for (uint32_t lanes : {0u, 100u}) {
+    AgvsConfig c = quiet(AgvsMethod::kAgvs, 10);
+    c.mutation_buffer = 50;
+    c.mutation_lanes = lanes;
+    EXPECT_THROW(AgvsSolver(scene, *caster, cells, c), Error) << lanes << " lanes";
+  }
 }
 
 /// A copy of the scene with a closed, outward box appended as a new object.

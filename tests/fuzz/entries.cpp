@@ -145,7 +145,7 @@ void entry_pvs(const uint8_t* data, size_t size) {
 }
 void entry_vagvs(const uint8_t* data, size_t size) {
   AgvsFixture& f = agvs_fixture();
-  const std::string path = container_file(data, size, "VAGS", 3, ".vagvs");
+  const std::string path = container_file(data, size, "VAGS", 4, ".vagvs");
   expecting_errors([&] {
     AgvsSolver solver(f.scene, *f.caster, f.cells, f.config);
     solver.load(path, kIdentity);

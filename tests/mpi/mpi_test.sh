@@ -53,8 +53,9 @@ for n in 1 2 3; do
     -o "c$n" || bad "compare on $n ranks"
   for f in c0/*.csv; do same_files "compare, $n ranks" "$f" "c$n/$(basename "$f")"; done
 done
-# REF and SGVS, and the visibility filter's densities (partitioned with the cells, then combined).
-for extra in "--method ref" "--method sgvs" "--filter"; do
+# REF and SGVS, the visibility filter's densities (partitioned with the cells, then combined), and
+# AGVS's mutation lanes (each drawn and fed by its own rank, combined at the end).
+for extra in "--method ref" "--method sgvs" "--filter" "--mutation-lanes 5"; do
   # shellcheck disable=SC2086
   "$VC" -q pvs office.vcells --scene office.obj --cells 12 --samples 30000 --batch 5000 $extra -o x0.pvs || bad "pvs $extra"
   # shellcheck disable=SC2086
@@ -65,8 +66,11 @@ done
 [ "$(jq -r .cluster.ranks s3.json)" = 3 ] && [ "$(jq -r .cluster.bytes_received s3.json)" -gt 0 ] && ok ||
   bad "the report of 3 ranks does not say what they exchanged: $(jq -c .cluster s3.json)"
 
-# A rank killed in the middle of a checkpointing run.
-ranks 2 -q pvs office.vcells --scene office.obj --cells 12 --samples 3000000 --batch 5000 --save state.vagvs \
+# A rank killed in the middle of a checkpointing run (with mutation lanes: the checkpoint holds
+# every rank's).
+lanes="--mutation-lanes 5"
+# shellcheck disable=SC2086
+ranks 2 -q pvs office.vcells --scene office.obj --cells 12 --samples 3000000 --batch 5000 $lanes --save state.vagvs \
   --save-every 0.2 -o killed.pvs >/dev/null 2>killed.err &
 run=$!
 for _ in $(seq 600); do [ -s state.vagvs ] && break; sleep 0.1; done
@@ -79,14 +83,18 @@ rc=$?
 [ ! -e killed.pvs ] && ok || bad "the run with a killed rank wrote its output"
 grep -q "killed\|signal 9" killed.err && ok || bad "mpirun did not say a rank was killed: $(head -c 300 killed.err)"
 # The checkpoint was taken in the middle of the run.
-saved=$("$VC" pvs office.vcells --scene office.obj --cells 12 --samples 1 --batch 5000 \
+# shellcheck disable=SC2086
+saved=$("$VC" pvs office.vcells --scene office.obj --cells 12 --samples 1 --batch 5000 $lanes \
           --resume state.vagvs -o probe.pvs --report probe.json -q && jq -r .samples probe.json)
 [ "${saved:-0}" -gt 0 ] && [ "${saved:-0}" -lt 3000000 ] && ok || bad "the checkpoint holds ${saved:-?} samples"
 echo "mpi_test: killed a rank; the checkpoint held $saved of 3,000,000 samples"
 cp state.vagvs state-copy.vagvs
-ranks 3 -q pvs office.vcells --scene office.obj --cells 12 --samples 3000000 --batch 5000 --resume state-copy.vagvs \
-  -o resumed.pvs || bad "resume on 3 ranks"
-"$VC" -q pvs office.vcells --scene office.obj --cells 12 --samples 3000000 --batch 5000 -o full.pvs || bad "full run"
+# shellcheck disable=SC2086
+ranks 3 -q pvs office.vcells --scene office.obj --cells 12 --samples 3000000 --batch 5000 $lanes \
+  --resume state-copy.vagvs -o resumed.pvs || bad "resume on 3 ranks"
+# shellcheck disable=SC2086
+"$VC" -q pvs office.vcells --scene office.obj --cells 12 --samples 3000000 --batch 5000 $lanes -o full.pvs ||
+  bad "full run"
 same_files "resumed on 3 ranks after a kill" full.pvs resumed.pvs
 
 echo "mpi_test: $passed passed, $failed failed"

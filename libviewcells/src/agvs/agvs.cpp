@@ -40,6 +40,10 @@ const char* to_string(AgvsDistribution d) {
 
 AgvsSolver::AgvsSolver(const Scene& scene, const RayCaster& caster, const CellLocator& cells, const AgvsConfig& config) {
   if (config.batch_size == 0) throw Error("the batch size must be positive");
+  if (config.mutation_lanes == 0 || config.mutation_lanes > kMaxMutationLanes ||
+      config.mutation_lanes > config.mutation_buffer)
+    throw Error("the mutation lanes must be between 1 and " + std::to_string(kMaxMutationLanes) +
+                ", and at most the mutation buffer's size");
   if (!(config.min_share >= 0 && config.min_share <= 1)) throw Error("the minimum share must be within [0, 1]");
   if (!(config.window_p > 0 && config.window_p < 1) || !(config.window_k > 0))
     throw Error("the pixel error window needs 0 < P < 1 and k > 0");

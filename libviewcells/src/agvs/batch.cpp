@@ -39,6 +39,13 @@ struct SilhouetteJob {
 struct AgvsSolver::Impl::BatchSamples {
   std::vector<Vec3> points, dirs;
   std::vector<int32_t> ref_cell;  ///< REF: the cell each sample belongs to
+  /// The mutation samples' runs by lane: distribution, lane, first sample, count. Only the
+  /// lane's owner (a rank) knows their points.
+  struct LaneRange {
+    int dist;
+    uint32_t lane, first, size;
+  };
+  std::vector<LaneRange> lane_ranges;
   uint32_t first_of[kDists] = {}, end_of[kDists] = {};
   uint64_t discovery_rays = 0;  ///< the silhouette searches' rays
 };
@@ -47,6 +54,7 @@ struct AgvsSolver::Impl::BatchSamples {
 struct AgvsSolver::Impl::BatchChunk {
   uint32_t first = 0, size = 0;
   int dist = 0;
+  int32_t lane = -1;  ///< the mutation lane whose samples these are (-1: a stationary distribution's)
   SegmentSet segs;
   std::vector<uint32_t> sample_of;
   std::vector<std::vector<int32_t>> pierced;  ///< per segment: the cells it has length in (not for REF)
@@ -54,69 +62,148 @@ struct AgvsSolver::Impl::BatchChunk {
   size_t seg_start = 0;  ///< index of its first segment among the batch's
 };
 
+namespace {
+/// Lane l's share of n draws.
+uint32_t lane_share(uint32_t n, size_t lanes, size_t l) {
+  return static_cast<uint32_t>(n / lanes + (l < n % lanes ? 1 : 0));
+}
+/// Lane l's random stream in batch `index`: lane 0's is the batch's own (one lane draws as the
+/// single buffer did).
+uint64_t lane_stream(uint64_t index, size_t l) { return 1000 + index + (static_cast<uint64_t>(l) << 40); }
+}  // namespace
+
+uint32_t AgvsSolver::Impl::draw_mutations(uint64_t index, const uint32_t want[kDists], BatchSamples& s) {
+  // Each of this rank's lanes takes its candidates and random numbers in order; the silhouette
+  // searches then run in parallel over all of them.
+  struct LaneDraw {
+    std::vector<SilhouetteJob> sil;
+    std::vector<Vec3> sil_points, sil_dirs, tpm_points, tpm_dirs;
+    uint32_t sil_failed = 0, tpm_failed = 0;
+    uint64_t sil_rays = 0;
+  };
+  const size_t n_lanes = lanes.size();
+  std::vector<LaneDraw> draws(n_lanes);
+  tbb::parallel_for(size_t{0}, n_lanes, [&](size_t l) {
+    if (!cluster::mine(l)) return;
+    LaneDraw& ld = draws[l];
+    MutationLane& lane = lanes[l];
+    Rng rng(config.seed, lane_stream(index, l));
+    for (uint32_t k = lane_share(want[kSil], n_lanes, l); k > 0; --k) {
+      if (lane.silhouette.empty()) {
+        ++ld.sil_failed;
+        continue;
+      }
+      SilhouetteJob job;
+      job.candidate = lane.silhouette.take();
+      job.u[0] = rng.uniform(), job.u[1] = rng.uniform();
+      ld.sil.push_back(job);
+    }
+    for (uint32_t k = lane_share(want[kTpm], n_lanes, l); k > 0; --k) {
+      Vec3 p, dir;
+      if (!draw_two_point_mutation(rng, lane, p, dir)) {
+        ++ld.tpm_failed;
+        continue;
+      }
+      ld.tpm_points.push_back(p);
+      ld.tpm_dirs.push_back(dir);
+    }
+  });
+  std::vector<std::pair<uint32_t, uint32_t>> jobs;  // (lane, job)
+  for (size_t l = 0; l < n_lanes; ++l)
+    for (size_t j = 0; j < draws[l].sil.size(); ++j) jobs.push_back({static_cast<uint32_t>(l), static_cast<uint32_t>(j)});
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, jobs.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t j = r.begin(); j < r.end(); ++j) {
+      SilhouetteJob& job = draws[jobs[j].first].sil[jobs[j].second];
+      job.n = silhouette_samples(job.candidate, job.u, job.points, job.dirs, job.rays);
+    }
+  });
+  for (LaneDraw& ld : draws)
+    for (const SilhouetteJob& job : ld.sil) {
+      ld.sil_rays += job.rays;
+      if (job.n == 0) ++ld.sil_failed;
+      for (int j = 0; j < job.n; ++j) {
+        ld.sil_points.push_back(job.points[j]);
+        ld.sil_dirs.push_back(job.dirs[j]);
+      }
+    }
+  // What every lane drew, on every rank: its samples' count (the points are only its owner's:
+  // nothing but casting reads a mutation sample's point), failures and discovery rays.
+  std::vector<std::array<uint64_t, 5>> drawn(n_lanes);
+  for (size_t l = 0; l < n_lanes; ++l) {
+    const LaneDraw& ld = draws[l];
+    drawn[l] = {ld.sil_points.size(), ld.sil_failed, ld.sil_rays, ld.tpm_points.size(), ld.tpm_failed};
+  }
+  if (cluster::size() > 1) {
+    std::vector<std::string> items(n_lanes);
+    for (size_t l = 0; l < n_lanes; ++l)
+      if (cluster::mine(l)) {
+        ByteWriter w;
+        w.put(drawn[l]);
+        items[l] = w.take();
+      }
+    cluster::share(items);
+    for (size_t l = 0; l < n_lanes; ++l) {
+      ByteReader r(items[l], "a rank's mutation draws");
+      drawn[l] = r.get<std::array<uint64_t, 5>>();
+      if (drawn[l][0] > 2 * want[kSil] || drawn[l][3] > want[kTpm]) r.fail("more mutation samples than wanted");
+    }
+  }
+  uint32_t failed = 0;
+  auto append = [&](int d, int count_at, auto points_of, auto dirs_of) {
+    s.first_of[d] = static_cast<uint32_t>(s.points.size());
+    for (size_t l = 0; l < n_lanes; ++l) {
+      const uint32_t first = static_cast<uint32_t>(s.points.size()), n = static_cast<uint32_t>(drawn[l][count_at]);
+      if (n == 0) continue;
+      s.lane_ranges.push_back({d, static_cast<uint32_t>(l), first, n});
+      if (cluster::mine(l)) {
+        s.points.insert(s.points.end(), points_of(draws[l]).begin(), points_of(draws[l]).end());
+        s.dirs.insert(s.dirs.end(), dirs_of(draws[l]).begin(), dirs_of(draws[l]).end());
+      } else {
+        s.points.resize(first + n);
+        s.dirs.resize(first + n);
+      }
+    }
+    s.end_of[d] = static_cast<uint32_t>(s.points.size());
+  };
+  append(kSil, 0, [](LaneDraw& d) -> auto& { return d.sil_points; }, [](LaneDraw& d) -> auto& { return d.sil_dirs; });
+  append(kTpm, 3, [](LaneDraw& d) -> auto& { return d.tpm_points; }, [](LaneDraw& d) -> auto& { return d.tpm_dirs; });
+  for (const auto& d : drawn) {
+    failed += static_cast<uint32_t>(d[1] + d[4]);
+    s.discovery_rays += d[2];
+  }
+  return failed;
+}
+
 void AgvsSolver::Impl::draw_samples(uint64_t index, uint32_t n, const double share[kDists], BatchSamples& s) {
-  Rng rng(config.seed, 1000 + index);
   uint32_t want[kDists];
   uint32_t assigned = 0;
   for (int d = 0; d < kDists; ++d) assigned += want[d] = static_cast<uint32_t>(std::floor(share[d] * n));
   want[kVsd] += n - assigned;  // what rounding left over
-  uint32_t failed = 0;
-  std::vector<SilhouetteJob> sil_jobs;
-  for (int d : kOrder) {
-    s.first_of[d] = static_cast<uint32_t>(s.points.size());
-    const uint32_t target = want[d] + (d == kVsd ? failed : 0);
-    if (config.method != AgvsMethod::kRef && (d == kOd || d == kTp || d == kVsd)) {
-      // Quasi-random, from Halton indices alone: computed in parallel, taken in order.
-      failed += stationary_samples(d, target, s.points, s.dirs);
-      s.end_of[d] = static_cast<uint32_t>(s.points.size());
-      continue;
-    }
-    for (uint32_t k = 0; k < target; ++k) {
-      Vec3 p, dir;
-      if (config.method == AgvsMethod::kRef) {
-        // A random cell, a uniform point in it (rejection in its bounds), a random direction.
-        const uint32_t c = static_cast<uint32_t>(rng.below(cells.cell_count()));
-        const Box3& b = cells.cell_bounds(c);
-        for (int tries = 0; tries < 1000; ++tries) {
-          p = {rng.uniform(b.lo.x, b.hi.x), rng.uniform(b.lo.y, b.hi.y), rng.uniform(b.lo.z, b.hi.z)};
-          if (cells.cell_at(p) == static_cast<int32_t>(c) && (!config.view_space || config.view_space(p))) break;
-        }
-        dir = sphere_direction(rng.uniform(), rng.uniform());
-        s.ref_cell.push_back(static_cast<int32_t>(c));
-      } else if (d == kSil) {
-        // Candidates and random numbers drawn here, in order; the searches run below.
-        if (silhouette.empty()) {
-          ++failed;
-          continue;
-        }
-        SilhouetteJob job;
-        job.candidate = silhouette.take();
-        job.u[0] = rng.uniform(), job.u[1] = rng.uniform();
-        sil_jobs.push_back(job);
-        continue;
-      } else if (!draw_two_point_mutation(rng, p, dir)) {  // d == kTpm
-        ++failed;
-        continue;
+  if (config.method == AgvsMethod::kRef) {
+    // All view space-direction (shares()): a random cell, a uniform point in it (rejection in
+    // its bounds), a random direction.
+    Rng rng(config.seed, 1000 + index);
+    for (uint32_t k = 0; k < n; ++k) {
+      Vec3 p;
+      const uint32_t c = static_cast<uint32_t>(rng.below(cells.cell_count()));
+      const Box3& b = cells.cell_bounds(c);
+      for (int tries = 0; tries < 1000; ++tries) {
+        p = {rng.uniform(b.lo.x, b.hi.x), rng.uniform(b.lo.y, b.hi.y), rng.uniform(b.lo.z, b.hi.z)};
+        if (cells.cell_at(p) == static_cast<int32_t>(c) && (!config.view_space || config.view_space(p))) break;
       }
       s.points.push_back(p);
-      s.dirs.push_back(dir);
+      s.dirs.push_back(sphere_direction(rng.uniform(), rng.uniform()));
+      s.ref_cell.push_back(static_cast<int32_t>(c));
     }
-    if (d == kSil && !sil_jobs.empty()) {
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, sil_jobs.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t j = r.begin(); j < r.end(); ++j) {
-          SilhouetteJob& job = sil_jobs[j];
-          job.n = silhouette_samples(job.candidate, job.u, job.points, job.dirs, job.rays);
-        }
-      });
-      for (const SilhouetteJob& job : sil_jobs) {
-        s.discovery_rays += job.rays;
-        if (job.n == 0) ++failed;
-        for (int j = 0; j < job.n; ++j) {
-          s.points.push_back(job.points[j]);
-          s.dirs.push_back(job.dirs[j]);
-        }
-      }
-    }
+    s.end_of[kVsd] = n;
+    return;
+  }
+  uint32_t failed = draw_mutations(index, want, s);
+  // Quasi-random, from Halton indices alone: computed in parallel, taken in order.
+  for (int d : kOrder) {
+    if (d == kSil || d == kTpm) continue;
+    s.first_of[d] = static_cast<uint32_t>(s.points.size());
+    failed += stationary_samples(d, want[d] + (d == kVsd ? failed : 0), s.points, s.dirs);
     s.end_of[d] = static_cast<uint32_t>(s.points.size());
   }
 }
@@ -149,14 +236,21 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
   // Cast in fixed chunks within each distribution, in parallel; outputs in sample order.
   constexpr uint32_t kChunk = 1024;
   std::vector<BatchChunk> chunks;
-  for (int d : kOrder)
-    for (uint32_t f = s.first_of[d]; f < s.end_of[d]; f += kChunk) {
+  auto add_chunks = [&](int d, uint32_t first, uint32_t end, int32_t lane) {
+    for (uint32_t f = first; f < end; f += kChunk) {
       BatchChunk c;
       c.first = f;
-      c.size = std::min(kChunk, s.end_of[d] - f);
+      c.size = std::min(kChunk, end - f);
       c.dist = d;
+      c.lane = lane;
       chunks.push_back(std::move(c));
     }
+  };
+  for (int d : kOrder)
+    if (d != kSil && d != kTpm) add_chunks(d, s.first_of[d], s.end_of[d], -1);
+    else
+      for (const BatchSamples::LaneRange& r : s.lane_ranges)
+        if (r.dist == d) add_chunks(d, r.first, r.first + r.size, static_cast<int32_t>(r.lane));
   // A chunk: its samples cast, and the cells of each segment.
   auto cast_chunk = [&](BatchChunk& c) {
     if (config.method == AgvsMethod::kRef) {
@@ -172,11 +266,16 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
   if (cluster::size() > 1) {
     // Several ranks: each casts the chunks it owns (numbered across batches, so that the work
     // turns round the ranks; a chunk's owner may differ between rank counts, its content does
-    // not), and every rank receives all chunks.
+    // not), and every rank receives all chunks. A mutation lane's chunks are its owner's, the
+    // only rank that drew their points.
     std::vector<std::string> items(chunks.size());
     const uint64_t base = stats.batches * 4096;
+    const uint64_t ranks = static_cast<uint64_t>(cluster::size());
+    auto owner = [&](size_t k) {
+      return static_cast<int>((chunks[k].lane >= 0 ? static_cast<uint64_t>(chunks[k].lane) : base + k) % ranks);
+    };
     tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
-      if (!cluster::mine(base + k)) return;
+      if (owner(k) != cluster::rank()) return;
       BatchChunk& c = chunks[k];
       cast_chunk(c);
       ByteWriter w;
@@ -186,7 +285,7 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
       for (const auto& p : c.pierced) w.put_array(p);
       items[k] = w.take();
     });
-    cluster::share(items, base);
+    cluster::share(items, owner);
     for (size_t k = 0; k < chunks.size(); ++k) {
       BatchChunk& c = chunks[k];
       ByteReader r(items[k], "a rank's casting results");
@@ -361,7 +460,7 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
         counts.camera_rays[sample] = 2;
         counts.wrong_rays[sample] = static_cast<uint8_t>(((flags[k] >> 2) & 1) + ((flags[k] >> 3) & 1));
       }
-      if (mutations && gains[k] > 0)
+      if (mutations && gains[k] > 0 && cluster::mine(sample % lanes.size()))  // its lane's owner feeds it
         radius[k] = {end_radius(c.segs.object_a[i], c.segs.a(i)), end_radius(c.segs.object_b[i], c.segs.b(i))};
     }
   });
@@ -369,24 +468,71 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
     counts.rays[chunks[ci].dist] += chunks[ci].rays;
     counts.contribution[chunks[ci].dist] += chunk_contribution[ci];
   }
-  if (mutations) {
-    for (const BatchChunk& c : chunks)
-      for (size_t i = 0; i < c.segs.size(); ++i) {
-        const size_t k = c.seg_start + i;
-        if (gains[k] == 0) continue;
-        // A mutation candidate per end whose object contributed.
-        const Vec3 ends[2] = {c.segs.a(i), c.segs.b(i)};
-        const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
-        for (int e = 0; e < 2; ++e)
-          if ((flags[k] >> e) & 1) add_candidate({ends[1 - e], ends[e], radius[k][1 - e], radius[k][e], objs[e]});
-      }
-  }
+  if (mutations) add_candidates(chunks, gains, flags, radius);
   if (cluster::size() == 1) return;
   // The table's size over all ranks' rows (for the mean PVS of the curve and the status).
   partitioned = true;
   std::vector<uint64_t> grown{pvs.entries() - synced_entries};
   cluster::sum(grown);
   global_entries = synced_entries + grown[0];
+}
+
+void AgvsSolver::Impl::add_candidates(const std::vector<BatchChunk>& chunks, const std::vector<uint32_t>& gains,
+                                      const std::vector<uint8_t>& flags,
+                                      const std::vector<std::array<double, 2>>& radius) {
+  // A mutation candidate per end whose object contributed, into the lane of its sample (index
+  // in the batch modulo the lanes). The contributing segments are sorted by lane (a counting
+  // sort: per chunk and lane, then by offsets), keeping sample order within each lane; then
+  // each lane takes its own in parallel. Every rank counts every lane's candidates.
+  const size_t n_lanes = lanes.size(), n_chunks = chunks.size();
+  auto lane_of = [&](const BatchChunk& c, size_t i) { return (c.first + c.sample_of[i]) % n_lanes; };
+  std::vector<uint32_t> per(n_chunks * n_lanes, 0);  // [chunk][lane]: contributing segments
+  tbb::parallel_for(size_t{0}, n_chunks, [&](size_t ci) {
+    const BatchChunk& c = chunks[ci];
+    for (size_t i = 0; i < c.segs.size(); ++i)
+      if (flags[c.seg_start + i] & 3) ++per[ci * n_lanes + lane_of(c, i)];
+  });
+  std::vector<size_t> start(n_lanes + 1, 0);
+  for (size_t l = 0; l < n_lanes; ++l) {
+    start[l + 1] = start[l];
+    for (size_t ci = 0; ci < n_chunks; ++ci) {
+      const uint32_t n = per[ci * n_lanes + l];
+      per[ci * n_lanes + l] = static_cast<uint32_t>(start[l + 1]);  // now: where the chunk's go
+      start[l + 1] += n;
+    }
+  }
+  std::vector<uint32_t> order(start[n_lanes]);  // segments, by lane, in sample order
+  tbb::parallel_for(size_t{0}, n_chunks, [&](size_t ci) {
+    const BatchChunk& c = chunks[ci];
+    for (size_t i = 0; i < c.segs.size(); ++i)
+      if (flags[c.seg_start + i] & 3) order[per[ci * n_lanes + lane_of(c, i)]++] = static_cast<uint32_t>(c.seg_start + i);
+  });
+  // Segment k's chunk: the last one starting at or before it.
+  auto chunk_of = [&](size_t k) {
+    return std::prev(std::upper_bound(chunks.begin(), chunks.end(), k,
+                                      [](size_t x, const BatchChunk& c) { return x < c.seg_start; }));
+  };
+  tbb::parallel_for(size_t{0}, n_lanes, [&](size_t l) {
+    MutationLane& lane = lanes[l];
+    uint64_t added = 0;
+    const bool own = cluster::mine(l);
+    for (size_t at = start[l]; at < start[l + 1]; ++at) {
+      const size_t k = order[at];
+      const BatchChunk& c = *chunk_of(k);
+      const size_t i = k - c.seg_start;
+      const Vec3 ends[2] = {c.segs.a(i), c.segs.b(i)};
+      const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
+      for (int e = 0; e < 2; ++e) {
+        if (!((flags[k] >> e) & 1)) continue;
+        ++added;
+        if (!own) continue;
+        const Candidate cand{ends[1 - e], ends[e], radius[k][1 - e], radius[k][e], objs[e]};
+        lane.two_point.add(cand, lane_capacity);
+        lane.silhouette.add(cand, lane_capacity);
+      }
+    }
+    lane.count = std::min<uint64_t>(lane_capacity, lane.count + added);
+  });
 }
 
 void AgvsSolver::Impl::sync() {
@@ -409,6 +555,20 @@ void AgvsSolver::Impl::sync() {
     cluster::sum(cell_samples);
     cluster::sum(hit_counts);
   }
+  // The mutation lanes, each from its owner.
+  std::vector<std::string> items(lanes.size());
+  for (size_t l = 0; l < lanes.size(); ++l)
+    if (cluster::mine(l)) {
+      ByteWriter w;
+      save_lane(w, lanes[l]);
+      items[l] = w.take();
+    }
+  cluster::share(items);
+  for (size_t l = 0; l < lanes.size(); ++l)
+    if (!cluster::mine(l)) {
+      ByteReader r(items[l], "a rank's mutation candidates");
+      lanes[l] = load_lane(r, items[l].size());
+    }
   synced_entries = global_entries = pvs.entries();
   partitioned = false;
 }
@@ -452,7 +612,7 @@ void AgvsSolver::Impl::batch(uint64_t index, uint32_t n) {
   update_weights(share, samples_of, counts.contribution, counts.rays);
   stats.samples += count;
   stats.batches += 1;
-  stats.mutation_candidates = two_point.size();
+  stats.mutation_candidates = mutation_candidates();
   stats.camera_rays += vsd_rays;
   stats.wrong_camera_rays += vsd_contributing;
   update_estimate(vsd_rays, vsd_contributing);

@@ -160,9 +160,9 @@ uint32_t AgvsSolver::Impl::stationary_samples(int d, uint32_t attempts, std::vec
   return failed;
 }
 
-bool AgvsSolver::Impl::draw_two_point_mutation(Rng& rng, Vec3& point, Vec3& dir) {
-  if (two_point.empty()) return false;
-  const Candidate& c = two_point.take();
+bool AgvsSolver::Impl::draw_two_point_mutation(Rng& rng, MutationLane& lane, Vec3& point, Vec3& dir) {
+  if (lane.two_point.empty()) return false;
+  const Candidate& c = lane.two_point.take();
   const Vec3 axis = c.term - c.origin;
   if (!(length(axis) > 0)) return false;
   Vec3 u, v;

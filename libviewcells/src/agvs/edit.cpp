@@ -99,10 +99,11 @@ AgvsEditStats AgvsSolver::Impl::edit(const Scene& edited, const RayCaster& rc, c
   pvs = std::move(next);
   hit_counts = std::move(next_hits);
   // Mutation candidates keep their segments; their objects follow the map.
-  for (CandidateBuffer* b : {&two_point, &silhouette})
-    b->for_each([&](Candidate& cand) {
-      if (cand.object != kNoObject) cand.object = new_of_old[cand.object];
-    });
+  for (MutationLane& lane : lanes)
+    for (CandidateBuffer* b : {&lane.two_point, &lane.silhouette})
+      b->for_each([&](Candidate& cand) {
+        if (cand.object != kNoObject) cand.object = new_of_old[cand.object];
+      });
   // The estimator's rays described the old scene.
   window.clear();
   window_total = 0;

@@ -12,9 +12,8 @@ void AgvsSolver::Impl::shares(double share[kDists]) {
     share[kVsd] = 1;
     return;
   }
-  auto usable = [&](int d) {
-    return (d != kTpm || !two_point.empty()) && (d != kSil || !silhouette.empty());
-  };
+  const bool candidates = mutation_candidates() > 0;  // both mutations' (the buffers hold the same number)
+  auto usable = [&](int d) { return (d != kTpm && d != kSil) || candidates; };
   const bool calibrate = !calibrated || stats.samples - last_calibration >= config.recalibrate_every;
   // A distribution not tried yet (the mutation, before its first candidates) gets the
   // best weight: it is then measured like the others.

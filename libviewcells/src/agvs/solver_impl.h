@@ -5,6 +5,7 @@
 // batch of the sampling loop), estimator.cpp (4.5), filter.cpp (5), edit.cpp (6),
 // state_io.cpp (saving and resuming) and agvs.cpp (the loop and the public API).
 #include <algorithm>
+#include <array>
 #include <deque>
 #include <limits>
 #include <memory>
@@ -24,6 +25,16 @@ namespace viewcells {
 namespace agvs_detail {
 constexpr int kDists = static_cast<int>(AgvsDistribution::kCount);
 constexpr int kVsd = 0, kOd = 1, kTp = 2, kTpm = 3, kSil = 4;
+constexpr uint32_t kMaxMutationLanes = 1 << 16;
+
+/// One lane of the mutation strategies (AgvsConfig::mutation_lanes): its candidates for both
+/// mutations. On several ranks, lane l is drawn and fed by rank l mod ranks only (the others'
+/// copies are stale until sync()); its candidate count is kept current on every rank (both
+/// buffers always hold the same number: add() adds to both, take() moves one).
+struct MutationLane {
+  CandidateBuffer two_point, silhouette;
+  uint64_t count = 0;
+};
 
 /// contribute() in one cell: inserts the objects (skipping none, and b when it is a) with
 /// insert(object) -> bool (new), returns the entries added, and marks contributed[e] and,
@@ -61,8 +72,9 @@ struct AgvsSolver::Impl {
   std::vector<double> object_radius;
   Halton halton[kDists];
   uint64_t halton_index[kDists] = {};
-  // Mutation candidates of the two mutation strategies.
-  CandidateBuffer two_point, silhouette;
+  // Mutation candidates of the two mutation strategies, in lanes.
+  std::vector<MutationLane> lanes;
+  size_t lane_capacity = 0;  ///< candidates a lane keeps
   // The mixture: contribution and rays of each distribution in the last batch.
   double weight[kDists] = {};
   double recent_contribution[kDists] = {}, recent_rays[kDists] = {};
@@ -102,6 +114,8 @@ struct AgvsSolver::Impl {
         halton{Halton(cfg.seed, 11), Halton(cfg.seed, 12), Halton(cfg.seed, 13), Halton(cfg.seed, 14),
                Halton(cfg.seed, 15)} {
     bind(s, rc);
+    lanes.resize(config.mutation_lanes);
+    lane_capacity = config.mutation_buffer / config.mutation_lanes;
     if (config.filter_statistics) {
       cell_samples.assign(c.cell_count(), 0);
       hit_counts.assign(size_t(c.cell_count()) * s.object_count(), 0);
@@ -134,14 +148,23 @@ struct AgvsSolver::Impl {
   /// The next `attempts` samples of stationary distribution d appended in order, computed in
   /// parallel; returns how many attempts failed.
   uint32_t stationary_samples(int d, uint32_t attempts, std::vector<Vec3>& points, std::vector<Vec3>& dirs);
-  /// Draws one two-point mutation sample into (point, dir); false when it cannot (no candidate,
-  /// a degenerate pair).
-  bool draw_two_point_mutation(Rng& rng, Vec3& point, Vec3& dir);
+  /// Draws one two-point mutation sample from `lane` into (point, dir); false when it cannot
+  /// (no candidate, a degenerate pair).
+  bool draw_two_point_mutation(Rng& rng, MutationLane& lane, Vec3& point, Vec3& dir);
 
-  void add_candidate(const Candidate& c) {
-    two_point.add(c, config.mutation_buffer);
-    silhouette.add(c, config.mutation_buffer);
+  uint64_t mutation_candidates() const {
+    uint64_t n = 0;
+    for (const MutationLane& l : lanes) n += l.count;
+    return n;
   }
+  /// Where mutation candidates' ends may lie: the view box and the scene, with slack for rounding.
+  Box3 candidate_bounds() const;
+  void save_lane(ByteWriter& w, const MutationLane& lane) const {
+    lane.two_point.save(w);
+    lane.silhouette.save(w);
+  }
+  /// A lane as save_lane() wrote it; fails on `r` (a corrupt file) where a candidate cannot be.
+  MutationLane load_lane(ByteReader& r, size_t payload) const;
 
   /// Silhouette mutation (paper 4.4, after Wonka et al.'s adaptive border sampling): from the
   /// candidate's other end, discovery rays towards points moved off the seen object along a
@@ -184,6 +207,13 @@ struct AgvsSolver::Impl {
   struct BatchChunk;
   struct BatchCounts;
   void draw_samples(uint64_t index, uint32_t n, const double share[kDists], BatchSamples& s);
+  /// The batch's mutation samples (want[kSil], want[kTpm]), lane by lane, each lane from its
+  /// own stream; on several ranks each rank draws its own lanes and the others' are only
+  /// counted. Returns the draws that failed.
+  uint32_t draw_mutations(uint64_t index, const uint32_t want[kDists], BatchSamples& s);
+  /// Feeds each lane the candidates of its contributing segments, in sample order.
+  void add_candidates(const std::vector<BatchChunk>& chunks, const std::vector<uint32_t>& gains,
+                      const std::vector<uint8_t>& flags, const std::vector<std::array<double, 2>>& radius);
   /// REF's casting as the paper describes it: one forward ray per sample, into chunk `c`.
   void cast_ref_chunk(const BatchSamples& s, BatchChunk& c) const;
   std::vector<BatchChunk> cast_samples(const BatchSamples& s);

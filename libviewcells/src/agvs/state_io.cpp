@@ -6,7 +6,7 @@ namespace viewcells {
 
 namespace {
 constexpr char kStateMagic[5] = "VAGS";
-constexpr uint32_t kStateVersion = 3;
+constexpr uint32_t kStateVersion = 4;
 }  // namespace
 
 void AgvsSolver::save(const std::string& path, uint64_t identity) const {
@@ -17,6 +17,7 @@ void AgvsSolver::save(const std::string& path, uint64_t identity) const {
   w.put(m.config.seed);
   w.put(m.config.batch_size);
   w.put(m.config.min_share);
+  w.put(m.config.mutation_lanes);
   m.pvs.save(w);
   const AgvsStats& s = m.stats;
   w.put(s.samples), w.put(s.rays), w.put(s.batches), w.put(s.seconds), w.put(s.window_rays);
@@ -28,8 +29,7 @@ void AgvsSolver::save(const std::string& path, uint64_t identity) const {
   w.put(m.last_calibration);
   w.put(static_cast<uint8_t>(m.calibrated));
   w.put(m.error);
-  m.two_point.save(w);
-  m.silhouette.save(w);
+  for (const MutationLane& lane : m.lanes) m.save_lane(w, lane);
   w.put(m.window_total);
   w.put<uint64_t>(m.window.size());
   for (const auto& [n, nc] : m.window) w.put(n), w.put(nc);
@@ -41,6 +41,27 @@ void AgvsSolver::save(const std::string& path, uint64_t identity) const {
     w.put_array(m.hit_counts);
   }
   write_container(path, kStateMagic, kStateVersion, w.data());
+}
+
+Box3 AgvsSolver::Impl::candidate_bounds() const {
+  // Candidate ends lie in the view box or on the scene; a little slack for rounding.
+  Box3 ends = cells.view_box();
+  ends.extend(scene_->bounds.lo);
+  ends.extend(scene_->bounds.hi);
+  const Vec3 slack = ends.extent() * 1e-6 + Vec3{1e-9, 1e-9, 1e-9};
+  ends.lo = ends.lo - slack, ends.hi = ends.hi + slack;
+  return ends;
+}
+
+MutationLane AgvsSolver::Impl::load_lane(ByteReader& r, size_t payload) const {
+  const Box3 ends = candidate_bounds();
+  const uint32_t n_objects = pvs.object_count();
+  MutationLane lane;
+  lane.two_point = CandidateBuffer::load(r, lane_capacity, payload, ends, n_objects);
+  lane.silhouette = CandidateBuffer::load(r, lane_capacity, payload, ends, n_objects);
+  if (lane.two_point.size() != lane.silhouette.size()) r.fail("the mutations' candidate counts differ");
+  lane.count = lane.two_point.size();
+  return lane;
 }
 
 uint64_t AgvsSolver::state_identity(const std::string& path) {
@@ -60,9 +81,11 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   const uint64_t seed = r.get<uint64_t>();
   const uint32_t batch = r.get<uint32_t>();
   const double min_share = r.get<double>();
+  const uint32_t lanes = r.get<uint32_t>();
   if (method != static_cast<int32_t>(m.config.method) || seed != m.config.seed || batch != m.config.batch_size ||
-      min_share != m.config.min_share)
-    throw Error(path, 0, "this state was computed with another method, seed, batch size or minimum share");
+      min_share != m.config.min_share || lanes != m.config.mutation_lanes)
+    throw Error(path, 0,
+                "this state was computed with another method, seed, batch size, minimum share or mutation lanes");
   // Read everything into locals first: a corrupt file leaves the solver as it was.
   GlobalPvs pvs = GlobalPvs::load(r, m.pvs.cell_count(), m.pvs.object_count());
   AgvsStats s = m.stats;
@@ -84,15 +107,8 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
     if (!(weight[d] >= 0 && weight[d] < 1e300) || !(recent_c[d] >= 0 && recent_c[d] < 1e300) ||
         !(recent_r[d] >= 0 && recent_r[d] < 1e300) || !(s.dist_probability[d] >= 0 && s.dist_probability[d] <= 1))
       r.fail("mixture weights out of range");
-  // Candidate ends lie in the view box or on the scene; a little slack for rounding.
-  Box3 ends = m.cells.view_box();
-  ends.extend(m.scene_->bounds.lo);
-  ends.extend(m.scene_->bounds.hi);
-  const Vec3 slack = ends.extent() * 1e-6 + Vec3{1e-9, 1e-9, 1e-9};
-  ends.lo = ends.lo - slack, ends.hi = ends.hi + slack;
-  const uint32_t objects = m.pvs.object_count();
-  CandidateBuffer two_point = CandidateBuffer::load(r, m.config.mutation_buffer, payload.size(), ends, objects);
-  CandidateBuffer silhouette = CandidateBuffer::load(r, m.config.mutation_buffer, payload.size(), ends, objects);
+  std::vector<MutationLane> mutation_lanes;
+  for (uint32_t l = 0; l < lanes; ++l) mutation_lanes.push_back(m.load_lane(r, payload.size()));
   const uint64_t window_total = r.get<uint64_t>();
   const uint64_t windows = r.get<uint64_t>();
   if (windows > payload.size()) r.fail("estimator window too long");
@@ -119,7 +135,6 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
       r.fail("filter statistics of the wrong size");
   }
   if (!r.at_end()) r.fail("trailing bytes");
-  s.mutation_candidates = two_point.size();
   // Commit.
   m.pvs = std::move(pvs);
   m.stats = std::move(s);
@@ -129,8 +144,8 @@ void AgvsSolver::load(const std::string& path, uint64_t identity) {
   m.last_calibration = last_calibration;
   m.calibrated = calibrated;
   m.error = error;
-  m.two_point = std::move(two_point);
-  m.silhouette = std::move(silhouette);
+  m.lanes = std::move(mutation_lanes);
+  m.stats.mutation_candidates = m.mutation_candidates();
   m.window = std::move(window);
   m.window_total = window_total;
   m.cell_samples = std::move(cell_samples);

@@ -1,6 +1,7 @@
 #include "viewcells/core/cluster.h"
 
 #include <chrono>
+#include <functional>
 #include <cstdio>
 #include <cstdlib>
 #include <algorithm>
@@ -77,14 +78,14 @@ bool built_with_mpi() {
 
 const Traffic& traffic() { return g_traffic; }
 
-void share(std::vector<std::string>& items, uint64_t first) {
+void share(std::vector<std::string>& items, const std::function<int(size_t)>& owner) {
   if (g_size == 1) return;
 #ifdef VIEWCELLS_MPI
   const auto start = std::chrono::steady_clock::now();
   // This rank's items, each as (length, bytes), in item order.
   std::string mine_bytes;
   for (uint64_t i = 0; i < items.size(); ++i) {
-    if (!mine(first + i)) continue;
+    if (owner(i) != g_rank) continue;
     const uint64_t n = items[i].size();
     mine_bytes.append(reinterpret_cast<const char*>(&n), sizeof n);
     mine_bytes += items[i];
@@ -109,9 +110,8 @@ void share(std::vector<std::string>& items, uint64_t first) {
     if (r == g_rank) continue;
     uint64_t pos = static_cast<uint64_t>(offsets[r]);
     const uint64_t end = pos + static_cast<uint64_t>(lens[r]);
-    const uint64_t size = static_cast<uint64_t>(g_size);
-    // The first item rank r owns: (first + i) mod size == r.
-    for (uint64_t i = (static_cast<uint64_t>(r) + size - first % size) % size; i < items.size(); i += size) {
+    for (uint64_t i = 0; i < items.size(); ++i) {
+      if (owner(i) != r) continue;
       uint64_t n = 0;
       if (pos + sizeof n > end) throw Error("MPI: a rank sent fewer items than it owns");
       std::memcpy(&n, all.data() + pos, sizeof n);
@@ -126,6 +126,11 @@ void share(std::vector<std::string>& items, uint64_t first) {
   g_traffic.bytes_received += total - static_cast<uint64_t>(len);
   g_traffic.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 #endif
+}
+
+void share(std::vector<std::string>& items, uint64_t first) {
+  const uint64_t n = static_cast<uint64_t>(g_size);
+  share(items, [&](size_t i) { return static_cast<int>((first + i) % n); });
 }
 
 namespace {

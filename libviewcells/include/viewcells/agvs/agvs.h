@@ -74,6 +74,13 @@ struct AgvsConfig {
   /// one, then one every `recalibrate_every` samples.
   uint64_t recalibrate_every = 2'000'000;
   uint32_t mutation_buffer = 1 << 18;  ///< mutation candidates kept (fewest mutations first)
+  /// The mutations' lanes: each holds its own candidates (mutation_buffer / lanes of them),
+  /// draws its share of every batch's mutation samples from its own random stream, and is fed
+  /// the candidates of the samples whose index in the batch is its number modulo the lanes.
+  /// Lanes draw and take candidates independently: in parallel on a machine's cores and, on
+  /// a cluster, each on its own rank. 1 keeps one buffer and one stream, as the paper does.
+  /// The result depends on it (as on the seed), never on the threads or ranks.
+  uint32_t mutation_lanes = 1;
   /// Share of each batch kept for the view space-direction distribution whatever its
   /// weight: the pixel error estimator needs its rays (at 5%, AGVS's estimator could not
   /// resolve errors below several pixels), and it guarantees progress everywhere.

@@ -11,6 +11,7 @@
 /// as in one process: results are identical, byte for byte, for any number of ranks. Only
 /// rank 0 writes files and prints.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -39,6 +40,8 @@ inline bool mine(uint64_t item) { return static_cast<int>(item % static_cast<uin
 /// items[i] holds the serialised result (core/binary_file.h's ByteWriter) of item first + i where mine(first + i); afterwards
 /// every rank holds all of them. Collective: every rank calls it with the same arguments.
 void share(std::vector<std::string>& items, uint64_t first = 0);
+/// As above, with item i belonging to rank owner(i) (the same function on every rank).
+void share(std::vector<std::string>& items, const std::function<int(size_t)>& owner);
 
 /// Element-wise sums and bitwise ors over all ranks, in place (every rank gets the result).
 /// Collective: every rank calls them with vectors of the same length.
