@@ -57,7 +57,14 @@ struct AgvsSolver::Impl::BatchChunk {
   int32_t lane = -1;  ///< the mutation lane whose samples these are (-1: a stationary distribution's)
   SegmentSet segs;
   std::vector<uint32_t> sample_of;
-  std::vector<std::vector<int32_t>> pierced;  ///< per segment: the cells it has length in (not for REF)
+  /// Every (segment, cell) with the segment having length in the cell, in segment order (not for
+  /// REF); on several ranks only those of this rank's cells (cell mod ranks == rank).
+  struct CellPair {
+    uint32_t segment;  ///< index in the chunk
+    int32_t cell;
+  };
+  std::vector<CellPair> pairs;
+  uint64_t pierced = 0;  ///< all ranks' pairs
   uint64_t rays = 0;
   size_t seg_start = 0;  ///< index of its first segment among the batch's
 };
@@ -73,6 +80,7 @@ uint64_t lane_stream(uint64_t index, size_t l) { return 1000 + index + (static_c
 }  // namespace
 
 uint32_t AgvsSolver::Impl::draw_mutations(uint64_t index, const uint32_t want[kDists], BatchSamples& s) {
+  const auto start = std::chrono::steady_clock::now();
   // Each of this rank's lanes takes its candidates and random numbers in order; the silhouette
   // searches then run in parallel over all of them.
   struct LaneDraw {
@@ -171,6 +179,7 @@ uint32_t AgvsSolver::Impl::draw_mutations(uint64_t index, const uint32_t want[kD
     failed += static_cast<uint32_t>(d[1] + d[4]);
     s.discovery_rays += d[2];
   }
+  stats.mutation_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return failed;
 }
 
@@ -229,7 +238,6 @@ void AgvsSolver::Impl::cast_ref_chunk(const BatchSamples& s, BatchChunk& c) cons
     c.segs.push_back(rays[k].origin, end, kNoObject, seen ? h.object : kNoObject);
     c.sample_of.push_back(k);
   }
-  c.pierced.assign(c.segs.size(), {});
 }
 
 std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const BatchSamples& s) {
@@ -259,15 +267,20 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
     }
     c.rays = caster().cast(std::span<const Vec3>(s.points.data() + c.first, c.size),
                            std::span<const Vec3>(s.dirs.data() + c.first, c.size), c.segs, c.sample_of);
-    c.pierced.assign(c.segs.size(), {});
     std::vector<std::tuple<int32_t, double, double>> stack;
-    for (size_t i = 0; i < c.segs.size(); ++i) cells.cells_of_segment(c.segs.a(i), c.segs.b(i), c.pierced[i], stack);
+    std::vector<int32_t> pierced;
+    for (size_t i = 0; i < c.segs.size(); ++i) {
+      cells.cells_of_segment(c.segs.a(i), c.segs.b(i), pierced, stack);
+      for (int32_t cell : pierced) c.pairs.push_back({static_cast<uint32_t>(i), cell});
+    }
+    c.pierced = c.pairs.size();
   };
   if (cluster::size() > 1) {
     // Several ranks: each casts the chunks it owns (numbered across batches, so that the work
     // turns round the ranks; a chunk's owner may differ between rank counts, its content does
     // not), and every rank receives all chunks. A mutation lane's chunks are its owner's, the
-    // only rank that drew their points.
+    // only rank that drew their points. A chunk's pairs travel sorted by the rank of their cell:
+    // each rank keeps its own.
     std::vector<std::string> items(chunks.size());
     const uint64_t base = stats.batches * 4096;
     const uint64_t ranks = static_cast<uint64_t>(cluster::size());
@@ -282,7 +295,10 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
       w.put(c.rays);
       w.put_array(c.sample_of);
       put_segments(w, c.segs);
-      for (const auto& p : c.pierced) w.put_array(p);
+      w.put(c.pierced);
+      std::vector<std::vector<BatchChunk::CellPair>> of_rank(ranks);
+      for (const BatchChunk::CellPair& p : c.pairs) of_rank[static_cast<uint64_t>(p.cell) % ranks].push_back(p);
+      for (const auto& pairs : of_rank) w.put_array(pairs);
       items[k] = w.take();
     });
     cluster::share(items, owner);
@@ -292,8 +308,17 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
       c.rays = r.get<uint64_t>();
       r.get_array(c.sample_of, items[k].size());
       get_segments(r, c.segs, items[k].size());
-      c.pierced.resize(c.segs.size());
-      for (auto& p : c.pierced) r.get_array(p, items[k].size());
+      c.pierced = r.get<uint64_t>();
+      std::vector<BatchChunk::CellPair> pairs;
+      for (uint64_t rank = 0; rank < ranks; ++rank) {
+        r.get_array(pairs, items[k].size());
+        if (rank != static_cast<uint64_t>(cluster::rank())) continue;
+        for (const BatchChunk::CellPair& p : pairs)
+          if (p.segment >= c.segs.size() || p.cell < 0 || static_cast<uint32_t>(p.cell) >= cells.cell_count() ||
+              !cluster::mine(static_cast<uint64_t>(p.cell)))
+            r.fail("a segment's cell is out of range");
+        c.pairs = std::move(pairs);
+      }
     }
   } else {
     tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) { cast_chunk(chunks[k]); });
@@ -340,8 +365,9 @@ void AgvsSolver::Impl::insert_segments(const BatchSamples& s, const std::vector<
   });
   // This rank's cells divided among parts, each inserting into its own cells in sample order
   // (so the table, the gains and the flags do not depend on the number of parts): first the
-  // (segment, cell) pairs of each part, per block of segments, then each part's in order, the
-  // outcome kept with each pair; then, per block, every pair's outcome added to its segment's.
+  // (segment, cell) pairs of each part, per chunk, then each part's in order, the outcome kept
+  // with each pair; then, per chunk, every pair's outcome added to its segment's. A rank walks
+  // only the pairs of its own cells (the casting rank sorted them by rank).
   struct Pair {
     uint32_t segment;
     int32_t cell;
@@ -350,19 +376,18 @@ void AgvsSolver::Impl::insert_segments(const BatchSamples& s, const std::vector<
   };
   const uint64_t ranks = static_cast<uint64_t>(cluster::size());
   const size_t parts = static_cast<size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
-  constexpr size_t kBlock = 4096;
-  const size_t blocks = (total + kBlock - 1) / kBlock;
-  std::vector<std::vector<std::vector<Pair>>> pairs(blocks, std::vector<std::vector<Pair>>(parts));
-  tbb::parallel_for(size_t{0}, blocks, [&](size_t b) {
-    for (size_t k = b * kBlock; k < std::min(total, (b + 1) * kBlock); ++k)
-      for (int32_t cell : at[k].first->pierced[at[k].second])
-        if (cluster::mine(static_cast<uint64_t>(cell)))
-          pairs[b][(static_cast<uint64_t>(cell) / ranks) % parts].push_back({static_cast<uint32_t>(k), cell});
+  const size_t n_chunks = chunks.size();
+  std::vector<std::vector<std::vector<Pair>>> pairs(n_chunks, std::vector<std::vector<Pair>>(parts));
+  tbb::parallel_for(size_t{0}, n_chunks, [&](size_t ci) {
+    const BatchChunk& c = chunks[ci];
+    for (const BatchChunk::CellPair& p : c.pairs)  // this rank's cells only
+      pairs[ci][(static_cast<uint64_t>(p.cell) / ranks) % parts].push_back(
+          {static_cast<uint32_t>(c.seg_start + p.segment), p.cell});
   });
   std::vector<uint64_t> part_entries(parts, 0);
   tbb::parallel_for(size_t{0}, parts, [&](size_t p) {
-    for (size_t b = 0; b < blocks; ++b)
-      for (Pair& pair : pairs[b][p]) {
+    for (size_t ci = 0; ci < n_chunks; ++ci)
+      for (Pair& pair : pairs[ci][p]) {
         const BatchChunk& c = *at[pair.segment].first;
         const uint32_t i = at[pair.segment].second;
         const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
@@ -377,16 +402,16 @@ void AgvsSolver::Impl::insert_segments(const BatchSamples& s, const std::vector<
       }
   });
   for (uint64_t n : part_entries) pvs.add_entries(n);
-  tbb::parallel_for(size_t{0}, blocks, [&](size_t b) {
-    for (const std::vector<Pair>& of_part : pairs[b])
+  tbb::parallel_for(size_t{0}, n_chunks, [&](size_t ci) {
+    for (const std::vector<Pair>& of_part : pairs[ci])
       for (const Pair& pair : of_part) {
         gains[pair.segment] += pair.gain;
         flags[pair.segment] |= pair.flags;
       }
-    for (size_t k = b * kBlock; k < std::min(total, (b + 1) * kBlock); ++k) {
+    const BatchChunk& c = chunks[ci];
+    for (size_t i = 0; i < c.segs.size(); ++i) {
       // Both ends see the same object: both rays were wrong pixels before (as contribute()).
-      const BatchChunk& c = *at[k].first;
-      const uint32_t i = at[k].second;
+      const size_t k = c.seg_start + i;
       if (c.segs.object_a[i] == c.segs.object_b[i] && c.segs.object_a[i] != kNoObject)
         flags[k] = static_cast<uint8_t>((flags[k] & ~8u) | ((flags[k] & 4u) << 1));
     }
@@ -484,6 +509,7 @@ void AgvsSolver::Impl::add_candidates(const std::vector<BatchChunk>& chunks, con
   // in the batch modulo the lanes). The contributing segments are sorted by lane (a counting
   // sort: per chunk and lane, then by offsets), keeping sample order within each lane; then
   // each lane takes its own in parallel. Every rank counts every lane's candidates.
+  const auto clock_start = std::chrono::steady_clock::now();
   const size_t n_lanes = lanes.size(), n_chunks = chunks.size();
   auto lane_of = [&](const BatchChunk& c, size_t i) { return (c.first + c.sample_of[i]) % n_lanes; };
   std::vector<uint32_t> per(n_chunks * n_lanes, 0);  // [chunk][lane]: contributing segments
@@ -533,6 +559,7 @@ void AgvsSolver::Impl::add_candidates(const std::vector<BatchChunk>& chunks, con
     }
     lane.count = std::min<uint64_t>(lane_capacity, lane.count + added);
   });
+  stats.mutation_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - clock_start).count();
 }
 
 void AgvsSolver::Impl::sync() {
@@ -596,7 +623,7 @@ void AgvsSolver::Impl::batch(uint64_t index, uint32_t n) {
   apply_segments(s, chunks, counts);
   for (const BatchChunk& c : chunks) {
     stats.segments += c.segs.size();
-    for (const auto& p : c.pierced) stats.pierced_cells += p.size();
+    stats.pierced_cells += c.pierced;
   }
   // The estimator counts view space-direction samples (all of them for SGVS and REF).
   uint64_t vsd_rays = 0, vsd_contributing = 0;

@@ -448,6 +448,7 @@ std::string report_json(const PvsResult& r) {
                 {{"draw_seconds", st.draw_seconds},
                  {"cast_seconds", st.cast_seconds},
                  {"apply_seconds", st.apply_seconds},
+                 {"mutation_seconds", st.mutation_seconds},
                  {"segments", st.segments},
                  {"pierced_cells", st.pierced_cells}}},
                {"distributions", agvs_distributions(st)},

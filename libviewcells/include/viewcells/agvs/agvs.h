@@ -152,8 +152,11 @@ struct AgvsStats {
   double seconds = 0;
   /// Where this run's time went, batch by batch (not saved with the state): drawing the samples
   /// (silhouette searches included), casting them and finding their cells (spread over the
-  /// ranks on a cluster; the exchange of results included), applying them in order (serial).
-  double draw_seconds = 0, cast_seconds = 0, apply_seconds = 0;
+  /// ranks on a cluster; the exchange of results included), applying them (the table divided
+  /// by cells). `mutation_seconds`: the part of drawing and applying that the mutation lanes
+  /// take (drawing their samples, silhouette searches included, and taking their candidates),
+  /// which lanes divide among threads and ranks.
+  double draw_seconds = 0, cast_seconds = 0, apply_seconds = 0, mutation_seconds = 0;
   uint64_t segments = 0, pierced_cells = 0;  ///< segments applied, and cells they pierced in all
   std::string stop_reason;
   EmptySpaceDecision empty_space;
