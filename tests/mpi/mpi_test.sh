@@ -63,6 +63,18 @@ for extra in "--method ref" "--method sgvs" "--filter" "--mutation-lanes 5"; do
     bad "pvs $extra on 3 ranks"
   same_files "pvs $extra, 3 ranks" x0.pvs x3.pvs
 done
+# Mutation lanes on a scene of closed solids: a sample whose origin is inside one is re-cast after
+# the chunk's other samples, so a chunk's bounds order its segments. Lanes dealt to the ranks
+# must not move those bounds (this failed when a rank's lanes were cast as one run).
+"$VC" -q generate city --size 3 -o city.obj || exit 1
+"$VC" -q build city.obj --samples 30000 --max-cells 60 --merge-pvs samples -o city.vcells || exit 1
+"$VC" -q pvs city.vcells --scene city.obj --cells 40 --samples 100000 --batch 20000 --mutation-lanes 100 \
+  -o l0.pvs || bad "pvs with lanes on the city"
+for n in 2 3; do
+  ranks "$n" -q pvs city.vcells --scene city.obj --cells 40 --samples 100000 --batch 20000 --mutation-lanes 100 \
+    -o "l$n.pvs" || bad "pvs with lanes on the city on $n ranks"
+  same_files "pvs with lanes on the city, $n ranks" l0.pvs "l$n.pvs"
+done
 [ "$(jq -r .cluster.ranks s3.json)" = 3 ] && [ "$(jq -r .cluster.bytes_received s3.json)" -gt 0 ] && ok ||
   bad "the report of 3 ranks does not say what they exchanged: $(jq -c .cluster s3.json)"
 

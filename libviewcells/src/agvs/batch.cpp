@@ -54,7 +54,7 @@ struct AgvsSolver::Impl::BatchSamples {
 struct AgvsSolver::Impl::BatchChunk {
   uint32_t first = 0, size = 0;
   int dist = 0;
-  int32_t lane = -1;  ///< the mutation lane whose samples these are (-1: a stationary distribution's)
+  int32_t lane = -1;  ///< the first mutation lane whose samples these are (-1: a stationary distribution's)
   SegmentSet segs;
   std::vector<uint32_t> sample_of;
   /// Every (segment, cell) with the segment having length in the cell, in segment order (not for
@@ -92,7 +92,7 @@ uint32_t AgvsSolver::Impl::draw_mutations(uint64_t index, const uint32_t want[kD
   const size_t n_lanes = lanes.size();
   std::vector<LaneDraw> draws(n_lanes);
   tbb::parallel_for(size_t{0}, n_lanes, [&](size_t l) {
-    if (!cluster::mine(l)) return;
+    if (!my_lane(l)) return;
     LaneDraw& ld = draws[l];
     MutationLane& lane = lanes[l];
     Rng rng(config.seed, lane_stream(index, l));
@@ -144,12 +144,12 @@ uint32_t AgvsSolver::Impl::draw_mutations(uint64_t index, const uint32_t want[kD
   if (cluster::size() > 1) {
     std::vector<std::string> items(n_lanes);
     for (size_t l = 0; l < n_lanes; ++l)
-      if (cluster::mine(l)) {
+      if (my_lane(l)) {
         ByteWriter w;
         w.put(drawn[l]);
         items[l] = w.take();
       }
-    cluster::share(items);
+    cluster::share(items, [&](size_t l) { return lane_owner(l); });
     for (size_t l = 0; l < n_lanes; ++l) {
       ByteReader r(items[l], "a rank's mutation draws");
       drawn[l] = r.get<std::array<uint64_t, 5>>();
@@ -163,7 +163,7 @@ uint32_t AgvsSolver::Impl::draw_mutations(uint64_t index, const uint32_t want[kD
       const uint32_t first = static_cast<uint32_t>(s.points.size()), n = static_cast<uint32_t>(drawn[l][count_at]);
       if (n == 0) continue;
       s.lane_ranges.push_back({d, static_cast<uint32_t>(l), first, n});
-      if (cluster::mine(l)) {
+      if (my_lane(l)) {
         s.points.insert(s.points.end(), points_of(draws[l]).begin(), points_of(draws[l]).end());
         s.dirs.insert(s.dirs.end(), dirs_of(draws[l]).begin(), dirs_of(draws[l]).end());
       } else {
@@ -254,11 +254,25 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
       chunks.push_back(std::move(c));
     }
   };
-  for (int d : kOrder)
-    if (d != kSil && d != kTpm) add_chunks(d, s.first_of[d], s.end_of[d], -1);
-    else
-      for (const BatchSamples::LaneRange& r : s.lane_ranges)
-        if (r.dist == d) add_chunks(d, r.first, r.first + r.size, static_cast<int32_t>(r.lane));
+  for (int d : kOrder) {
+    if (d != kSil && d != kTpm) {
+      add_chunks(d, s.first_of[d], s.end_of[d], -1);
+      continue;
+    }
+    // A mutation's samples in runs of one lane group each.
+    const BatchSamples::LaneRange* run = nullptr;
+    uint32_t end = 0;
+    for (const BatchSamples::LaneRange& r : s.lane_ranges) {
+      if (r.dist != d) continue;
+      if (run && lane_group(r.lane) == lane_group(run->lane)) {
+        end = r.first + r.size;
+        continue;
+      }
+      if (run) add_chunks(d, run->first, end, static_cast<int32_t>(run->lane));
+      run = &r, end = r.first + r.size;
+    }
+    if (run) add_chunks(d, run->first, end, static_cast<int32_t>(run->lane));
+  }
   // A chunk: its samples cast, and the cells of each segment.
   auto cast_chunk = [&](BatchChunk& c) {
     if (config.method == AgvsMethod::kRef) {
@@ -285,7 +299,7 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
     const uint64_t base = stats.batches * 4096;
     const uint64_t ranks = static_cast<uint64_t>(cluster::size());
     auto owner = [&](size_t k) {
-      return static_cast<int>((chunks[k].lane >= 0 ? static_cast<uint64_t>(chunks[k].lane) : base + k) % ranks);
+      return chunks[k].lane >= 0 ? lane_owner(static_cast<size_t>(chunks[k].lane)) : static_cast<int>((base + k) % ranks);
     };
     tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
       if (owner(k) != cluster::rank()) return;
@@ -485,7 +499,7 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
         counts.camera_rays[sample] = 2;
         counts.wrong_rays[sample] = static_cast<uint8_t>(((flags[k] >> 2) & 1) + ((flags[k] >> 3) & 1));
       }
-      if (mutations && gains[k] > 0 && cluster::mine(sample % lanes.size()))  // its lane's owner feeds it
+      if (mutations && gains[k] > 0 && my_lane(sample % lanes.size()))  // its lane's owner feeds it
         radius[k] = {end_radius(c.segs.object_a[i], c.segs.a(i)), end_radius(c.segs.object_b[i], c.segs.b(i))};
     }
   });
@@ -512,26 +526,28 @@ void AgvsSolver::Impl::add_candidates(const std::vector<BatchChunk>& chunks, con
   const auto clock_start = std::chrono::steady_clock::now();
   const size_t n_lanes = lanes.size(), n_chunks = chunks.size();
   auto lane_of = [&](const BatchChunk& c, size_t i) { return (c.first + c.sample_of[i]) % n_lanes; };
-  std::vector<uint32_t> per(n_chunks * n_lanes, 0);  // [chunk][lane]: contributing segments
+  std::vector<uint32_t> per(n_lanes * n_chunks, 0);  // [lane][chunk]: contributing segments
   tbb::parallel_for(size_t{0}, n_chunks, [&](size_t ci) {
     const BatchChunk& c = chunks[ci];
     for (size_t i = 0; i < c.segs.size(); ++i)
-      if (flags[c.seg_start + i] & 3) ++per[ci * n_lanes + lane_of(c, i)];
+      if (flags[c.seg_start + i] & 3) ++per[lane_of(c, i) * n_chunks + ci];
   });
   std::vector<size_t> start(n_lanes + 1, 0);
+  size_t placed = 0;
   for (size_t l = 0; l < n_lanes; ++l) {
-    start[l + 1] = start[l];
+    start[l] = placed;
     for (size_t ci = 0; ci < n_chunks; ++ci) {
-      const uint32_t n = per[ci * n_lanes + l];
-      per[ci * n_lanes + l] = static_cast<uint32_t>(start[l + 1]);  // now: where the chunk's go
-      start[l + 1] += n;
+      const uint32_t n = per[l * n_chunks + ci];
+      per[l * n_chunks + ci] = static_cast<uint32_t>(placed);  // now: where the chunk's go
+      placed += n;
     }
   }
-  std::vector<uint32_t> order(start[n_lanes]);  // segments, by lane, in sample order
+  start[n_lanes] = placed;
+  std::vector<uint32_t> order(placed);  // segments, by lane, in sample order
   tbb::parallel_for(size_t{0}, n_chunks, [&](size_t ci) {
     const BatchChunk& c = chunks[ci];
     for (size_t i = 0; i < c.segs.size(); ++i)
-      if (flags[c.seg_start + i] & 3) order[per[ci * n_lanes + lane_of(c, i)]++] = static_cast<uint32_t>(c.seg_start + i);
+      if (flags[c.seg_start + i] & 3) order[per[lane_of(c, i) * n_chunks + ci]++] = static_cast<uint32_t>(c.seg_start + i);
   });
   // Segment k's chunk: the last one starting at or before it.
   auto chunk_of = [&](size_t k) {
@@ -541,7 +557,7 @@ void AgvsSolver::Impl::add_candidates(const std::vector<BatchChunk>& chunks, con
   tbb::parallel_for(size_t{0}, n_lanes, [&](size_t l) {
     MutationLane& lane = lanes[l];
     uint64_t added = 0;
-    const bool own = cluster::mine(l);
+    const bool own = my_lane(l);
     for (size_t at = start[l]; at < start[l + 1]; ++at) {
       const size_t k = order[at];
       const BatchChunk& c = *chunk_of(k);
@@ -585,14 +601,14 @@ void AgvsSolver::Impl::sync() {
   // The mutation lanes, each from its owner.
   std::vector<std::string> items(lanes.size());
   for (size_t l = 0; l < lanes.size(); ++l)
-    if (cluster::mine(l)) {
+    if (my_lane(l)) {
       ByteWriter w;
       save_lane(w, lanes[l]);
       items[l] = w.take();
     }
-  cluster::share(items);
+  cluster::share(items, [&](size_t l) { return lane_owner(l); });
   for (size_t l = 0; l < lanes.size(); ++l)
-    if (!cluster::mine(l)) {
+    if (!my_lane(l)) {
       ByteReader r(items[l], "a rank's mutation candidates");
       lanes[l] = load_lane(r, items[l].size());
     }
@@ -606,14 +622,16 @@ void AgvsSolver::Impl::batch(uint64_t index, uint32_t n) {
   using Clock = std::chrono::steady_clock;
   auto since = [](Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); };
   auto t = Clock::now();
+  double lanes_before = stats.mutation_seconds;  // the lanes' time is counted apart
   BatchSamples s;
   draw_samples(index, n, share, s);
-  stats.draw_seconds += since(t);
+  stats.draw_seconds += since(t) - (stats.mutation_seconds - lanes_before);
   t = Clock::now();
   const size_t count = s.points.size();
   const std::vector<BatchChunk> chunks = cast_samples(s);
   stats.cast_seconds += since(t);
   t = Clock::now();
+  lanes_before = stats.mutation_seconds;
   // Apply in sample order (contributions depend on what came before).
   BatchCounts counts;
   counts.rays[kSil] += s.discovery_rays;
@@ -643,7 +661,7 @@ void AgvsSolver::Impl::batch(uint64_t index, uint32_t n) {
   stats.camera_rays += vsd_rays;
   stats.wrong_camera_rays += vsd_contributing;
   update_estimate(vsd_rays, vsd_contributing);
-  stats.apply_seconds += since(t);
+  stats.apply_seconds += since(t) - (stats.mutation_seconds - lanes_before);
 }
 
 }  // namespace viewcells

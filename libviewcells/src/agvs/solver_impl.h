@@ -28,9 +28,9 @@ constexpr int kVsd = 0, kOd = 1, kTp = 2, kTpm = 3, kSil = 4;
 constexpr uint32_t kMaxMutationLanes = 1 << 16;
 
 /// One lane of the mutation strategies (AgvsConfig::mutation_lanes): its candidates for both
-/// mutations. On several ranks, lane l is drawn and fed by rank l mod ranks only (the others'
-/// copies are stale until sync()); its candidate count is kept current on every rank (both
-/// buffers always hold the same number: add() adds to both, take() moves one).
+/// mutations. On several ranks, a lane is drawn and fed by its owner only (Impl::lane_owner;
+/// the others' copies are stale until sync()); its candidate count is kept current on every
+/// rank (both buffers always hold the same number: add() adds to both, take() moves one).
 struct MutationLane {
   CandidateBuffer two_point, silhouette;
   uint64_t count = 0;
@@ -152,6 +152,14 @@ struct AgvsSolver::Impl {
   /// (no candidate, a degenerate pair).
   bool draw_two_point_mutation(Rng& rng, MutationLane& lane, Vec3& point, Vec3& dir);
 
+  /// Lanes form at most kLaneGroups groups of consecutive lanes: a group's mutation samples are
+  /// cast in chunks of their own (chunk boundaries order a chunk's segments, so they must not
+  /// depend on the ranks), and groups are dealt to the ranks in turn.
+  static constexpr size_t kLaneGroups = 64;
+  size_t lane_group(size_t l) const { return l * kLaneGroups / lanes.size(); }
+  /// The rank that draws and feeds mutation lane l.
+  int lane_owner(size_t l) const { return static_cast<int>(lane_group(l) % static_cast<size_t>(cluster::size())); }
+  bool my_lane(size_t l) const { return lane_owner(l) == cluster::rank(); }
   uint64_t mutation_candidates() const {
     uint64_t n = 0;
     for (const MutationLane& l : lanes) n += l.count;

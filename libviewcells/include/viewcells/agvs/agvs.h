@@ -150,12 +150,12 @@ struct AgvsStats {
   uint64_t window_rays = 0;
   uint64_t camera_rays = 0, wrong_camera_rays = 0;  ///< the estimator's rays since the start
   double seconds = 0;
-  /// Where this run's time went, batch by batch (not saved with the state): drawing the samples
-  /// (silhouette searches included), casting them and finding their cells (spread over the
-  /// ranks on a cluster; the exchange of results included), applying them (the table divided
-  /// by cells). `mutation_seconds`: the part of drawing and applying that the mutation lanes
-  /// take (drawing their samples, silhouette searches included, and taking their candidates),
-  /// which lanes divide among threads and ranks.
+  /// Where this run's time went, batch by batch (not saved with the state), in four parts that
+  /// add up: drawing the stationary distributions' samples (every rank draws them all), the
+  /// mutation lanes (drawing their samples, silhouette searches included, and taking their
+  /// candidates: divided among threads and, on a cluster, ranks), casting and finding the cells
+  /// (spread over the ranks; the exchange of results included), and applying the segments to
+  /// the table (divided by cells).
   double draw_seconds = 0, cast_seconds = 0, apply_seconds = 0, mutation_seconds = 0;
   uint64_t segments = 0, pierced_cells = 0;  ///< segments applied, and cells they pierced in all
   std::string stop_reason;
