@@ -226,6 +226,7 @@ std::optional<AgvsConfig> MergeOptions::agvs(const Common& c, uint64_t seed, uin
   a.seed = seed + 7'000'001;  // not the construction samples' stream
   a.max_samples = samples;
   a.pixel_error = pixel_error;
+  a.mutation_lanes = lanes;
   if (!samples && !(pixel_error > 0)) a.max_samples = std::max<uint64_t>(construction_samples, 1);
   a.show_progress = !c.quiet;
   return a;
@@ -249,6 +250,11 @@ void add_merge_options(CLI::App* cmd, MergeOptions& a) {
                   "Run each AGVS run over the elementary cells until its estimated pixel error (of 1024x1024) is at "
                   "most this")
       ->check(positive());
+  cmd->add_option("--merge-mutation-lanes", a.lanes,
+                  "Mutation lanes of those AGVS runs (as pvs --mutation-lanes: more lanes spread the mutations over "
+                  "threads and cluster ranks; the result depends on it, not on the threads or ranks)")
+      ->capture_default_str()
+      ->check(whole(1, 65536));
 }
 
 void add_cell_options(CLI::App* cmd, CellOptions& a, const std::string& max_cells_help) {

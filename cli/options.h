@@ -111,6 +111,7 @@ struct MergeOptions {
   std::string pvs = "agvs";
   uint64_t samples = 0;
   double pixel_error = 0;
+  uint32_t lanes = 1;
   /// Unset for --merge-pvs samples; else AGVS with the stopping rule given (default: as many
   /// samples as the construction had, `construction_samples`), seeded from `seed`.
   std::optional<AgvsConfig> agvs(const Common& c, uint64_t seed, uint64_t construction_samples) const;

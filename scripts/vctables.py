@@ -1101,46 +1101,70 @@ def unpack_maps(*args):
 def mpi_model(*args):
     """MPI: measured exchange and phase times per rank count, and the strong-scaling model (docs/distributed.md)."""
     with open(args[0]) as f:
-        runs = [json.loads(line) for line in f if line.strip()]
-    print("| run | ranks | threads per rank | samples | seconds | draw / cast / apply s | exchanges "
+        all_runs = [json.loads(line) for line in f if line.strip()]
+    # Repeated configurations: the medians of every number (a configuration's seconds, phases and
+    # traffic), in the order the configurations first ran.
+    groups = {}
+    for r in all_runs:
+        key = (r["kind"], r.get("cells"), r.get("lanes"), r["ranks"], r.get("threads", 1))
+        groups.setdefault(key, []).append(r)
+
+    def median_of(items):
+        if isinstance(items[0], dict):
+            return {k: median_of([x[k] for x in items]) for k in items[0]}
+        if isinstance(items[0], (int, float)) and not isinstance(items[0], bool):
+            return statistics.median(items)
+        return items[0]
+    runs = [dict(median_of(g), repeats=len(g)) for g in groups.values()]
+    print(f"Medians of {max(r['repeats'] for r in runs)} runs of each configuration.")
+    print()
+    print("| run | mutation lanes | ranks | threads per rank | samples | seconds "
+          "| draw / mutations / cast / apply s | exchanges "
           "| sent per exchange (rank 0) | received per exchange | exchange s | exchange share |")
-    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
+    print("| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |")
     for r in runs:
         c = r["cluster"]
         ex = max(c["exchanges"], 1)
         name = f"pvs, {r['cells']} cells" if r["kind"] == "pvs" else "sample"
         phases = r.get("phases")
-        split = (f"{phases['draw_seconds']:.2f} / {phases['cast_seconds']:.2f} / {phases['apply_seconds']:.2f}"
-                 if phases else "")
-        print(f"| {name} | {r['ranks']} | {r.get('threads', 1)} | {r['samples']:,} | {r['seconds']:.2f} | {split} "
-              f"| {c['exchanges']} "
+        split = (f"{phases['draw_seconds']:.2f} / {phases['mutation_seconds']:.2f} / {phases['cast_seconds']:.2f} / "
+                 f"{phases['apply_seconds']:.2f}" if phases else "")
+        print(f"| {name} | {r.get('lanes', '')} | {r['ranks']} | {r.get('threads', 1)} | {r['samples']:,.0f} "
+              f"| {r['seconds']:.2f} | {split} | {c['exchanges']} "
               f"| {c['bytes_sent'] / ex / 1e3:,.0f} kB | {c['bytes_received'] / ex / 1e3:,.0f} kB "
               f"| {c['exchange_seconds']:.2f} | {100 * c['exchange_seconds'] / r['seconds']:.1f}% |")
     print()
-    # Model inputs per sample, from one rank of one thread, and one rank of two threads for the
-    # parts that the cores divide: x1 = s + p, x2 = s + p / 2 for drawing (its quasi-random
-    # distributions are computed in parallel) and applying (the table's insertions, divided by
-    # cells among the cores of every rank); bytes from two ranks (what rank 0 sent and received
-    # is the whole batch's results).
+    # Model inputs per sample and phase (drawing, the mutation lanes, casting, applying). What
+    # the ranks divide: from one rank and two ranks of one thread each, x1 = r + d, x2 = r + d / 2
+    # (r: repeated on every rank, d: divided among them). How well a node's cores divide a rank's
+    # share: from one rank of one thread and of two, as Amdahl's serial fraction s of the phase
+    # (x2 = x1 (s + (1 - s) / 2)); on this machine that also holds what two cores lose to
+    # sharing memory. Bytes from two ranks (what rank 0 sent and received is the whole batch's).
     def fit(x1, x2):
         divided = min(max(2 * (x1 - x2), 0.0), x1)
         return x1 - divided, divided
 
+    phase_keys = ("draw_seconds", "mutation_seconds", "cast_seconds", "apply_seconds")
     inputs = {}
+    lanes = max(r.get("lanes", 1) for r in runs if r["kind"] == "pvs")
     for cells in sorted({r["cells"] for r in runs if r["kind"] == "pvs"}):
-        def run_of(ranks, threads):
+        def run_of(ranks, threads, n_lanes=lanes):
             return next(r for r in runs if r["kind"] == "pvs" and r["cells"] == cells and r["ranks"] == ranks
-                        and r.get("threads", 1) == threads)
-        one, threads2, two = run_of(1, 1), run_of(1, 2), run_of(2, 1)
-        ph, n = one["phases"], one["samples"]
-        ph2, n2 = threads2["phases"], threads2["samples"]
-        serial_draw, divided_draw = fit(ph["draw_seconds"] / n, ph2["draw_seconds"] / n2)
-        serial_apply, divided_apply = fit(ph["apply_seconds"] / n, ph2["apply_seconds"] / n2)
-        inputs[cells] = {
-            "serial_draw": serial_draw, "divided_draw": divided_draw, "cast": ph["cast_seconds"] / n,
-            "apply": ph["apply_seconds"] / n, "serial_apply": serial_apply, "divided_apply": divided_apply,
-            "bytes": (two["cluster"]["bytes_sent"] + two["cluster"]["bytes_received"]) / two["samples"],
-            "pierced": ph["pierced_cells"] / max(ph["segments"], 1), "segments": ph["segments"] / n}
+                        and r.get("threads", 1) == threads and r.get("lanes", 1) == n_lanes)
+        one, threads2, two, single = run_of(1, 1), run_of(1, 2), run_of(2, 1), run_of(1, 1, 1)
+
+        def per(run, key):
+            return run["phases"][key] / run["samples"]
+        m = {"bytes": (two["cluster"]["bytes_sent"] + two["cluster"]["bytes_received"]) / two["samples"],
+             "pierced": one["phases"]["pierced_cells"] / max(one["phases"]["segments"], 1),
+             "segments": one["phases"]["segments"] / one["samples"],
+             "single_lane_mutation": per(single, "mutation_seconds")}
+        for key in phase_keys:
+            x1 = per(one, key)
+            repeated, divided = fit(x1, per(two, key))
+            serial, _ = fit(x1, per(threads2, key))
+            m[key] = {"repeated": repeated, "divided": divided, "serial_share": serial / x1 if x1 > 0 else 0.0}
+        inputs[cells] = m
     if len(inputs) >= 2:
         lo, hi = sorted(inputs)[0], sorted(inputs)[-1]
         k = math.log(inputs[hi]["pierced"] / inputs[lo]["pierced"]) / math.log(hi / lo)
@@ -1148,48 +1172,64 @@ def mpi_model(*args):
         grow = (big / hi) ** k
         m = dict(inputs[hi])
         m["pierced"] = inputs[hi]["pierced"] * grow
-        for key in ("apply", "serial_apply", "divided_apply"):
-            m[key] = inputs[hi][key] * grow
+        m["apply_seconds"] = dict(inputs[hi]["apply_seconds"])
+        for part in ("repeated", "divided"):
+            m["apply_seconds"][part] *= grow
         m["bytes"] = inputs[hi]["bytes"] + 4 * inputs[hi]["segments"] * (m["pierced"] - inputs[hi]["pierced"])
         inputs[big] = m
         print(f"Pierced cells per segment grow as cells^{k:.2f} (measured at {lo:,} and {hi:,} cells); "
               f"at {big:,} cells the model extrapolates {m['pierced']:.1f} per segment, and applying in proportion.")
         print()
-    print("| cells | draw µs/sample: serial + divided by a node's cores | cast core-µs/sample "
-          "| apply µs/sample: serial + divided by all cores | exchanged bytes/sample | pierced cells/segment |")
-    print("| --- | --- | --- | --- | --- | --- |")
+    names = {"draw_seconds": "draw", "mutation_seconds": "mutation lanes", "cast_seconds": "cast",
+             "apply_seconds": "apply"}
+    print(f"Inputs, in µs a sample, with {lanes:,} mutation lanes: per phase, repeated on every rank + divided "
+          "among the ranks, and (in brackets) the serial share of a rank's part among its node's cores:")
+    print()
+    print("| cells | " + " | ".join(names[key] for key in phase_keys)
+          + " | one lane's mutations (serial, on one rank) | exchanged bytes/sample | pierced cells/segment |")
+    print("| --- | " + " | ".join("---" for _ in phase_keys) + " | --- | --- | --- |")
     for cells, m in sorted(inputs.items()):
-        print(f"| {cells:,} | {1e6 * m['serial_draw']:.2f} + {1e6 * m['divided_draw']:.2f} | {1e6 * m['cast']:.2f} "
-              f"| {1e6 * m['serial_apply']:.2f} + {1e6 * m['divided_apply']:.2f} | {m['bytes']:.0f} "
-              f"| {m['pierced']:.1f} |")
+        print(f"| {cells:,} | " + " | ".join(
+            f"{1e6 * m[key]['repeated']:.2f} + {1e6 * m[key]['divided']:.2f} ({100 * m[key]['serial_share']:.0f}%)"
+            for key in phase_keys)
+              + f" | {1e6 * m['single_lane_mutation']:.2f} | {m['bytes']:.0f} | {m['pierced']:.1f} |")
     print()
     cores, bandwidth, latency, batch = 32, 10e9, 5e-6, 20000
     nodes = [1, 2, 4, 8, 16, 32, 64]
 
-    def per_sample(m, n, all_parallel):
+    def per_sample(m, n, mode):
         # One exchange of the batch's results (ring allgather: (n - 1) / n of them reach each
-        # rank) and three small reductions per batch, each a few latencies.
-        exchange = ((n - 1) / n) * m["bytes"] / bandwidth + (4 * math.ceil(math.log2(n)) * latency / batch
+        # rank) and four small collectives per batch (the lanes' counts, gains, flags, entries),
+        # each a few latencies.
+        exchange = ((n - 1) / n) * m["bytes"] / bandwidth + (5 * math.ceil(math.log2(n)) * latency / batch
                                                           if n > 1 else 0)
-        draw = m["serial_draw"] + m["divided_draw"]
-        if all_parallel:
-            return (draw + m["apply"] + m["cast"]) / (n * cores) + exchange
-        return (m["serial_draw"] + m["divided_draw"] / cores + m["serial_apply"] + m["divided_apply"] / (n * cores)
-                + m["cast"] / (n * cores) + exchange)
+        if mode == "bound":
+            return sum(m[key]["repeated"] + m[key]["divided"] for key in phase_keys) / (n * cores) + exchange
+        t = exchange
+        for key in phase_keys:
+            p = m[key]
+            if mode == "one lane" and key == "mutation_seconds":
+                t += m["single_lane_mutation"]
+                continue
+            t += (p["repeated"] + p["divided"] / n) * (p["serial_share"] + (1 - p["serial_share"]) / cores)
+        return t
 
-    for all_parallel in (False, True):
-        what = ("if drawing and applying were spread like casting (not built: the bound from the exchange alone)"
-                if all_parallel else "as built: the serial parts of drawing and applying on every rank, drawing's "
-                "divided part over each node's cores, applying's over all cores")
+    whats = {
+        "lanes": f"as built, with {lanes:,} mutation lanes (at least as many as the cores; one rank a node, whose "
+                 "threads share its part)",
+        "one lane": "as built, with one mutation lane (the default): the same, but the mutations drawn and fed "
+                    "serially by one rank",
+        "bound": "if everything were divided like casting (not built: the bound from the exchange alone)"}
+    for mode, what in whats.items():
         print(f"{what}; batches of {batch:,} samples, {cores} cores per node, {bandwidth / 1e9:.0f} GB/s and "
               f"{latency * 1e6:.0f} µs between nodes: speed-up over one node (parallel efficiency)")
         print()
         print("| cells | " + " | ".join(f"{n} nodes" for n in nodes) + " |")
         print("| --- | " + " | ".join("---" for _ in nodes) + " |")
         for cells, m in sorted(inputs.items()):
-            base = per_sample(m, 1, all_parallel)
+            base = per_sample(m, 1, mode)
             print(f"| {cells:,} | " + " | ".join(
-                f"{base / per_sample(m, n, all_parallel):.1f} ({100 * base / per_sample(m, n, all_parallel) / n:.0f}%)"
+                f"{base / per_sample(m, n, mode):.1f} ({100 * base / per_sample(m, n, mode) / n:.0f}%)"
                 for n in nodes) + " |")
         print()
 

@@ -5,6 +5,7 @@ import contextlib
 import csv
 import io
 import json
+import math
 import os
 import sys
 import tempfile
@@ -446,37 +447,56 @@ class MpiModelTest(unittest.TestCase):
         with tempfile.TemporaryDirectory() as d:
             path = os.path.join(d, "runs.jsonl")
             lines = []
+            # Seconds of 1,000 samples per phase for (ranks, threads), with 64 lanes:
+            # drawing repeated on every rank, a node's two threads dividing 80% of it;
+            # the lanes and casting divided by ranks and threads alike;
+            # applying half repeated on every rank and half divided, threads dividing half.
+            phases = {(1, 1): (0.1, 0.04, 1.0, 0.2), (1, 2): (0.06, 0.02, 0.5, 0.15), (2, 1): (0.1, 0.02, 0.5, 0.15)}
             for cells, pierced in ((500, 2000), (5000, 4000)):
-                for ranks, threads in ((1, 1), (1, 2), (2, 1)):
-                    # Drawing: 0.1 s on one thread, 0.06 s on two: 0.02 s serial, 0.08 s divided.
-                    # Applying: 0.2 s on one thread, 0.15 s on two: 0.1 s serial, 0.1 s divided.
-                    lines.append({"kind": "pvs", "cells": cells, "ranks": ranks, "threads": threads, "samples": 1000,
-                                  "seconds": 2.0,
-                                  "phases": {"draw_seconds": 0.1 if threads == 1 else 0.06, "cast_seconds": 1.0,
-                                             "apply_seconds": 0.2 if threads == 1 else 0.15,
+                runs = [(ranks, threads, 64, phases[(ranks, threads)]) for ranks, threads in phases]
+                runs.append((1, 1, 1, (0.1, 0.03, 1.0, 0.2)))  # one lane: its mutations take 0.03 s
+                if cells == 500:  # a repeat of the first configuration, slower: the medians take 0.1 s
+                    runs += [(1, 1, 64, (0.1, 0.04, 1.0, 0.2)), (1, 1, 64, (0.9, 0.9, 9.0, 0.9))]
+                for ranks, threads, lanes, (draw, mutation, cast, apply) in runs:
+                    lines.append({"kind": "pvs", "cells": cells, "lanes": lanes, "ranks": ranks, "threads": threads,
+                                  "samples": 1000, "seconds": 2.0,
+                                  "phases": {"draw_seconds": draw, "mutation_seconds": mutation,
+                                             "cast_seconds": cast, "apply_seconds": apply,
                                              "segments": 1000, "pierced_cells": pierced},
                                   "cluster": {"exchanges": 4 * (ranks - 1), "bytes_sent": 50000 * (ranks - 1),
                                               "bytes_received": 50000 * (ranks - 1), "exchange_seconds": 0.1}})
             with open(path, "w") as f:
                 f.write("\n".join(json.dumps(x) for x in lines) + "\n")
             out = run("mpi-model", path)
-        # Per sample: 0.02 + 0.08 ms drawing, 1 ms casting, 0.1 + 0.1 ms applying, 100 bytes.
+        self.assertIn("Medians of 3 runs", out)
+        # Per sample in µs: repeated + divided among ranks (serial share among a node's cores).
         cells = row(out, "500")
-        self.assertEqual(cells[1:5], ["20.00 + 80.00", "1000.00", "100.00 + 100.00", "100"])
+        self.assertEqual(cells[1:8], ["100.00 + 0.00 (20%)", "0.00 + 40.00 (0%)", "0.00 + 1000.00 (0%)",
+                                      "100.00 + 100.00 (50%)", "30.00", "100", "2.0"])
         # Pierced cells double per tenfold cells: at 50,000 cells 8 per segment, applying doubled.
         self.assertIn("cells^0.30", out)
-        self.assertEqual(row(out, "50,000")[3], "200.00 + 200.00")
+        self.assertEqual(row(out, "50,000")[4], "200.00 + 200.00 (50%)")
         rows = [l for l in out.splitlines() if l.startswith("| 500 | 1.0 (100%)")]
-        self.assertEqual(len(rows), 2)
-        # As built, 2 nodes of 32 cores: drawing's divided part over 32 cores, applying's over 64.
-        fixed = 2e-5 + 8e-5 / 32 + 1e-4
-        one = fixed + 1e-4 / 32 + 1e-3 / 32
-        two = fixed + 1e-4 / 64 + 1e-3 / 64 + 0.5 * 100 / 1e10 + 4 * 5e-6 / 20000
-        self.assertEqual(rows[0].split("|")[3].strip(), f"{one / two:.1f} ({100 * one / two / 2:.0f}%)")
-        # All parallel, 2 nodes: (1e-4 + 2e-4 + 1e-3) / 64 + the exchange.
-        one = (1e-4 + 2e-4 + 1e-3) / 32
-        two = (1e-4 + 2e-4 + 1e-3) / 64 + 0.5 * 100 / 1e10 + 4 * 5e-6 / 20000
-        self.assertEqual(rows[1].split("|")[3].strip(), f"{one / two:.1f} ({100 * one / two / 2:.0f}%)")
+        self.assertEqual(len(rows), 3)
+
+        def exchange(n):
+            return (n - 1) / n * 100 / 1e10 + (5 * math.ceil(math.log2(n)) * 5e-6 / 20000 if n > 1 else 0)
+
+        def node(r, dv, share, n):
+            return (r + dv / n) * (share + (1 - share) / 32)
+
+        def built(n, one_lane):
+            mutation = 3e-5 if one_lane else node(0, 4e-5, 0, n)
+            return (node(1e-4, 0, 0.2, n) + mutation + node(0, 1e-3, 0, n) + node(1e-4, 1e-4, 0.5, n)
+                    + exchange(n))
+
+        def bound(n):
+            return (1e-4 + 4e-5 + 1e-3 + 2e-4) / (32 * n) + exchange(n)
+
+        for k, t in enumerate((lambda n: built(n, False), lambda n: built(n, True), bound)):
+            self.assertEqual(rows[k].split("|")[3].strip(), f"{t(1) / t(2):.1f} ({100 * t(1) / t(2) / 2:.0f}%)")
+            self.assertEqual(rows[k].split("|")[8].strip(), f"{t(1) / t(64):.1f} ({100 * t(1) / t(64) / 64:.0f}%)")
+
 
 if __name__ == "__main__":
     unittest.main()
