@@ -71,6 +71,7 @@ struct PvsArgs {
   uint32_t measure_cameras = 0;
   uint32_t measure_size = 1024;
   std::vector<uint64_t> measure_at;
+  double measured_error = 0;
   std::string save, resume, edited_from;
   double save_every = 0;
   std::vector<std::string> references;
@@ -103,6 +104,7 @@ int run_pvs(const PvsArgs& a, const Common& c) {
   config.measure_cameras = a.measure_cameras;
   config.measure_size = a.measure_size;
   config.measure_at = a.measure_at;
+  config.measured_error = a.measured_error;
   config.save = a.save;
   config.save_every = a.save_every;
   config.resume = a.resume;
@@ -164,6 +166,12 @@ void add_pvs_command(CLI::App& app, const Common& common, Commands& commands) {
                  "cameras, for a convergence curve by measured error (the report's measured_curve; the solver's "
                  "clock stops while measuring)")
       ->check(whole(1, kMaxSamples));
+  pv->add_option("--measured-error", a->measured_error,
+                 "With --measure-cameras: stop when the measured pixel error (the cameras' mean wrong pixels of "
+                 "1024x1024) is at most this. The PVSs are measured after one batch and at every doubling of the "
+                 "samples (each measurement in the report's measured_curve), so a run may sample up to twice what "
+                 "it needed; other limits still apply")
+      ->check(CLI::NonNegativeNumber);
   pv->add_option("--measure-size", a->measure_size, "Width and height of the measuring cameras, in pixels")
       ->capture_default_str()
       ->check(whole(1, 2048));

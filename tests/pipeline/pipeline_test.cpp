@@ -11,6 +11,7 @@
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pipeline/bake.h"
 #include "viewcells/pipeline/cut.h"
+#include "viewcells/pipeline/pvs.h"
 #include "viewcells/pipeline/report.h"
 #include "viewcells/runtime.hpp"
 #include "viewcells/scene/generators.h"
@@ -146,6 +147,48 @@ TEST(Pipeline, BakeRefusesNoBudgetOrTwo) {
   c.cells = 4;
   c.memory = 100000;
   EXPECT_THROW(pipeline::bake(c, quiet), Error);
+}
+
+/// pvs --measured-error: sampling stops at the first measurement (after one batch, then at
+/// every doubling) whose cameras' mean error is within the target; every earlier one was not;
+/// another limit reached first stops it too, and says so.
+TEST(Pipeline, PvsStopsAtAMeasuredError) {
+  const std::string hierarchy = test::temp_path("measured.vcells");
+  pipeline::build(small_build(hierarchy), quiet);
+  pipeline::PvsConfig c;
+  c.hierarchy_path = hierarchy;
+  c.scene_path = office();
+  c.cells = 60;
+  c.agvs.batch_size = 1000;
+  c.agvs.show_progress = false;
+  c.measure_cameras = 16;
+  c.measure_size = 128;  // one wrong pixel is 64 of 1024 x 1024, 4 in the mean of 16 cameras
+  c.measured_error = 1;  // so: no wrong pixel at all
+  c.output = test::temp_path("measured.pvs");
+  const pipeline::PvsResult r = pipeline::compute_pvs(c, quiet);
+  ASSERT_GE(r.measured_curve.size(), 2u) << "one batch of 1,000 samples does not see everything";
+  EXPECT_EQ(r.measured_curve.front().samples, 1000u);
+  for (size_t k = 0; k + 1 < r.measured_curve.size(); ++k) {
+    EXPECT_GT(r.measured_curve[k].measured.pixels, c.measured_error) << "measurement " << k;
+    EXPECT_GE(r.measured_curve[k + 1].samples, 2 * r.measured_curve[k].samples) << "measurement " << k;
+  }
+  EXPECT_LE(r.measured_curve.back().measured.pixels, c.measured_error);
+  EXPECT_EQ(r.stats.samples, r.measured_curve.back().samples) << "no sample after the last measurement";
+  EXPECT_NE(r.stats.stop_reason.find("measured pixel error"), std::string::npos) << r.stats.stop_reason;
+  ASSERT_TRUE(r.measured);
+  EXPECT_EQ(r.measured->pixels, r.measured_curve.back().measured.pixels) << "the file written is the one measured";
+  // A sample limit below what the error needs stops it first.
+  c.agvs.max_samples = 1500;
+  const pipeline::PvsResult limited = pipeline::compute_pvs(c, quiet);
+  EXPECT_EQ(limited.stats.stop_reason.find("measured"), std::string::npos) << limited.stats.stop_reason;
+  EXPECT_GE(limited.stats.samples, 1500u);
+  EXPECT_EQ(limited.stats.samples, limited.measured_curve.back().samples);
+  // The rule needs cameras, and chooses its own measurements.
+  c.measure_cameras = 0;
+  EXPECT_THROW(pipeline::compute_pvs(c, quiet), Error);
+  c.measure_cameras = 16;
+  c.measure_at = {5000};
+  EXPECT_THROW(pipeline::compute_pvs(c, quiet), Error);
 }
 
 }  // namespace

@@ -25,8 +25,14 @@ uint64_t pvs_state_identity(uint64_t scene_fingerprint, const PvsFile& cells) {
 namespace {
 
 void check_config(const PvsConfig& c) {
-  if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0))
-    throw Error("give when to stop: --pixel-error, --time or --samples");
+  if (!(c.measured_error >= 0) || !std::isfinite(c.measured_error))
+    throw Error("--measured-error must be a finite number >= 0");
+  if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0) && !(c.measured_error > 0))
+    throw Error("give when to stop: --pixel-error, --measured-error, --time or --samples");
+  if (c.measured_error > 0 && !c.measure_cameras)
+    throw Error("--measured-error needs --measure-cameras: the cameras that measure the PVSs");
+  if (c.measured_error > 0 && !c.measure_at.empty())
+    throw Error("--measured-error chooses its own measurements (every doubling of the samples): drop --measure-at");
   if (!(c.filter.k >= 0) || !std::isfinite(c.filter.k)) throw Error("--filter-k must be a finite number >= 0");
   if (c.filter.k != 1.0 && !c.filter_object_space)
     throw Error("--filter-k sets the object space filter's factor: add --filter");
@@ -140,6 +146,43 @@ void measured_run(const PvsConfig& c, const Scenes& s, const CameraSet& cams, Ag
   solver.set_limits(a.max_samples, a.max_seconds, a.pixel_error);
 }
 
+/// The stopping rule by measured error: the solver run to one batch, then to every doubling of
+/// its samples, and measured each time, until the cameras' mean wrong pixels (the paper's pixel
+/// error, which the estimator estimates) are at most c.measured_error or another limit stops
+/// it. Returns whether the measured error stopped it.
+bool run_to_measured_error(const PvsConfig& c, const Scenes& s, const CameraSet& cams, AgvsSolver& solver,
+                           PvsResult& out, const Log& log) {
+  const AgvsConfig& a = c.agvs;
+  uint64_t next = std::max<uint64_t>(solver.stats().samples + 1, a.batch_size);
+  while (true) {
+    const uint64_t until = a.max_samples ? std::min(next, a.max_samples) : next;
+    solver.set_limits(until, a.max_seconds, a.pixel_error);
+    solver.run();
+    const AgvsStats& st = solver.stats();
+    MeasuredPoint p;
+    p.samples = st.samples;
+    p.rays = st.rays;
+    p.seconds = st.seconds;
+    p.mean_pvs = solver.mean_pvs();
+    p.estimated = solver.pixel_error();
+    p.measured = measure_frames(s.scene, *s.caster, cams.cameras, cams.cells, solver.pvs(), measuring_frame(c, out));
+    p.measured.wrong.clear();
+    const double error = p.measured.pixels;
+    log("viewcells: after " + std::to_string(p.samples) + " samples (" + fmt(p.seconds, 2) +
+        " s): measured pixel error " + fmt(error, 3) + " (median camera " + fmt(p.measured.median_pixels, 3) + ")");
+    out.measured_curve.push_back(std::move(p));
+    if (error <= c.measured_error) return true;
+    // Another limit: the samples, the time, or the estimator's error (the solver's own stop).
+    const double estimated = solver.pixel_error(), bound = solver.pixel_error_bound();
+    if (st.samples < until || (a.max_samples && st.samples >= a.max_samples) ||
+        (a.max_seconds > 0 && st.seconds >= a.max_seconds) ||
+        (a.pixel_error > 0 && ((!std::isnan(estimated) && estimated <= a.pixel_error) ||
+                               (!std::isnan(bound) && bound <= a.pixel_error))))
+      return false;
+    next = 2 * st.samples;
+  }
+}
+
 /// Measures the pixel error of the PVSs written (and of the unfiltered ones, when filtered).
 void measure(const PvsConfig& c, const Scenes& s, const CameraSet& cams, const AgvsSolver& solver,
              const GlobalPvs& written, PvsResult& out, const Log& log) {
@@ -160,7 +203,8 @@ void measure(const PvsConfig& c, const Scenes& s, const CameraSet& cams, const A
 
 std::string describe_stop(const PvsConfig& c) {
   const AgvsConfig& a = c.agvs;
-  return (a.pixel_error > 0 ? "an estimated pixel error of " + fmt(a.pixel_error, 2) + " " : std::string()) +
+  return (c.measured_error > 0 ? "a measured pixel error of " + fmt(c.measured_error, 2) + " " : std::string()) +
+         (a.pixel_error > 0 ? "an estimated pixel error of " + fmt(a.pixel_error, 2) + " " : std::string()) +
          (a.max_seconds > 0 ? fmt(a.max_seconds, 1) + " s " : std::string()) +
          (a.max_samples ? std::to_string(a.max_samples) + " samples" : std::string());
 }
@@ -218,13 +262,21 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
       solver->save(c.save, identity);
     });
   }
-  if (cams && !c.measure_at.empty()) measured_run(c, scenes, *cams, *solver, out, log);
-  solver->run();
+  bool measured_stop = false;
+  if (cams && c.measured_error > 0) {
+    measured_stop = run_to_measured_error(c, scenes, *cams, *solver, out, log);
+  } else {
+    if (cams && !c.measure_at.empty()) measured_run(c, scenes, *cams, *solver, out, log);
+    solver->run();
+  }
   if (!c.save.empty()) {
     solver->save(c.save, pvs_state_identity(scenes.scene.fingerprint(), pf));
     log("viewcells: state -> " + c.save + " (continue with --resume)");
   }
   out.stats = solver->stats();
+  if (measured_stop)
+    out.stats.stop_reason = "measured pixel error at most " + fmt(c.measured_error, 3) + " (mean of " +
+                            std::to_string(c.measure_cameras) + " cameras)";
   // The sampled PVSs (filtered, when asked) replace the construction ones, compressed through
   // the hierarchy.
   VisibilityFilter filter = c.filter;
@@ -249,7 +301,11 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   write_pvs_checked(c.output, pf, lists);
   out.pixel_error = solver->pixel_error();
   out.pixel_error_bound = solver->pixel_error_bound();
-  if (cams) measure(c, scenes, *cams, *solver, written, out, log);
+  if (cams && measured_stop && !out.filtering) {
+    out.measured = out.measured_curve.back().measured;  // the PVSs written were measured last
+  } else if (cams) {
+    measure(c, scenes, *cams, *solver, written, out, log);
+  }
   const double err = out.pixel_error, bound = out.pixel_error_bound;
   log("viewcells: " + std::to_string(out.stats.samples) + " samples (" + std::to_string(out.stats.rays) + " rays) in " +
       fmt(out.stats.seconds, 2) + " s; mean PVS " + fmt(out.mean_pvs, 1) + " objects; estimated pixel error " +

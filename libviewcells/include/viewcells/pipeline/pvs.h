@@ -28,6 +28,12 @@ struct PvsConfig {
   /// (ascending; those beyond the stopping rule are not reached), with the same cameras. The
   /// solver's clock does not run while measuring.
   std::vector<uint64_t> measure_at;
+  /// With measure_cameras: a stopping rule by measured error. The PVSs are measured after one
+  /// batch, then at every doubling of the samples, and sampling stops at the first measurement
+  /// whose cameras show at most this many wrong pixels on average (scaled to the estimator's
+  /// resolution, 1024 x 1024 by default: the paper's pixel error, measured instead of estimated),
+  /// or when another limit is reached first. 0: not used.
+  double measured_error = 0;
   std::string save, resume, edited_from;
   double save_every = 0;  ///< with `save`: also write the state every this many seconds (a checkpoint)
   std::vector<std::string> references;
