@@ -53,9 +53,11 @@ for n in 1 2 3; do
     -o "c$n" || bad "compare on $n ranks"
   for f in c0/*.csv; do same_files "compare, $n ranks" "$f" "c$n/$(basename "$f")"; done
 done
-# REF and SGVS, the visibility filter's densities (partitioned with the cells, then combined), and
-# AGVS's mutation lanes (each drawn and fed by its own rank, combined at the end).
-for extra in "--method ref" "--method sgvs" "--filter" "--mutation-lanes 5"; do
+# REF and SGVS, the visibility filter's densities (partitioned with the cells, then combined),
+# AGVS's mutation lanes (each drawn and fed by its own rank, combined at the end), and stopping
+# on a measured error (every rank measures the same table and stops at the same batch).
+for extra in "--method ref" "--method sgvs" "--filter" "--mutation-lanes 5" \
+  "--measure-cameras 64 --measure-size 64 --measured-error 1 --mutation-lanes 9"; do
   # shellcheck disable=SC2086
   "$VC" -q pvs office.vcells --scene office.obj --cells 12 --samples 30000 --batch 5000 $extra -o x0.pvs || bad "pvs $extra"
   # shellcheck disable=SC2086
