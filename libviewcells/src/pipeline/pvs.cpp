@@ -121,6 +121,24 @@ FrameConfig measuring_frame(const PvsConfig& c, const PvsResult& out) {
   return FrameConfig{c.measure_size, c.measure_size, 90.0, out.agvs.resolution};
 }
 
+/// The solver's PVSs now, measured by the cameras, appended to out.measured_curve.
+const MeasuredPoint& measure_now(const PvsConfig& c, const Scenes& s, const CameraSet& cams, const AgvsSolver& solver,
+                                 PvsResult& out, const Log& log) {
+  const AgvsStats& st = solver.stats();
+  MeasuredPoint p;
+  p.samples = st.samples;
+  p.rays = st.rays;
+  p.seconds = st.seconds;
+  p.mean_pvs = solver.mean_pvs();
+  p.estimated = solver.pixel_error();
+  p.measured = measure_frames(s.scene, *s.caster, cams.cameras, cams.cells, solver.pvs(), measuring_frame(c, out));
+  p.measured.wrong.clear();
+  log("viewcells: after " + std::to_string(p.samples) + " samples (" + fmt(p.seconds, 2) + " s): measured pixel error " +
+      fmt(p.measured.pixels, 3) + " (median camera " + fmt(p.measured.median_pixels, 3) + ")");
+  out.measured_curve.push_back(std::move(p));
+  return out.measured_curve.back();
+}
+
 /// Runs the solver up to each of c.measure_at and measures its PVSs there.
 void measured_run(const PvsConfig& c, const Scenes& s, const CameraSet& cams, AgvsSolver& solver, PvsResult& out,
                   const Log& log) {
@@ -129,19 +147,8 @@ void measured_run(const PvsConfig& c, const Scenes& s, const CameraSet& cams, Ag
     if (a.max_samples && n > a.max_samples) break;
     solver.set_limits(n, a.max_seconds, 0);
     solver.run();
-    const AgvsStats& st = solver.stats();
-    MeasuredPoint p;
-    p.samples = st.samples;
-    p.rays = st.rays;
-    p.seconds = st.seconds;
-    p.mean_pvs = solver.mean_pvs();
-    p.estimated = solver.pixel_error();
-    p.measured = measure_frames(s.scene, *s.caster, cams.cameras, cams.cells, solver.pvs(), measuring_frame(c, out));
-    p.measured.wrong.clear();
-    log("viewcells: after " + std::to_string(p.samples) + " samples (" + fmt(p.seconds, 2) + " s): measured pixel error " +
-        fmt(p.measured.pixels, 3));
-    out.measured_curve.push_back(std::move(p));
-    if (a.max_seconds > 0 && st.seconds >= a.max_seconds) break;
+    measure_now(c, s, cams, solver, out, log);
+    if (a.max_seconds > 0 && solver.stats().seconds >= a.max_seconds) break;
   }
   solver.set_limits(a.max_samples, a.max_seconds, a.pixel_error);
 }
@@ -159,19 +166,7 @@ bool run_to_measured_error(const PvsConfig& c, const Scenes& s, const CameraSet&
     solver.set_limits(until, a.max_seconds, a.pixel_error);
     solver.run();
     const AgvsStats& st = solver.stats();
-    MeasuredPoint p;
-    p.samples = st.samples;
-    p.rays = st.rays;
-    p.seconds = st.seconds;
-    p.mean_pvs = solver.mean_pvs();
-    p.estimated = solver.pixel_error();
-    p.measured = measure_frames(s.scene, *s.caster, cams.cameras, cams.cells, solver.pvs(), measuring_frame(c, out));
-    p.measured.wrong.clear();
-    const double error = p.measured.pixels;
-    log("viewcells: after " + std::to_string(p.samples) + " samples (" + fmt(p.seconds, 2) +
-        " s): measured pixel error " + fmt(error, 3) + " (median camera " + fmt(p.measured.median_pixels, 3) + ")");
-    out.measured_curve.push_back(std::move(p));
-    if (error <= c.measured_error) return true;
+    if (measure_now(c, s, cams, solver, out, log).measured.pixels <= c.measured_error) return true;
     // Another limit: the samples, the time, or the estimator's error (the solver's own stop).
     const double estimated = solver.pixel_error(), bound = solver.pixel_error_bound();
     if (st.samples < until || (a.max_samples && st.samples >= a.max_samples) ||
