@@ -183,6 +183,8 @@ TEST(Pipeline, PvsStopsAtAMeasuredError) {
   EXPECT_EQ(limited.stats.stop_reason.find("measured"), std::string::npos) << limited.stats.stop_reason;
   EXPECT_GE(limited.stats.samples, 1500u);
   EXPECT_EQ(limited.stats.samples, limited.measured_curve.back().samples);
+  ASSERT_TRUE(limited.measured);
+  EXPECT_EQ(limited.measured->pixels, limited.measured_curve.back().measured.pixels);
   // The rule needs cameras, and chooses its own measurements.
   c.measure_cameras = 0;
   EXPECT_THROW(pipeline::compute_pvs(c, quiet), Error);

@@ -296,8 +296,9 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   write_pvs_checked(c.output, pf, lists);
   out.pixel_error = solver->pixel_error();
   out.pixel_error_bound = solver->pixel_error_bound();
-  if (cams && measured_stop && !out.filtering) {
-    out.measured = out.measured_curve.back().measured;  // the PVSs written were measured last
+  if (cams && c.measured_error > 0 && !out.filtering) {
+    // The rule's last measurement, whatever stopped it, was of the PVSs written.
+    out.measured = out.measured_curve.back().measured;
   } else if (cams) {
     measure(c, scenes, *cams, *solver, written, out, log);
   }
