@@ -83,11 +83,15 @@ uint32_t AgvsSolver::Impl::draw_mutations(uint64_t index, const uint32_t want[kD
   const auto start = std::chrono::steady_clock::now();
   // Each of this rank's lanes takes its candidates and random numbers in order; the silhouette
   // searches then run in parallel over all of them.
+  // Per lane: its samples of the two mutations (0: silhouette, 1: two-point), in order.
+  constexpr int kMutations[2] = {kSil, kTpm};
+  struct LaneCounts {  // what every rank learns of a lane (the points are only its owner's)
+    uint64_t samples[2] = {0, 0}, failed = 0, discovery_rays = 0;
+  };
   struct LaneDraw {
     std::vector<SilhouetteJob> sil;
-    std::vector<Vec3> sil_points, sil_dirs, tpm_points, tpm_dirs;
-    uint32_t sil_failed = 0, tpm_failed = 0;
-    uint64_t sil_rays = 0;
+    std::vector<Vec3> points[2], dirs[2];
+    LaneCounts counts;
   };
   const size_t n_lanes = lanes.size();
   std::vector<LaneDraw> draws(n_lanes);
@@ -98,7 +102,7 @@ uint32_t AgvsSolver::Impl::draw_mutations(uint64_t index, const uint32_t want[kD
     Rng rng(config.seed, lane_stream(index, l));
     for (uint32_t k = lane_share(want[kSil], n_lanes, l); k > 0; --k) {
       if (lane.silhouette.empty()) {
-        ++ld.sil_failed;
+        ++ld.counts.failed;
         continue;
       }
       SilhouetteJob job;
@@ -109,11 +113,11 @@ uint32_t AgvsSolver::Impl::draw_mutations(uint64_t index, const uint32_t want[kD
     for (uint32_t k = lane_share(want[kTpm], n_lanes, l); k > 0; --k) {
       Vec3 p, dir;
       if (!draw_two_point_mutation(rng, lane, p, dir)) {
-        ++ld.tpm_failed;
+        ++ld.counts.failed;
         continue;
       }
-      ld.tpm_points.push_back(p);
-      ld.tpm_dirs.push_back(dir);
+      ld.points[1].push_back(p);
+      ld.dirs[1].push_back(dir);
     }
   });
   std::vector<std::pair<uint32_t, uint32_t>> jobs;  // (lane, job)
@@ -125,59 +129,57 @@ uint32_t AgvsSolver::Impl::draw_mutations(uint64_t index, const uint32_t want[kD
       job.n = silhouette_samples(job.candidate, job.u, job.points, job.dirs, job.rays);
     }
   });
-  for (LaneDraw& ld : draws)
+  std::vector<LaneCounts> counts(n_lanes);
+  for (size_t l = 0; l < n_lanes; ++l) {
+    LaneDraw& ld = draws[l];
     for (const SilhouetteJob& job : ld.sil) {
-      ld.sil_rays += job.rays;
-      if (job.n == 0) ++ld.sil_failed;
+      ld.counts.discovery_rays += job.rays;
+      if (job.n == 0) ++ld.counts.failed;
       for (int j = 0; j < job.n; ++j) {
-        ld.sil_points.push_back(job.points[j]);
-        ld.sil_dirs.push_back(job.dirs[j]);
+        ld.points[0].push_back(job.points[j]);
+        ld.dirs[0].push_back(job.dirs[j]);
       }
     }
-  // What every lane drew, on every rank: its samples' count (the points are only its owner's:
-  // nothing but casting reads a mutation sample's point), failures and discovery rays.
-  std::vector<std::array<uint64_t, 5>> drawn(n_lanes);
-  for (size_t l = 0; l < n_lanes; ++l) {
-    const LaneDraw& ld = draws[l];
-    drawn[l] = {ld.sil_points.size(), ld.sil_failed, ld.sil_rays, ld.tpm_points.size(), ld.tpm_failed};
+    for (int m = 0; m < 2; ++m) ld.counts.samples[m] = ld.points[m].size();
+    counts[l] = ld.counts;
   }
   if (cluster::size() > 1) {
     std::vector<std::string> items(n_lanes);
     for (size_t l = 0; l < n_lanes; ++l)
       if (my_lane(l)) {
         ByteWriter w;
-        w.put(drawn[l]);
+        w.put(counts[l]);
         items[l] = w.take();
       }
     cluster::share(items, [&](size_t l) { return lane_owner(l); });
     for (size_t l = 0; l < n_lanes; ++l) {
       ByteReader r(items[l], "a rank's mutation draws");
-      drawn[l] = r.get<std::array<uint64_t, 5>>();
-      if (drawn[l][0] > 2 * want[kSil] || drawn[l][3] > want[kTpm]) r.fail("more mutation samples than wanted");
+      counts[l] = r.get<LaneCounts>();
+      if (counts[l].samples[0] > 2 * want[kSil] || counts[l].samples[1] > want[kTpm])
+        r.fail("more mutation samples than wanted");
     }
   }
-  uint32_t failed = 0;
-  auto append = [&](int d, int count_at, auto points_of, auto dirs_of) {
+  for (int m = 0; m < 2; ++m) {
+    const int d = kMutations[m];
     s.first_of[d] = static_cast<uint32_t>(s.points.size());
     for (size_t l = 0; l < n_lanes; ++l) {
-      const uint32_t first = static_cast<uint32_t>(s.points.size()), n = static_cast<uint32_t>(drawn[l][count_at]);
+      const uint32_t first = static_cast<uint32_t>(s.points.size()), n = static_cast<uint32_t>(counts[l].samples[m]);
       if (n == 0) continue;
       s.lane_ranges.push_back({d, static_cast<uint32_t>(l), first, n});
       if (my_lane(l)) {
-        s.points.insert(s.points.end(), points_of(draws[l]).begin(), points_of(draws[l]).end());
-        s.dirs.insert(s.dirs.end(), dirs_of(draws[l]).begin(), dirs_of(draws[l]).end());
+        s.points.insert(s.points.end(), draws[l].points[m].begin(), draws[l].points[m].end());
+        s.dirs.insert(s.dirs.end(), draws[l].dirs[m].begin(), draws[l].dirs[m].end());
       } else {
         s.points.resize(first + n);
         s.dirs.resize(first + n);
       }
     }
     s.end_of[d] = static_cast<uint32_t>(s.points.size());
-  };
-  append(kSil, 0, [](LaneDraw& d) -> auto& { return d.sil_points; }, [](LaneDraw& d) -> auto& { return d.sil_dirs; });
-  append(kTpm, 3, [](LaneDraw& d) -> auto& { return d.tpm_points; }, [](LaneDraw& d) -> auto& { return d.tpm_dirs; });
-  for (const auto& d : drawn) {
-    failed += static_cast<uint32_t>(d[1] + d[4]);
-    s.discovery_rays += d[2];
+  }
+  uint32_t failed = 0;
+  for (const LaneCounts& c : counts) {
+    failed += static_cast<uint32_t>(c.failed);
+    s.discovery_rays += c.discovery_rays;
   }
   stats.mutation_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return failed;
@@ -543,25 +545,21 @@ void AgvsSolver::Impl::add_candidates(const std::vector<BatchChunk>& chunks, con
     }
   }
   start[n_lanes] = placed;
-  std::vector<uint32_t> order(placed);  // segments, by lane, in sample order
+  // The contributing segments, by lane, in sample order: (chunk, segment in the chunk).
+  std::vector<std::pair<uint32_t, uint32_t>> order(placed);
   tbb::parallel_for(size_t{0}, n_chunks, [&](size_t ci) {
     const BatchChunk& c = chunks[ci];
     for (size_t i = 0; i < c.segs.size(); ++i)
-      if (flags[c.seg_start + i] & 3) order[per[lane_of(c, i) * n_chunks + ci]++] = static_cast<uint32_t>(c.seg_start + i);
+      if (flags[c.seg_start + i] & 3)
+        order[per[lane_of(c, i) * n_chunks + ci]++] = {static_cast<uint32_t>(ci), static_cast<uint32_t>(i)};
   });
-  // Segment k's chunk: the last one starting at or before it.
-  auto chunk_of = [&](size_t k) {
-    return std::prev(std::upper_bound(chunks.begin(), chunks.end(), k,
-                                      [](size_t x, const BatchChunk& c) { return x < c.seg_start; }));
-  };
   tbb::parallel_for(size_t{0}, n_lanes, [&](size_t l) {
     MutationLane& lane = lanes[l];
     uint64_t added = 0;
     const bool own = my_lane(l);
     for (size_t at = start[l]; at < start[l + 1]; ++at) {
-      const size_t k = order[at];
-      const BatchChunk& c = *chunk_of(k);
-      const size_t i = k - c.seg_start;
+      const BatchChunk& c = chunks[order[at].first];
+      const size_t i = order[at].second, k = c.seg_start + i;
       const Vec3 ends[2] = {c.segs.a(i), c.segs.b(i)};
       const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
       for (int e = 0; e < 2; ++e) {

@@ -1,11 +1,11 @@
 #include "viewcells/core/cluster.h"
 
+#include <algorithm>
 #include <chrono>
-#include <functional>
 #include <cstdio>
 #include <cstdlib>
-#include <algorithm>
 #include <cstring>
+#include <functional>
 
 #include "viewcells/core/error.h"
 
@@ -106,20 +106,20 @@ void share(std::vector<std::string>& items, const std::function<int(size_t)>& ow
   check(MPI_Allgatherv(mine_bytes.data(), len, MPI_BYTE, all.data(), lens.data(), offsets.data(), MPI_BYTE,
                        MPI_COMM_WORLD),
         "allgatherv");
-  for (int r = 0; r < g_size; ++r) {
+  // One pass over the items, each read from its owner's data where that rank's last one ended.
+  std::vector<uint64_t> pos(g_size);
+  for (int r = 0; r < g_size; ++r) pos[r] = static_cast<uint64_t>(offsets[r]);
+  for (uint64_t i = 0; i < items.size(); ++i) {
+    const int r = owner(i);
     if (r == g_rank) continue;
-    uint64_t pos = static_cast<uint64_t>(offsets[r]);
-    const uint64_t end = pos + static_cast<uint64_t>(lens[r]);
-    for (uint64_t i = 0; i < items.size(); ++i) {
-      if (owner(i) != r) continue;
-      uint64_t n = 0;
-      if (pos + sizeof n > end) throw Error("MPI: a rank sent fewer items than it owns");
-      std::memcpy(&n, all.data() + pos, sizeof n);
-      pos += sizeof n;
-      if (n > end - pos) throw Error("MPI: a rank's item runs past its data");
-      items[i].assign(all.data() + pos, n);
-      pos += n;
-    }
+    const uint64_t end = static_cast<uint64_t>(offsets[r]) + static_cast<uint64_t>(lens[r]);
+    uint64_t n = 0;
+    if (pos[r] + sizeof n > end) throw Error("MPI: a rank sent fewer items than it owns");
+    std::memcpy(&n, all.data() + pos[r], sizeof n);
+    pos[r] += sizeof n;
+    if (n > end - pos[r]) throw Error("MPI: a rank's item runs past its data");
+    items[i].assign(all.data() + pos[r], n);
+    pos[r] += n;
   }
   g_traffic.calls += 1;
   g_traffic.bytes_sent += static_cast<uint64_t>(len);
