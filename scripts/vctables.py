@@ -214,13 +214,13 @@ def merging(*args):
     print("\nThe construction samples' costs (\"cost at\") are not comparable between the two kinds: with AGVS the "
           "leaves' PVSs hold more of what they see. docs/results.md compares them on independent samples.")
     print("\nCompression of the sampled PVSs through the merge history (`viewcells compress`):\n")
-    print("| scene | view cells | objects | PVS entries | kept after | ratio | varint bytes before | after | .pvs file bytes | bit rows bytes | Quake RLE bytes |")
+    print("| scene | view cells | objects | PVS entries | kept after | ratio | list bytes before | after | .pvs file bytes | bit rows bytes | Quake RLE bytes |")
     print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
     for name, counts in [("city", [cells, 5000, 500, 50]), ("office", [2000, 200, 20])]:
         for n in counts:
             r = json.load(open(f"{d}/compress-{name}-{n}.json"))
             print(f"| {name} | {r['cells']:,} | {r['objects']:,} | {r['entries_before']:,} | {r['entries_after']:,} | "
-                  f"{r['entry_ratio']:.3f} | {r['varint_bytes_before']:,} | {r['varint_bytes_after']:,} | {r['file_bytes']:,} | "
+                  f"{r['entry_ratio']:.3f} | {r['list_bytes_before']:,} | {r['list_bytes_after']:,} | {r['file_bytes']:,} | "
                   f"{r['flat']['bit_row_bytes']:,} | {r['flat']['run_length_bytes']:,} |")
 
 
@@ -958,7 +958,7 @@ def shipped(out, err, secs):
              "needs not counted). Ours: `viewcells bake MAP --cells "
              f"CLUSTERS --pixel-error {err} --time {secs}` (1M construction samples, AV-M cells at q3map2's cluster "
              "count, PVSs by AGVS until the estimated error is below the target or the time is up), its storage the "
-             "hierarchy-compressed object lists (varints; the .pvs file adds point location, object names and zstd).\n",
+             "hierarchy-compressed object lists (binary interpolative coding; the .pvs file adds point location, object names and zstd).\n",
              "| map | clusters | q3map2 cost / frame | ours | ours / q3map2 | q3map2 wrong px (mean) | ours wrong px "
              "(mean / median) | cameras wrong (ours) | AGVS estimate | q3map2 rows + leaf lists (B) | ours: lists / .pvs file (B) | bake (s) "
              "| within the rows: cells, ours / q3map2, wrong px | goal (rows / rows + leaf lists) |",

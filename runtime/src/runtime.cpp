@@ -4,6 +4,8 @@
 // read out of bounds, loop or allocate beyond what the file's own size implies.
 #include "viewcells/runtime.h"
 
+#include "id_lists.h"
+
 #include <zstd.h>
 
 #include <algorithm>
@@ -110,7 +112,7 @@ class Reader {
 
 /// The container: magic, version (low 16 bits; the third byte names the writer's Embree
 /// ISA), payload size, FNV-1a checksum, compressed size, zstd frame.
-std::string read_container(const std::string& path) {
+std::string read_container(const std::string& path, uint32_t& version) {
   struct stat st;
   if (stat(path.c_str(), &st) != 0) throw FileError("no such file");
   if (!S_ISREG(st.st_mode)) throw FileError("not a regular file");
@@ -123,8 +125,9 @@ std::string read_container(const std::string& path) {
   r.get<uint32_t>();
   const uint32_t tagged = r.get<uint32_t>();
   if (tagged >> 24) throw FileError("corrupt file: malformed version field");
-  if ((tagged & 0xffff) != 1)
-    throw FileError("format version " + std::to_string(tagged & 0xffff) + " is not supported (this reader reads 1)");
+  version = tagged & 0xffff;
+  if (version != 1 && version != 2)
+    throw FileError("format version " + std::to_string(version) + " is not supported (this reader reads 1 and 2)");
   const uint64_t raw_size = r.get<uint64_t>(), checksum = r.get<uint64_t>(), csize = r.get<uint64_t>();
   if (csize != file.size() - 32) throw FileError("corrupt file: compressed size does not match (truncated?)");
   if (ZSTD_getFrameContentSize(file.data() + 32, csize) != raw_size)
@@ -435,7 +438,7 @@ void read_bsp(Reader& r, vc_pvs& f, uint64_t max_items) {
 }
 
 /// Decodes the kept lists of the hierarchy and expands every cell's visible set.
-void read_lists(Reader& r, vc_pvs& f, uint64_t max_items) {
+void read_lists(Reader& r, vc_pvs& f, uint64_t max_items, uint32_t version) {
   f.cell_count = r.get<uint32_t>();
   const std::vector<int32_t> parent = r.get_array<int32_t>(max_items);
   const std::vector<uint32_t> mht = r.get_array<uint32_t>(max_items);
@@ -447,21 +450,29 @@ void read_lists(Reader& r, vc_pvs& f, uint64_t max_items) {
   for (size_t n = 0; n < total; ++n)
     if (parent[n] != -1 && (parent[n] <= static_cast<int64_t>(n) || static_cast<size_t>(parent[n]) >= total))
       throw FileError("corrupt file: hierarchy node " + std::to_string(n) + " has a bad parent");
-  Reader lr(lists);
   std::vector<std::vector<uint32_t>> stored(total);
-  for (auto& ids : stored) {
-    const uint32_t n = lr.get_varint();
-    if (n > f.object_count) throw FileError("corrupt file: a list holds more entries than there are objects");
-    ids.resize(n);
-    uint64_t previous = 0;
-    for (uint32_t i = 0; i < n; ++i) {
-      const uint64_t id = (i ? previous + 1 : 0) + lr.get_varint();
-      if (id >= f.object_count) throw FileError("corrupt file: object id out of range");
-      ids[i] = static_cast<uint32_t>(id);
-      previous = id;
+  if (version == 1) {  // LEB128 varints of the differences
+    Reader lr(lists);
+    for (auto& ids : stored) {
+      const uint32_t n = lr.get_varint();
+      if (n > f.object_count) throw FileError("corrupt file: a list holds more entries than there are objects");
+      ids.resize(n);
+      uint64_t previous = 0;
+      for (uint32_t i = 0; i < n; ++i) {
+        const uint64_t id = (i ? previous + 1 : 0) + lr.get_varint();
+        if (id >= f.object_count) throw FileError("corrupt file: object id out of range");
+        ids[i] = static_cast<uint32_t>(id);
+        previous = id;
+      }
     }
+    if (!lr.at_end()) throw FileError("corrupt file: trailing bytes after the PVS lists");
+  } else {  // binary interpolative coding (id_lists.h)
+    viewcells::id_lists::BitReader lr(lists.data(), lists.size());
+    for (size_t n = 0; n < total; ++n)
+      if (!viewcells::id_lists::get_list(lr, f.object_count, stored[n]))
+        throw FileError("corrupt file: malformed PVS list of hierarchy node " + std::to_string(n));
+    if (!lr.at_end()) throw FileError("corrupt file: trailing bytes after the PVS lists");
   }
-  if (!lr.at_end()) throw FileError("corrupt file: trailing bytes after the PVS lists");
   // Size first: a path may not repeat an object, so a cell holds at most object_count.
   uint64_t expanded = 0;
   for (uint32_t c = 0; c < f.cell_count; ++c) {
@@ -547,7 +558,8 @@ void build_grid(vc_pvs& f) {
 }
 
 void read_file(const std::string& path, vc_pvs& f) {
-  const std::string payload = read_container(path);
+  uint32_t version = 0;
+  const std::string payload = read_container(path, version);
   Reader r(payload);
   const uint64_t max_items = payload.size();
   f.fingerprint = r.get<uint64_t>();
@@ -567,7 +579,7 @@ void read_file(const std::string& path, vc_pvs& f) {
   }
   if (!box_ok || !(volume > 0)) throw FileError("corrupt file: invalid view box");
   read_bsp(r, f, max_items);
-  read_lists(r, f, max_items);
+  read_lists(r, f, max_items, version);
   for (Node& n : f.nodes) {
     if (n.right != 0) continue;
     if (n.meta >= f.cell_count) throw FileError("corrupt file: a BSP leaf has no view cell");

@@ -118,7 +118,7 @@ void entry_vcells(const uint8_t* data, size_t size) {
 }
 void entry_pvs(const uint8_t* data, size_t size) {
   expecting_errors([&] {
-    const std::string path = container_file(data, size, "VPVS", 1, ".pvs");
+    const std::string path = container_file(data, size, "VPVS", 2, ".pvs");
     // The engines' reader (runtime/) must accept exactly what the toolkit accepts, and then
     // agree with it: the same cells and visible sets at the same points.
     vc_pvs* runtime = nullptr;

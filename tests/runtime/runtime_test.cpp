@@ -4,10 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 
+#include "id_lists.h"
 #include "support/test_scenes.h"
+#include "viewcells/core/binary_file.h"
 #include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/rng.h"
@@ -237,8 +240,17 @@ TEST(Runtime, RefusesWhatIsNotAValidPvsFile) {
   f.pvs.parent[0] = 0;
   EXPECT_TRUE(refused(f));
   f = l.file;
-  f.pvs.stored.back().push_back(f.object_count + 3);
-  EXPECT_TRUE(refused(f));
+  f.pvs.stored.back().push_back(f.object_count + 3);  // not a list the file can hold
+  EXPECT_THROW(write_pvs(bad, f), Error);
+  f = l.file;
+  {  // a cell's path that lists an object twice: a parent keeps what its child keeps too
+    const int32_t p = f.pvs.parent[0];
+    ASSERT_GE(p, 0);
+    ASSERT_FALSE(f.pvs.stored[p].empty());
+    auto& mine = f.pvs.stored[0];
+    mine.insert(std::upper_bound(mine.begin(), mine.end(), f.pvs.stored[p][0]), f.pvs.stored[p][0]);
+    EXPECT_TRUE(refused(f));
+  }
   f = l.file;
   *std::find_if(f.leaf_cell.begin(), f.leaf_cell.end(), [](int32_t c) { return c >= 0; }) = 999;
   EXPECT_TRUE(refused(f));
@@ -251,6 +263,73 @@ TEST(Runtime, RefusesWhatIsNotAValidPvsFile) {
   EXPECT_TRUE(refused(f));
   EXPECT_THROW(runtime::PvsFile{bad}, std::runtime_error);
   EXPECT_NE(vc_pvs_open(nullptr, nullptr, nullptr, 0), 0);
+}
+
+/// The payload of the .pvs at `path` with its PVS lists (the last field: a length, then the
+/// bytes) replaced by `lists`.
+std::string with_lists(const std::string& path, const std::string& lists, uint32_t* version) {
+  std::string payload = read_container(path, "VPVS", 2, *version);
+  uint64_t n = 0;
+  // The lists are the payload's tail: find the length field that spans exactly to the end.
+  for (size_t at = payload.size() - 8;; --at) {
+    std::memcpy(&n, payload.data() + at, 8);
+    if (n == payload.size() - at - 8) {
+      payload.resize(at);
+      break;
+    }
+    if (at == 0) ADD_FAILURE() << "no lists found";
+  }
+  n = lists.size();
+  payload.append(reinterpret_cast<const char*>(&n), 8);
+  return payload + lists;
+}
+
+TEST(Runtime, ReadsVersionOneAndRefusesMalformedLists) {
+  const Level& l = level();
+  const std::string path = test::temp_path("lists.pvs");
+  // Version 1 (files written before the interpolative coding): varints of the differences.
+  std::string varints;
+  auto put = [&](uint32_t v) {
+    for (; v >= 0x80; v >>= 7) varints.push_back(static_cast<char>((v & 0x7f) | 0x80));
+    varints.push_back(static_cast<char>(v));
+  };
+  for (const auto& ids : l.file.pvs.stored) {
+    put(static_cast<uint32_t>(ids.size()));
+    for (size_t i = 0; i < ids.size(); ++i) put(i ? ids[i] - ids[i - 1] - 1 : ids[i]);
+  }
+  uint32_t version = 0;
+  write_container(path, "VPVS", 1, with_lists(l.path, varints, &version));
+  EXPECT_EQ(version, 2u) << "the toolkit writes version 2";
+  const PvsFile v1 = read_pvs(path);
+  const runtime::PvsFile r1(path);
+  ASSERT_EQ(v1.pvs.cell_count, l.file.pvs.cell_count);
+  for (uint32_t c = 0; c < v1.pvs.cell_count; ++c) {
+    EXPECT_EQ(v1.pvs.cell_pvs(c), l.file.pvs.cell_pvs(c));
+    const runtime::ObjectList got = r1.objects(static_cast<int32_t>(c));
+    EXPECT_EQ(std::vector<uint32_t>(got.begin(), got.end()), l.file.pvs.cell_pvs(c));
+  }
+  // Version 2 lists cut short, with a byte or a padding bit too many, or a size beyond the
+  // objects: both readers refuse them.
+  const std::string good = id_lists::encode(l.file.pvs.stored, l.file.object_count);
+  ASSERT_GT(good.size(), 4u);
+  std::vector<uint32_t> too_many(l.file.object_count + 1);
+  for (uint32_t i = 0; i < too_many.size(); ++i) too_many[i] = i;
+  std::vector<std::vector<uint32_t>> oversized = l.file.pvs.stored;
+  oversized[0] = too_many;
+  std::string padded = good;
+  padded.back() = static_cast<char>(padded.back() | 0x80);
+  const bool last_bit_used = good.back() & 0x80;
+  for (const std::string& lists :
+       {good.substr(0, good.size() - 1), good + std::string(1, '\0'), padded, id_lists::encode(oversized, l.file.object_count + 1),
+        std::string(good.size(), '\0')}) {
+    if (lists == padded && last_bit_used) continue;  // no padding bit to set
+    write_container(path, "VPVS", 2, with_lists(l.path, lists, &version));
+    EXPECT_THROW(read_pvs(path), Error);
+    EXPECT_NE(open_code(path), 0);
+  }
+  write_container(path, "VPVS", 2, with_lists(l.path, good, &version));
+  EXPECT_NO_THROW(read_pvs(path));
+  EXPECT_EQ(open_code(path), 0);
 }
 
 }  // namespace

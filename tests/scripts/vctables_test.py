@@ -243,7 +243,7 @@ class Tables(unittest.TestCase):
             for c in counts:
                 dump(f"{self.d}/compress-{name}-{c}.json", {
                     "cells": c, "objects": 10, "entries_before": 100, "entries_after": 40, "entry_ratio": 0.4,
-                    "varint_bytes_before": 150, "varint_bytes_after": 60, "file_bytes": 500,
+                    "list_bytes_before": 150, "list_bytes_after": 60, "file_bytes": 500,
                     "flat": {"bit_row_bytes": 20, "run_length_bytes": 15}})
         with open(f"{self.d}/merge-stage.txt", "w") as f:
             f.write("run 0: cells 8, neighbour graph 0.300 s, merge 1.500 s\n"

@@ -49,7 +49,7 @@ ViewCellSet extract_by_file_size(const SubdivisionFile& file, uint64_t bytes, bo
   };
   auto bytes_of = [&](size_t count) {
     const PvsFile pf = pvs_file_for(file, cut(count));
-    return lists_only ? varint_bytes(pf.pvs.stored) : pvs_file_bytes(pf);
+    return lists_only ? list_bytes(pf.pvs.stored, pf.object_count) : pvs_file_bytes(pf);
   };
   const size_t n = largest_fitting(h.min_cells(), h.leaf_count, bytes, bytes_of);
   if (n == 0)
@@ -124,8 +124,8 @@ CompressResult compress(const CompressConfig& config, const Log& log) {
   out.objects = pf.object_count;
   out.hierarchy_nodes = pf.pvs.node_count();
   out.entries_after = pf.pvs.stored_entries();
-  out.varint_bytes_before = varint_bytes(flat);
-  out.varint_bytes_after = varint_bytes(pf.pvs.stored);
+  out.list_bytes_before = list_bytes(flat, pf.object_count);
+  out.list_bytes_after = list_bytes(pf.pvs.stored, pf.object_count);
   write_pvs_checked(config.output, pf, flat);
   out.file_bytes = std::filesystem::file_size(staged_path(config.output));
   log("viewcells: " + std::to_string(out.cells) + " view cells (" + set.rule + "): " +

@@ -324,8 +324,8 @@ std::string report_json(const CompressResult& r) {
                  {"entry_ratio", r.entries_before ? double(r.entries_after) / r.entries_before : 1.0},
                  {"raw_bytes_before", 4 * r.entries_before},
                  {"raw_bytes_after", 4 * r.entries_after},
-                 {"varint_bytes_before", r.varint_bytes_before},
-                 {"varint_bytes_after", r.varint_bytes_after},
+                 {"list_bytes_before", r.list_bytes_before},
+                 {"list_bytes_after", r.list_bytes_after},
                  {"file_bytes", r.file_bytes},
                  {"seconds", r.seconds}};
   if (!r.flat.empty())

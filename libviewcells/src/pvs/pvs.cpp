@@ -8,6 +8,7 @@
 #include "viewcells/bsp/bsp_io.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/binary_file.h"
+#include "id_lists.h"
 
 namespace viewcells {
 
@@ -79,25 +80,8 @@ PvsHierarchy compress_pvs(const MergeHistory& h, const std::vector<int32_t>& cel
 
 namespace {
 
-void put_varint(std::string& out, uint32_t v) {
-  while (v >= 0x80) {
-    out.push_back(static_cast<char>((v & 0x7f) | 0x80));
-    v >>= 7;
-  }
-  out.push_back(static_cast<char>(v));
-}
-
-std::string encode_list(const std::vector<uint32_t>& ids) {
-  std::string out;
-  put_varint(out, static_cast<uint32_t>(ids.size()));
-  uint32_t previous = 0;
-  for (size_t i = 0; i < ids.size(); ++i) {
-    put_varint(out, i ? ids[i] - previous - 1 : ids[i]);
-    previous = ids[i];
-  }
-  return out;
-}
-
+/// Version 1's lists: each a LEB128 varint count, then the differences between successive ids
+/// (minus one) as varints. Read for files written before version 2.
 uint32_t get_varint(ByteReader& r) {
   uint32_t v = 0;
   for (int shift = 0; shift < 35; shift += 7) {
@@ -108,7 +92,7 @@ uint32_t get_varint(ByteReader& r) {
   r.fail("malformed varint");
 }
 
-std::vector<uint32_t> decode_list(ByteReader& r, uint32_t object_count) {
+std::vector<uint32_t> decode_varint_list(ByteReader& r, uint32_t object_count) {
   const uint32_t n = get_varint(r);
   if (n > object_count) r.fail("a list holds more entries than there are objects");
   std::vector<uint32_t> ids(n);
@@ -123,15 +107,15 @@ std::vector<uint32_t> decode_list(ByteReader& r, uint32_t object_count) {
 }
 
 constexpr char kMagic[5] = "VPVS";
-constexpr uint32_t kVersion = 1;
+constexpr uint32_t kVersion = 2;  // 2: lists by binary interpolative coding (id_lists.h)
 constexpr char kFlatMagic[5] = "VFLT";
 
 }  // namespace
 
-uint64_t varint_bytes(const std::vector<std::vector<uint32_t>>& lists) {
-  uint64_t n = 0;
-  for (const auto& l : lists) n += encode_list(l).size();
-  return n;
+uint64_t list_bytes(const std::vector<std::vector<uint32_t>>& lists, uint32_t object_count) {
+  for (const auto& l : lists)
+    for (size_t i = 0; i < l.size(); ++i) VC_CHECK(l[i] < object_count && (i == 0 || l[i - 1] < l[i]));
+  return id_lists::encoded_bytes(lists, object_count);
 }
 
 std::string rle_row(const std::vector<uint32_t>& pvs, uint32_t object_count) {
@@ -267,9 +251,15 @@ std::string pvs_payload(const PvsFile& f) {
   w.put<uint32_t>(f.pvs.cell_count);
   w.put_array(f.pvs.parent);
   w.put_array(f.cell_mht_node);
-  std::string lists;
-  for (const auto& l : f.pvs.stored) lists += encode_list(l);
-  w.put_string(lists);
+  // The coding holds only sorted ids below the object count: refuse to write anything else.
+  for (size_t n = 0; n < f.pvs.stored.size(); ++n) {
+    const std::vector<uint32_t>& l = f.pvs.stored[n];
+    for (size_t i = 0; i < l.size(); ++i)
+      if (l[i] >= f.object_count || (i && l[i - 1] >= l[i]))
+        throw Error("the PVS list of hierarchy node " + std::to_string(n) + " is not sorted ids below the " +
+                    std::to_string(f.object_count) + " objects");
+  }
+  w.put_string(id_lists::encode(f.pvs.stored, f.object_count));
   return w.data();
 }
 
@@ -338,10 +328,18 @@ PvsFile read_pvs(const std::string& path) {
     if (p != -1 && (p <= static_cast<int32_t>(n) || p >= static_cast<int32_t>(total)))
       r.fail("hierarchy node " + std::to_string(n) + " has a bad parent");
   }
-  ByteReader lr(lists, path);
   f.pvs.stored.resize(total);
-  for (auto& l : f.pvs.stored) l = decode_list(lr, f.object_count);
-  if (!lr.at_end()) r.fail("trailing bytes after the PVS lists");
+  if (version == 1) {
+    ByteReader lr(lists, path);
+    for (auto& l : f.pvs.stored) l = decode_varint_list(lr, f.object_count);
+    if (!lr.at_end()) r.fail("trailing bytes after the PVS lists");
+  } else {
+    id_lists::BitReader lr(lists.data(), lists.size());
+    for (size_t n = 0; n < total; ++n)
+      if (!id_lists::get_list(lr, f.object_count, f.pvs.stored[n]))
+        r.fail("malformed PVS list of hierarchy node " + std::to_string(n));
+    if (!lr.at_end()) r.fail("trailing bytes after the PVS lists");
+  }
   for (uint32_t c = 0; c < f.pvs.cell_count; ++c) {
     // Kept lists along a path are disjoint by construction; a repeat means corruption.
     const std::vector<uint32_t> pvs = f.pvs.cell_pvs(c);

@@ -31,7 +31,7 @@ size_t largest_fitting(size_t lo, size_t hi, uint64_t memory, const std::functio
 /// The most view cells of the history whose .pvs file, with the hierarchy's own PVSs (what
 /// compress writes: point location, hierarchy and compressed lists), is at most `bytes`
 /// long, measured. Error naming the smallest file when not even the coarsest cut fits. With
-/// `lists_only`, the budget holds for the compressed PVS lists alone (varints; no point
+/// `lists_only`, the budget holds for the compressed PVS lists alone (as the file codes them; no point
 /// location, names or container), what stands against a map compiler's vis rows.
 ViewCellSet extract_by_file_size(const SubdivisionFile& file, uint64_t bytes, bool lists_only = false);
 
@@ -70,7 +70,7 @@ struct CompressResult {
   std::string input, output, flat, rule;
   uint32_t cells = 0, objects = 0;
   uint64_t hierarchy_nodes = 0, entries_before = 0, entries_after = 0;
-  uint64_t varint_bytes_before = 0, varint_bytes_after = 0, file_bytes = 0;
+  uint64_t list_bytes_before = 0, list_bytes_after = 0, file_bytes = 0;
   uint64_t flat_bit_row_bytes = 0, flat_run_length_bytes = 0, flat_file_bytes = 0;
   double seconds = 0;
 };

@@ -69,7 +69,7 @@ struct MeasureResult {
   uint32_t cells = 0, objects = 0;
   uint64_t pvs_entries = 0;
   uint64_t storage_bytes = 0;     ///< the .pvs file, or q3map2's uncompressed cluster rows
-  /// The PVSs alone: a .pvs's hierarchy-compressed object lists (varints, before the file's
+  /// The PVSs alone: a .pvs's hierarchy-compressed object lists (as the file codes them, before its
   /// zstd; without point location and object names), or q3map2's rows.
   uint64_t pvs_bytes = 0;
   uint64_t leaf_surface_bytes = 0;  ///< q3map2 only: the leaf -> surface lists its renderer also needs

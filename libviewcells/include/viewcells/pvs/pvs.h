@@ -33,9 +33,10 @@ struct PvsHierarchy {
 PvsHierarchy compress_pvs(const MergeHistory& h, const std::vector<int32_t>& cells,
                           const std::vector<std::vector<uint32_t>>& cell_pvs);
 
-/// Bytes of sorted id lists stored as differences in LEB128 varints (the .pvs encoding, before
-/// the container's zstd).
-uint64_t varint_bytes(const std::vector<std::vector<uint32_t>>& lists);
+/// Bytes of sorted id lists below `object_count` as the .pvs file codes them (binary
+/// interpolative coding, runtime/src/id_lists.h; before the container's zstd, which finds
+/// little more in them). Linear in the entries.
+uint64_t list_bytes(const std::vector<std::vector<uint32_t>>& lists, uint32_t object_count);
 
 /// One Quake-style row: bit o set for every object o of `pvs`, then zero bytes coded as
 /// (0, run length <= 255).

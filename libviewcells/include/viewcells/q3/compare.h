@@ -49,7 +49,7 @@ struct Q3Comparison {
   // Storage.
   uint64_t q3_row_bytes = 0;            ///< q3map2's uncompressed cluster rows
   uint64_t q3_leaf_surface_bytes = 0;   ///< the leaf -> surface lists the renderer also needs
-  uint64_t ours_compressed_bytes = 0;   ///< AV-M cells at cluster_count: hierarchy-compressed lists (varints)
+  uint64_t ours_compressed_bytes = 0;   ///< AV-M cells at cluster_count: hierarchy-compressed lists (as the .pvs codes them)
   uint64_t ours_rle_bytes = 0;          ///< the same cells as Quake-style RLE object rows
   double build_seconds = 0;             ///< AV-S + merging
 };
