@@ -15,6 +15,7 @@
 #include "viewcells/core/error.h"
 #include "viewcells/core/rng.h"
 #include "viewcells/merge/merge.h"
+#include "viewcells/pipeline/cut.h"
 #include "viewcells/pvs/pvs.h"
 #include "viewcells/runtime.hpp"
 #include "viewcells/scene/generators.h"
@@ -308,6 +309,18 @@ TEST(Runtime, ReadsVersionOneAndRefusesMalformedLists) {
     const runtime::ObjectList got = r1.objects(static_cast<int32_t>(c));
     EXPECT_EQ(std::vector<uint32_t>(got.begin(), got.end()), l.file.pvs.cell_pvs(c));
   }
+  // recode rewrites it in the current format: the same PVSs in fewer bytes.
+  const std::string recoded = test::temp_path("recoded.pvs");
+  const pipeline::RecodeResult rr = pipeline::recode(path, recoded, [](const std::string&) {});
+  EXPECT_EQ(rr.version_before, 1u);
+  EXPECT_EQ(rr.list_bytes_before, varints.size());
+  EXPECT_LT(rr.list_bytes_after, rr.list_bytes_before);
+  uint32_t format = 0;
+  const PvsFile v2 = read_pvs(recoded, &format);
+  EXPECT_EQ(format, 2u);
+  EXPECT_EQ(v2.pvs.stored, l.file.pvs.stored);
+  EXPECT_EQ(v2.leaf_cell, l.file.leaf_cell);
+  EXPECT_EQ(v2.object_names, l.file.object_names);
   // Version 2 lists cut short, with a byte or a padding bit too many, or a size beyond the
   // objects: both readers refuse them.
   const std::string good = id_lists::encode(l.file.pvs.stored, l.file.object_count);

@@ -83,6 +83,23 @@ void write_pvs_checked(const std::string& path, const PvsFile& pf, const std::ve
     if (back.pvs.cell_pvs(i) != lists[i]) throw Error(path, 0, "read-back check failed for cell " + std::to_string(i));
 }
 
+RecodeResult recode(const std::string& input, const std::string& output, const Log& log) {
+  RecodeResult out;
+  const PvsFile pf = read_pvs(input, &out.version_before);
+  std::vector<std::vector<uint32_t>> lists(pf.pvs.cell_count);
+  for (uint32_t i = 0; i < pf.pvs.cell_count; ++i) lists[i] = pf.pvs.cell_pvs(i);
+  out.file_bytes_before = std::filesystem::file_size(input);
+  out.list_bytes_before = list_bytes(pf.pvs.stored, pf.object_count, out.version_before);
+  out.list_bytes_after = list_bytes(pf.pvs.stored, pf.object_count);
+  write_pvs_checked(output, pf, lists);
+  out.file_bytes_after = std::filesystem::file_size(staged_path(output));
+  log("viewcells: " + input + " (format " + std::to_string(out.version_before) + "): lists " +
+      std::to_string(out.list_bytes_before) + " bytes, file " + std::to_string(out.file_bytes_before) + " bytes -> " +
+      output + ": lists " + std::to_string(out.list_bytes_after) + " bytes, file " +
+      std::to_string(out.file_bytes_after) + " bytes");
+  return out;
+}
+
 ExtractResult extract(const ExtractConfig& config, const Log& log) {
   ExtractResult out;
   out.input = config.hierarchy_path;

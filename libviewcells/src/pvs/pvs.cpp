@@ -112,9 +112,19 @@ constexpr char kFlatMagic[5] = "VFLT";
 
 }  // namespace
 
-uint64_t list_bytes(const std::vector<std::vector<uint32_t>>& lists, uint32_t object_count) {
+uint64_t list_bytes(const std::vector<std::vector<uint32_t>>& lists, uint32_t object_count, uint32_t format) {
+  VC_CHECK(format == 1 || format == kVersion);
   for (const auto& l : lists)
     for (size_t i = 0; i < l.size(); ++i) VC_CHECK(l[i] < object_count && (i == 0 || l[i - 1] < l[i]));
+  if (format == 1) {
+    auto varint = [](uint32_t v) { return v < (1u << 7) ? 1 : v < (1u << 14) ? 2 : v < (1u << 21) ? 3 : v < (1u << 28) ? 4 : 5; };
+    uint64_t n = 0;
+    for (const auto& l : lists) {
+      n += varint(static_cast<uint32_t>(l.size()));
+      for (size_t i = 0; i < l.size(); ++i) n += varint(i ? l[i] - l[i - 1] - 1 : l[i]);
+    }
+    return n;
+  }
   return id_lists::encoded_bytes(lists, object_count);
 }
 
@@ -269,9 +279,10 @@ void write_pvs(const std::string& path, const PvsFile& f) { write_container(path
 
 uint64_t pvs_file_bytes(const PvsFile& f) { return container_image(kMagic, kVersion, pvs_payload(f)).size(); }
 
-PvsFile read_pvs(const std::string& path) {
+PvsFile read_pvs(const std::string& path, uint32_t* format) {
   uint32_t version = 0;
   const std::string payload = read_container(path, kMagic, kVersion, version);
+  if (format) *format = version;
   ByteReader r(payload, path);
   PvsFile f;
   const uint64_t max_items = payload.size();

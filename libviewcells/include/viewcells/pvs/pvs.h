@@ -35,8 +35,9 @@ PvsHierarchy compress_pvs(const MergeHistory& h, const std::vector<int32_t>& cel
 
 /// Bytes of sorted id lists below `object_count` as the .pvs file codes them (binary
 /// interpolative coding, runtime/src/id_lists.h; before the container's zstd, which finds
-/// little more in them). Linear in the entries.
-uint64_t list_bytes(const std::vector<std::vector<uint32_t>>& lists, uint32_t object_count);
+/// little more in them). Linear in the entries. `format` 1 gives what format 1 took (LEB128
+/// varints of the differences).
+uint64_t list_bytes(const std::vector<std::vector<uint32_t>>& lists, uint32_t object_count, uint32_t format = 2);
 
 /// One Quake-style row: bit o set for every object o of `pvs`, then zero bytes coded as
 /// (0, run length <= 255).
@@ -69,8 +70,9 @@ PvsFile make_pvs_file(const Subdivision& s, const std::vector<std::vector<uint32
 void write_pvs(const std::string& path, const PvsFile& f);
 /// The size in bytes of the file write_pvs writes for `f`, measured without writing it.
 uint64_t pvs_file_bytes(const PvsFile& f);
-/// Reads and validates a `.pvs` file; any inconsistency is an Error naming the file.
-PvsFile read_pvs(const std::string& path);
+/// Reads and validates a `.pvs` file of any format this build reads (1 and 2; `format`, when
+/// given, receives the file's); any inconsistency is an Error naming the file.
+PvsFile read_pvs(const std::string& path, uint32_t* format = nullptr);
 
 /// Writes the flat rows of every view cell (Quake-style run-length coding) as a checksummed
 /// container; returns the bytes of the rows (without the container's own compression).
