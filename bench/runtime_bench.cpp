@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "viewcells/runtime.hpp"
@@ -116,8 +117,30 @@ void BM_LocateAndBitRow(benchmark::State& state) {
   counters(state);
 }
 
+/// Opening the file, as an engine does when a level loads: zstd, decoding the lists and
+/// expanding every cell's visible set. VIEWCELLS_BENCH_PVS_FORMAT1 may name the same cells
+/// written in format 1 (`viewcells recode --format 1`), timed the same way.
+void open_file(benchmark::State& state, const char* variable) {
+  const char* path = std::getenv(variable);
+  if (!path) {
+    state.SkipWithError((std::string(variable) + " is not set").c_str());
+    return;
+  }
+  size_t cells = 0;
+  for (auto _ : state) {
+    const viewcells::runtime::PvsFile f(path);
+    cells += f.cell_count();
+  }
+  benchmark::DoNotOptimize(cells);
+  state.SetItemsProcessed(state.iterations());
+}
+void BM_Open(benchmark::State& state) { open_file(state, "VIEWCELLS_BENCH_PVS"); }
+void BM_OpenFormat1(benchmark::State& state) { open_file(state, "VIEWCELLS_BENCH_PVS_FORMAT1"); }
+
 }  // namespace
 
+BENCHMARK(BM_Open)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_OpenFormat1)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_Locate);
 BENCHMARK(BM_LocateAndList);
 BENCHMARK(BM_WalkAndList);

@@ -77,11 +77,12 @@ int run_query(const QueryArgs& q) {
 
 struct RecodeArgs {
   std::string input, output;
+  uint32_t format = 2;
 };
 
 int run_recode(const RecodeArgs& a, const Common& c) {
   check_files({a.input}, {a.output});
-  pipeline::recode(a.input, a.output, c.logger());
+  pipeline::recode(a.input, a.output, a.format, c.logger());
   return 0;
 }
 
@@ -149,6 +150,10 @@ void add_cut_commands(CLI::App& app, const Common& common, Commands& commands) {
                                 "half the bytes of format 1); cells and PVSs are unchanged, checked by reading back");
   re->add_option("pvs", rc->input, "A .pvs file of any format this build reads")->required();
   re->add_option("-o,--output", rc->output, "The .pvs file to write")->required();
+  re->add_option("--format", rc->format,
+                 "Format to write: 2 (the current one), or 1 for engines whose runtime reader predates format 2")
+      ->check(CLI::IsMember({1u, 2u}))
+      ->capture_default_str();
   commands.push_back({re, [rc, &common] { return run_recode(*rc, common); }});
 
   auto v = std::make_shared<ViewArgs>();

@@ -15,11 +15,13 @@ if [ ! -f "$dir/city-merge.vcells" ]; then
     -o "$dir/city-merge.vcells" --report "$dir/merge-city.json"
 fi
 "$vc" compress "$dir/city-merge.vcells" --count "$cells" -o "$dir/city-$cells.pvs" -q
+"$vc" recode "$dir/city-$cells.pvs" --format 1 -o "$dir/city-$cells-format1.pvs" -q
 objects=$(python3 scripts/vctables.py get "$dir/merge-city.json" scene objects)
-VIEWCELLS_BENCH_PVS="$dir/city-$cells.pvs" taskset -c 0 build-release/bench/viewcells_runtime_bench \
+VIEWCELLS_BENCH_PVS="$dir/city-$cells.pvs" VIEWCELLS_BENCH_PVS_FORMAT1="$dir/city-$cells-format1.pvs" taskset -c 0 build-release/bench/viewcells_runtime_bench \
   --benchmark_min_time=1 --benchmark_repetitions=7 --benchmark_report_aggregates_only=true \
   --benchmark_format=json --benchmark_out="$dir/runtime.json" >/dev/null
-python3 scripts/vctables.py runtime "$dir/runtime.json" "$cells" "$objects" > "$dir/runtime-table.md"
+python3 scripts/vctables.py runtime "$dir/runtime.json" "$cells" "$objects" \
+  "$(stat -c %s "$dir/city-$cells.pvs")" "$(stat -c %s "$dir/city-$cells-format1.pvs")" > "$dir/runtime-table.md"
 python3 scripts/vctables.py replace-section BENCHMARKS.md runtime "scripts/bench-runtime.sh $size $cells" \
   "$dir/runtime-table.md"
 cat "$dir/runtime-table.md"

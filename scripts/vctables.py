@@ -1294,16 +1294,17 @@ def compare_methods(path):
     print(" ".join(seen))
 
 
-@command("BENCH_JSON CELLS OBJECTS")
-def runtime(path, cells, objects):
-    """BENCHMARKS.md, runtime: Google Benchmark's JSON of viewcells_runtime_bench."""
+@command("BENCH_JSON CELLS OBJECTS [FILE_BYTES FORMAT1_BYTES]")
+def runtime(path, cells, objects, file_bytes=None, format1_bytes=None):
+    """BENCHMARKS.md, runtime: Google Benchmark's JSON of viewcells_runtime_bench (and the
+    sizes of the .pvs in formats 2 and 1, whose opening it timed)."""
     r = json.load(open(path))
     ctx = r["context"]
     # Medians of the repetitions when there are some, else the single runs.
     medians = {b["run_name"]: b for b in r["benchmarks"] if b.get("aggregate_name") == "median"}
     rows = medians or {b["name"]: b for b in r["benchmarks"] if b.get("run_type", "iteration") == "iteration"}
     reps = max((b.get("repetitions", 1) for b in r["benchmarks"]), default=1)
-    first = next(iter(rows.values()))
+    first = next(b for b in rows.values() if "cells" in b)
     print(f"A .pvs of the city: {int(first['cells']):,} view cells over {int(first['objects']):,} objects "
           f"(`compress --count {int(cells):,}` of the merging benchmark's hierarchy); the reader holds "
           f"{first['memory_MB']:.1f} MB once the file is open. One core (taskset) of {ctx.get('num_cpus', '?')} at "
@@ -1322,6 +1323,18 @@ def runtime(path, cells, objects):
             ns = b["cpu_time"] * {"ns": 1, "us": 1e3, "ms": 1e6}[b.get("time_unit", "ns")]
             print(f"| {label} | {ns:.0f} | {b['items_per_second'] / 1e6:.2f} |")
     print()
+    opened = [(k, f, n) for k, f, n in (("BM_Open", 2, file_bytes), ("BM_OpenFormat1", 1, format1_bytes))
+              if k in rows and not rows[k].get("error_occurred")]
+    if opened:
+        print("Opening the file as a level loads (zstd, decoding the lists, expanding every cell's visible set), "
+              "the same cells in both formats:\n")
+        print("| .pvs format | file bytes | ms to open |")
+        print("| --- | ---: | ---: |")
+        for key, fmt, n in opened:
+            b = rows[key]
+            ms = b["real_time"] * {"ns": 1e-6, "us": 1e-3, "ms": 1, "s": 1e3}[b.get("time_unit", "ns")]
+            print(f"| {fmt} | {int(n):,} | {ms:.0f} |" if n else f"| {fmt} | - | {ms:.0f} |")
+        print()
 
 
 def main(argv):

@@ -311,7 +311,7 @@ TEST(Runtime, ReadsVersionOneAndRefusesMalformedLists) {
   }
   // recode rewrites it in the current format: the same PVSs in fewer bytes.
   const std::string recoded = test::temp_path("recoded.pvs");
-  const pipeline::RecodeResult rr = pipeline::recode(path, recoded, [](const std::string&) {});
+  const pipeline::RecodeResult rr = pipeline::recode(path, recoded, 2, [](const std::string&) {});
   EXPECT_EQ(rr.version_before, 1u);
   EXPECT_EQ(rr.list_bytes_before, varints.size());
   EXPECT_LT(rr.list_bytes_after, rr.list_bytes_before);

@@ -426,6 +426,21 @@ class Tables(unittest.TestCase):
         self.assertIn("| point location only | 125 | 8.00 |", t)
         self.assertIn("| 200 | 5.00 |", t)
         self.assertIn("50,000 view cells over 8,100 objects (`compress --count 50,000`", t)
+        self.assertNotIn("ms to open", t)
+        # Opening the file in both formats, a row each with its bytes; a skipped run is left out.
+        opens = [{"name": "BM_Open", "run_type": "iteration", "real_time": 310.4, "time_unit": "ms",
+                  "items_per_second": 3.2},
+                 {"name": "BM_OpenFormat1", "run_type": "iteration", "real_time": 0.25, "time_unit": "s",
+                  "items_per_second": 4.0}]
+        dump(f"{self.d}/o.json", dict(bench, benchmarks=bench["benchmarks"] + opens))
+        to = run("runtime", f"{self.d}/o.json", 50000, 8100, 1000000, 2000000)
+        self.assertIn("| 2 | 1,000,000 | 310 |", to)
+        self.assertIn("| 1 | 2,000,000 | 250 |", to)
+        skipped = dict(opens[1], error_occurred=True)
+        dump(f"{self.d}/s.json", dict(bench, benchmarks=bench["benchmarks"] + [opens[0], skipped]))
+        ts = run("runtime", f"{self.d}/s.json", 50000, 8100, 1000000, 2000000)
+        self.assertIn("| 2 | 1,000,000 | 310 |", ts)
+        self.assertNotIn("| 1 |", ts)
 
 
 class Cli(unittest.TestCase):

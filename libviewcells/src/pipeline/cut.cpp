@@ -76,26 +76,27 @@ PvsFile pvs_file_for(const SubdivisionFile& file, const ViewCellSet& set) {
   return pf;
 }
 
-void write_pvs_checked(const std::string& path, const PvsFile& pf, const std::vector<std::vector<uint32_t>>& lists) {
-  write_pvs(path, pf);
+void write_pvs_checked(const std::string& path, const PvsFile& pf, const std::vector<std::vector<uint32_t>>& lists,
+                       uint32_t format) {
+  write_pvs(path, pf, format);
   const PvsFile back = read_pvs(staged_path(path));  // a command's outputs are renamed at its end
   for (uint32_t i = 0; i < back.pvs.cell_count; ++i)
     if (back.pvs.cell_pvs(i) != lists[i]) throw Error(path, 0, "read-back check failed for cell " + std::to_string(i));
 }
 
-RecodeResult recode(const std::string& input, const std::string& output, const Log& log) {
+RecodeResult recode(const std::string& input, const std::string& output, uint32_t format, const Log& log) {
   RecodeResult out;
   const PvsFile pf = read_pvs(input, &out.version_before);
   std::vector<std::vector<uint32_t>> lists(pf.pvs.cell_count);
   for (uint32_t i = 0; i < pf.pvs.cell_count; ++i) lists[i] = pf.pvs.cell_pvs(i);
   out.file_bytes_before = std::filesystem::file_size(input);
   out.list_bytes_before = list_bytes(pf.pvs.stored, pf.object_count, out.version_before);
-  out.list_bytes_after = list_bytes(pf.pvs.stored, pf.object_count);
-  write_pvs_checked(output, pf, lists);
+  out.list_bytes_after = list_bytes(pf.pvs.stored, pf.object_count, format);
+  write_pvs_checked(output, pf, lists, format);
   out.file_bytes_after = std::filesystem::file_size(staged_path(output));
   log("viewcells: " + input + " (format " + std::to_string(out.version_before) + "): lists " +
       std::to_string(out.list_bytes_before) + " bytes, file " + std::to_string(out.file_bytes_before) + " bytes -> " +
-      output + ": lists " + std::to_string(out.list_bytes_after) + " bytes, file " +
+      output + " (format " + std::to_string(format) + "): lists " + std::to_string(out.list_bytes_after) + " bytes, file " +
       std::to_string(out.file_bytes_after) + " bytes");
   return out;
 }

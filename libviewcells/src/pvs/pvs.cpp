@@ -81,7 +81,13 @@ PvsHierarchy compress_pvs(const MergeHistory& h, const std::vector<int32_t>& cel
 namespace {
 
 /// Version 1's lists: each a LEB128 varint count, then the differences between successive ids
-/// (minus one) as varints. Read for files written before version 2.
+/// (minus one) as varints. Read for files written before version 2, written on request for
+/// engines whose reader predates it.
+void put_varint(std::string& out, uint32_t v) {
+  for (; v >= 0x80; v >>= 7) out.push_back(static_cast<char>((v & 0x7f) | 0x80));
+  out.push_back(static_cast<char>(v));
+}
+
 uint32_t get_varint(ByteReader& r) {
   uint32_t v = 0;
   for (int shift = 0; shift < 35; shift += 7) {
@@ -238,7 +244,7 @@ PvsFile make_pvs_file(const Subdivision& s, const std::vector<std::vector<uint32
 
 namespace {
 
-std::string pvs_payload(const PvsFile& f) {
+std::string pvs_payload(const PvsFile& f, uint32_t format) {
   ByteWriter w;
   w.put<uint64_t>(f.scene_fingerprint);
   w.put<uint32_t>(f.object_count);
@@ -269,15 +275,28 @@ std::string pvs_payload(const PvsFile& f) {
         throw Error("the PVS list of hierarchy node " + std::to_string(n) + " is not sorted ids below the " +
                     std::to_string(f.object_count) + " objects");
   }
-  w.put_string(id_lists::encode(f.pvs.stored, f.object_count));
+  if (format == 1) {
+    std::string lists;
+    for (const auto& l : f.pvs.stored) {
+      put_varint(lists, static_cast<uint32_t>(l.size()));
+      for (size_t i = 0; i < l.size(); ++i) put_varint(lists, i ? l[i] - l[i - 1] - 1 : l[i]);
+    }
+    w.put_string(lists);
+  } else {
+    w.put_string(id_lists::encode(f.pvs.stored, f.object_count));
+  }
   return w.data();
 }
 
 }  // namespace
 
-void write_pvs(const std::string& path, const PvsFile& f) { write_container(path, kMagic, kVersion, pvs_payload(f)); }
+void write_pvs(const std::string& path, const PvsFile& f, uint32_t format) {
+  if (format != 1 && format != kVersion)
+    throw Error(path, 0, "cannot write .pvs format " + std::to_string(format) + " (1 or " + std::to_string(kVersion) + ")");
+  write_container(path, kMagic, format, pvs_payload(f, format));
+}
 
-uint64_t pvs_file_bytes(const PvsFile& f) { return container_image(kMagic, kVersion, pvs_payload(f)).size(); }
+uint64_t pvs_file_bytes(const PvsFile& f) { return container_image(kMagic, kVersion, pvs_payload(f, kVersion)).size(); }
 
 PvsFile read_pvs(const std::string& path, uint32_t* format) {
   uint32_t version = 0;

@@ -42,7 +42,8 @@ SubdivisionFile read_merged(const std::string& path);
 PvsFile pvs_file_for(const SubdivisionFile& file, const ViewCellSet& set);
 
 /// Writes the .pvs file, then reads it back: every cell's PVS must come back as `lists`.
-void write_pvs_checked(const std::string& path, const PvsFile& pf, const std::vector<std::vector<uint32_t>>& lists);
+void write_pvs_checked(const std::string& path, const PvsFile& pf, const std::vector<std::vector<uint32_t>>& lists,
+                       uint32_t format = 2);
 
 struct ExtractConfig {
   std::string hierarchy_path;
@@ -82,9 +83,9 @@ struct RecodeResult {
   uint64_t list_bytes_before = 0, list_bytes_after = 0, file_bytes_before = 0, file_bytes_after = 0;
 };
 
-/// Rewrites the .pvs file `input` as `output` in the current format (format 2 codes the lists
-/// in about half the bytes of format 1), read back and compared cell by cell: the same view
-/// cells, point location, names and PVSs.
-RecodeResult recode(const std::string& input, const std::string& output, const Log& log);
+/// Rewrites the .pvs file `input` as `output` in `format` (2, the current one, codes the lists
+/// in about half the bytes of 1), read back and compared cell by cell: the same view cells,
+/// point location, names and PVSs.
+RecodeResult recode(const std::string& input, const std::string& output, uint32_t format, const Log& log);
 
 }  // namespace viewcells::pipeline

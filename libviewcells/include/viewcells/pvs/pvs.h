@@ -66,8 +66,10 @@ struct PvsFile {
 PvsFile make_pvs_file(const Subdivision& s, const std::vector<std::vector<uint32_t>>& leaf_pvs,
                       const MergeHistory& h, const std::vector<int32_t>& cells);
 
-/// Writes a versioned, checksummed `.pvs` file (atomically).
-void write_pvs(const std::string& path, const PvsFile& f);
+/// Writes a versioned, checksummed `.pvs` file (atomically), in format 2 or, for engines whose
+/// runtime reader predates it, format 1. Error when a kept list is not sorted ids below
+/// f.object_count.
+void write_pvs(const std::string& path, const PvsFile& f, uint32_t format = 2);
 /// The size in bytes of the file write_pvs writes for `f`, measured without writing it.
 uint64_t pvs_file_bytes(const PvsFile& f);
 /// Reads and validates a `.pvs` file of any format this build reads (1 and 2; `format`, when
