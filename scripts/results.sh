@@ -36,7 +36,25 @@ for name in office rotated-office city town town-street; do
   cp "$dir/compare-$name/summary.json" "docs/results/$name-summary.json"
 done
 python3 scripts/vctables.py results "$dir" "$cells" "$samples" "$size" > docs/results.md
-# The Quake 3 maps section is scripts/maps-table.sh's; keep what it last wrote.
+# The Quake 3 sections are scripts/maps-shipped.sh's and scripts/maps-table.sh's; keep what they
+# last wrote.
+cat >> docs/results.md <<'EOF_SHIPPED'
+
+## As shipped: q3map2's PVS against a bake
+
+What a player's frames draw and get wrong with the PVS each side ships, measured by the same
+cameras (`viewcells measure`; see [docs/quake3.md](quake3.md#as-shipped)). The section below
+this one compares partitions (q3map2's clusters scored with our sampled PVSs); this one
+compares the products.
+
+<!-- q3shipped:begin -->
+Not generated yet: run scripts/maps-shipped.sh.
+<!-- q3shipped:end -->
+EOF_SHIPPED
+if [ -f docs/results/q3-shipped.md ] && [ -f docs/results/q3-shipped.command ]; then
+  python3 scripts/vctables.py replace-section docs/results.md q3shipped "$(cat docs/results/q3-shipped.command)" \
+    docs/results/q3-shipped.md
+fi
 printf '\n## Real game levels: OpenArena maps against q3map2\n\n<!-- q3maps:begin -->\nNot generated yet: run scripts/maps-table.sh.\n<!-- q3maps:end -->\n' >> docs/results.md
 if [ -f docs/results/q3-maps.md ] && [ -f docs/results/q3-maps.command ]; then
   python3 scripts/vctables.py replace-section docs/results.md q3maps "$(cat docs/results/q3-maps.command)" docs/results/q3-maps.md

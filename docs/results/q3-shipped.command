@@ -1,1 +1,1 @@
-scripts/maps-shipped.sh 1 45
+SHIPPED_RECODE=1 scripts/maps-shipped.sh 1 45
