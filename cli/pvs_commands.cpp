@@ -231,8 +231,9 @@ void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
                  "and the cells are merged further until it fits")
       ->excludes(cells);
   bk->add_option("--memory-of", a->memory_of,
-                 "What --memory counts: file (the whole .pvs) or lists (the compressed PVS lists alone, without point "
-                 "location and object names: what stands against a map compiler's vis rows)")
+                 "What --memory counts: file (the whole .pvs) or lists (the visible sets alone as an engine's compact "
+                 "handle holds them: the coded lists and 8 bytes a hierarchy node, without point location and object "
+                 "names; what stands against a map compiler's vis rows)")
       ->capture_default_str();
   bk->add_option("--max-cells", a->cells.max_cells,
                  "Elementary cells to build before merging (default: 4 x --cells, or 4096 with --memory)")

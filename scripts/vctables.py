@@ -1309,7 +1309,10 @@ def runtime(path, cells, objects, file_bytes=None, format1_bytes=None):
     first = next(b for b in rows.values() if "cells" in b)
     print(f"A .pvs of the city: {int(first['cells']):,} view cells over {int(first['objects']):,} objects "
           f"(`compress --count {int(cells):,}` of the merging benchmark's hierarchy); the reader holds "
-          f"{first['memory_MB']:.1f} MB once the file is open. One core (taskset) of {ctx.get('num_cpus', '?')} at "
+          f"{first['memory_MB']:.1f} MB once the file is open"
+          + (f" ({first['list_MB']:.1f} MB of them the expanded visible sets), a compact handle "
+             f"(`vc_pvs_open_compact`) {first['compact_memory_MB']:.1f} MB ({first['compact_list_MB']:.1f} MB of "
+             f"coded lists and their index)" if "compact_memory_MB" in first else "") + ". One core (taskset) of {ctx.get('num_cpus', '?')} at "
           f"{ctx.get('mhz_per_cpu', 0) / 1000:.1f} GHz, Google Benchmark; viewpoints uniform in the view box "
           f"(1M drawn once, seed 1) unless said: the worst case for caches, since every query lands somewhere new"
           + (f"; medians of {reps} repetitions" if medians else "") + ".\n")
@@ -1318,14 +1321,17 @@ def runtime(path, cells, objects, file_bytes=None, format1_bytes=None):
     names = {"BM_Locate": "point location only",
              "BM_LocateAndList": "point location + the cell's visible objects (sorted ids)",
              "BM_WalkAndList": "the same along a walk (steps of 0.2% of the box diagonal: frames of a moving camera)",
-             "BM_LocateAndBitRow": f"point location + the cell's bit row ({(int(first['objects']) + 7) // 8:,} bytes, filled)"}
+             "BM_LocateAndBitRow": f"point location + the cell's bit row ({(int(first['objects']) + 7) // 8:,} bytes, filled)",
+             "BM_LocateAndCopyCompact": "compact handle: point location + the cell's objects decoded and copied",
+             "BM_WalkAndCopyCompact": "compact handle, along the walk (decoded when the camera enters another cell)"}
     for key, label in names.items():
         if key in rows:
             b = rows[key]
             ns = b["cpu_time"] * {"ns": 1, "us": 1e3, "ms": 1e6}[b.get("time_unit", "ns")]
             print(f"| {label} | {ns:.0f} | {b['items_per_second'] / 1e6:.2f} |")
     print()
-    opened = [(k, f, n) for k, f, n in (("BM_Open", 2, file_bytes), ("BM_OpenFormat1", 1, format1_bytes))
+    opened = [(k, f, n) for k, f, n in (("BM_Open", "2", file_bytes), ("BM_OpenFormat1", "1", format1_bytes),
+                                          ("BM_OpenCompact", "2, compact handle", file_bytes))
               if k in rows and not rows[k].get("error_occurred")]
     if opened:
         print("Opening the file as a level loads (zstd, decoding the lists, expanding every cell's visible set), "

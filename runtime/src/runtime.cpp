@@ -342,6 +342,13 @@ struct vc_pvs {
   std::vector<GeneralPlane> planes;
   std::vector<uint64_t> offsets;               // per cell + 1, into ids
   std::vector<uint32_t, LargePages<uint32_t>> ids;  // every cell's visible objects, sorted per cell
+  // A compact handle (vc_pvs_open_compact) keeps the hierarchy's lists coded instead of ids and
+  // offsets: the format 2 coding of every node's list, where each starts (in bits), and each
+  // node's parent. A cell's visible set is decoded along its path when asked for.
+  bool compact = false;
+  std::string coded;
+  std::vector<uint32_t> node_bit;
+  std::vector<int32_t> node_parent;
   // A uniform grid over the view box: per grid cell, the deepest BSP node whose subtree holds
   // the whole grid cell (slightly enlarged), where location starts instead of at the root.
   int grid_n[3] = {1, 1, 1};
@@ -473,6 +480,31 @@ void read_lists(Reader& r, vc_pvs& f, uint64_t max_items, uint32_t version) {
         throw FileError("corrupt file: malformed PVS list of hierarchy node " + std::to_string(n));
     if (!lr.at_end()) throw FileError("corrupt file: trailing bytes after the PVS lists");
   }
+  if (f.compact) {
+    // Each cell's path checked for repeats one cell at a time; only the coding is kept.
+    viewcells::id_lists::BitWriter w;
+    f.node_bit.reserve(total);
+    for (const auto& ids : stored) {
+      if (w.bits() > std::numeric_limits<uint32_t>::max()) throw FileError("the coded lists exceed 2^32 bits");
+      f.node_bit.push_back(static_cast<uint32_t>(w.bits()));
+      viewcells::id_lists::put_list(w, ids.data(), ids.size(), f.object_count);
+    }
+    f.coded = w.finish();
+    f.node_parent = parent;
+    std::vector<uint32_t> cell;
+    for (uint32_t c = 0; c < f.cell_count; ++c) {
+      cell.clear();
+      for (int32_t n = static_cast<int32_t>(c); n >= 0; n = parent[n]) {
+        if (cell.size() + stored[n].size() > f.object_count)
+          throw FileError("corrupt file: cell " + std::to_string(c) + " repeats an object");
+        cell.insert(cell.end(), stored[n].begin(), stored[n].end());
+      }
+      std::sort(cell.begin(), cell.end());
+      if (std::adjacent_find(cell.begin(), cell.end()) != cell.end())
+        throw FileError("corrupt file: cell " + std::to_string(c) + " repeats an object");
+    }
+    return;
+  }
   // Size first: a path may not repeat an object, so a cell holds at most object_count.
   uint64_t expanded = 0;
   for (uint32_t c = 0; c < f.cell_count; ++c) {
@@ -583,6 +615,7 @@ void read_file(const std::string& path, vc_pvs& f) {
   for (Node& n : f.nodes) {
     if (n.right != 0) continue;
     if (n.meta >= f.cell_count) throw FileError("corrupt file: a BSP leaf has no view cell");
+    if (f.compact) continue;  // no expanded lists to point at
     n.list[0] = static_cast<uint32_t>(f.offsets[n.meta]);
     n.list[1] = static_cast<uint32_t>(f.offsets[n.meta + 1] - f.offsets[n.meta]);
   }
@@ -598,7 +631,9 @@ void put_error(char* error, size_t size, const std::string& text) {
 
 extern "C" {
 
-int vc_pvs_open(const char* path, vc_pvs** out, char* error, size_t error_size) {
+namespace {
+
+int open_handle(const char* path, vc_pvs** out, char* error, size_t error_size, bool compact) {
   if (out) *out = nullptr;
   if (!path || !out) {
     put_error(error, error_size, "vc_pvs_open: path and out must not be NULL");
@@ -607,6 +642,7 @@ int vc_pvs_open(const char* path, vc_pvs** out, char* error, size_t error_size) 
   vc_pvs* f = nullptr;
   try {
     f = new vc_pvs;
+    f->compact = compact;
     read_file(path, *f);
   } catch (const FileError& e) {
     delete f;
@@ -625,7 +661,39 @@ int vc_pvs_open(const char* path, vc_pvs** out, char* error, size_t error_size) 
   return 0;
 }
 
+/// A compact handle's cell: the lists along its path decoded into `out`, sorted.
+void decode_cell(const vc_pvs* pvs, uint32_t cell, std::vector<uint32_t>& out) {
+  out.clear();
+  std::vector<uint32_t> part;
+  for (int32_t n = static_cast<int32_t>(cell); n >= 0; n = pvs->node_parent[n]) {
+    const uint32_t bit = pvs->node_bit[n];
+    viewcells::id_lists::BitReader r(pvs->coded.data() + bit / 8, pvs->coded.size() - bit / 8);
+    r.get(static_cast<int>(bit % 8));
+    viewcells::id_lists::get_list(r, pvs->object_count, part);  // checked when the handle was opened
+    out.insert(out.end(), part.begin(), part.end());
+  }
+  std::sort(out.begin(), out.end());
+}
+
+}  // namespace
+
+int vc_pvs_open(const char* path, vc_pvs** out, char* error, size_t error_size) {
+  return open_handle(path, out, error, error_size, false);
+}
+
+int vc_pvs_open_compact(const char* path, vc_pvs** out, char* error, size_t error_size) {
+  return open_handle(path, out, error, error_size, true);
+}
+
 void vc_pvs_close(vc_pvs* pvs) { delete pvs; }
+
+int vc_pvs_is_compact(const vc_pvs* pvs) { return pvs->compact ? 1 : 0; }
+
+size_t vc_pvs_list_bytes(const vc_pvs* pvs) {
+  return pvs->compact ? pvs->coded.size() + pvs->node_bit.size() * sizeof(uint32_t) +
+                            pvs->node_parent.size() * sizeof(int32_t)
+                      : pvs->offsets.size() * sizeof(uint64_t) + pvs->ids.size() * sizeof(uint32_t);
+}
 
 uint32_t vc_pvs_cell_count(const vc_pvs* pvs) { return pvs->cell_count; }
 uint32_t vc_pvs_object_count(const vc_pvs* pvs) { return pvs->object_count; }
@@ -648,8 +716,9 @@ size_t vc_pvs_memory_bytes(const vc_pvs* pvs) {
   size_t n = sizeof(vc_pvs) + pvs->rule.capacity();
   for (const std::string& s : pvs->names) n += sizeof(s) + s.capacity();
   return n + pvs->nodes.capacity() * sizeof(Node) + pvs->planes.capacity() * sizeof(GeneralPlane) +
-         pvs->grid_start.capacity() * sizeof(uint32_t) +
-         pvs->offsets.capacity() * sizeof(uint64_t) + pvs->ids.capacity() * sizeof(uint32_t);
+         pvs->grid_start.capacity() * sizeof(uint32_t) + pvs->offsets.capacity() * sizeof(uint64_t) +
+         pvs->ids.capacity() * sizeof(uint32_t) + pvs->coded.capacity() +
+         pvs->node_bit.capacity() * sizeof(uint32_t) + pvs->node_parent.capacity() * sizeof(int32_t);
 }
 
 namespace {
@@ -684,13 +753,14 @@ int32_t vc_pvs_locate(const vc_pvs* pvs, double x, double y, double z) {
 int32_t vc_pvs_locate_objects(const vc_pvs* pvs, double x, double y, double z, const uint32_t** objects,
                               size_t* count) {
   const Node* n = leaf_at(pvs, x, y, z);
-  if (objects) *objects = n ? pvs->ids.data() + n->list[0] : nullptr;
-  if (count) *count = n ? n->list[1] : 0;
+  const bool listed = n && !pvs->compact;
+  if (objects) *objects = listed ? pvs->ids.data() + n->list[0] : nullptr;
+  if (count) *count = listed ? n->list[1] : 0;
   return n ? static_cast<int32_t>(n->meta) : -1;
 }
 
 size_t vc_pvs_cell_objects(const vc_pvs* pvs, int32_t cell, const uint32_t** objects) {
-  if (cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count) {
+  if (cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count || pvs->compact) {
     if (objects) *objects = nullptr;
     return 0;
   }
@@ -699,10 +769,29 @@ size_t vc_pvs_cell_objects(const vc_pvs* pvs, int32_t cell, const uint32_t** obj
   return static_cast<size_t>(last - first);
 }
 
+size_t vc_pvs_cell_objects_copy(const vc_pvs* pvs, int32_t cell, uint32_t* objects, size_t capacity) {
+  if (cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count) return 0;
+  if (!pvs->compact) {
+    const uint64_t first = pvs->offsets[cell], count = pvs->offsets[cell + 1] - first;
+    if (objects) std::copy_n(pvs->ids.data() + first, std::min<uint64_t>(count, capacity), objects);
+    return static_cast<size_t>(count);
+  }
+  thread_local std::vector<uint32_t> ids;
+  decode_cell(pvs, static_cast<uint32_t>(cell), ids);
+  if (objects) std::copy_n(ids.data(), std::min(ids.size(), capacity), objects);
+  return ids.size();
+}
+
 int vc_pvs_cell_bits(const vc_pvs* pvs, int32_t cell, uint8_t* row, size_t row_bytes) {
   if (cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count || !row || row_bytes < vc_pvs_row_bytes(pvs))
     return -1;
   std::memset(row, 0, row_bytes);
+  if (pvs->compact) {
+    thread_local std::vector<uint32_t> ids;
+    decode_cell(pvs, static_cast<uint32_t>(cell), ids);
+    for (uint32_t o : ids) row[o >> 3] = static_cast<uint8_t>(row[o >> 3] | (1u << (o & 7)));
+    return 0;
+  }
   for (uint64_t i = pvs->offsets[cell]; i < pvs->offsets[cell + 1]; ++i)
     row[pvs->ids[i] >> 3] = static_cast<uint8_t>(row[pvs->ids[i] >> 3] | (1u << (pvs->ids[i] & 7)));
   return 0;
@@ -710,6 +799,11 @@ int vc_pvs_cell_bits(const vc_pvs* pvs, int32_t cell, uint8_t* row, size_t row_b
 
 int vc_pvs_cell_sees(const vc_pvs* pvs, int32_t cell, uint32_t object) {
   if (cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count) return 0;
+  if (pvs->compact) {
+    thread_local std::vector<uint32_t> ids;
+    decode_cell(pvs, static_cast<uint32_t>(cell), ids);
+    return std::binary_search(ids.begin(), ids.end(), object) ? 1 : 0;
+  }
   const uint32_t* first = pvs->ids.data() + pvs->offsets[cell];
   const uint32_t* last = pvs->ids.data() + pvs->offsets[cell + 1];
   return std::binary_search(first, last, object) ? 1 : 0;

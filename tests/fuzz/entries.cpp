@@ -122,8 +122,12 @@ void entry_pvs(const uint8_t* data, size_t size) {
     // The engines' reader (runtime/) must accept exactly what the toolkit accepts, and then
     // agree with it: the same cells and visible sets at the same points.
     vc_pvs* runtime = nullptr;
+    vc_pvs* compact = nullptr;
     const bool runtime_ok = vc_pvs_open(path.c_str(), &runtime, nullptr, 0) == 0;
     std::unique_ptr<vc_pvs, void (*)(vc_pvs*)> owner(runtime, vc_pvs_close);
+    const bool compact_ok = vc_pvs_open_compact(path.c_str(), &compact, nullptr, 0) == 0;
+    std::unique_ptr<vc_pvs, void (*)(vc_pvs*)> compact_owner(compact, vc_pvs_close);
+    if (compact_ok != runtime_ok) std::abort();
     std::optional<PvsFile> read;
     try {
       read.emplace(read_pvs(path));
@@ -140,6 +144,9 @@ void entry_pvs(const uint8_t* data, size_t size) {
       const uint32_t* ids = nullptr;
       const size_t n = vc_pvs_cell_objects(runtime, cell, &ids);
       if (cell >= 0 && std::vector<uint32_t>(ids, ids + n) != f.pvs.cell_pvs(static_cast<uint32_t>(cell))) std::abort();
+      std::vector<uint32_t> copied(f.object_count);
+      copied.resize(vc_pvs_cell_objects_copy(compact, cell, copied.data(), copied.size()));
+      if (cell >= 0 && copied != f.pvs.cell_pvs(static_cast<uint32_t>(cell))) std::abort();
     }
   });
 }

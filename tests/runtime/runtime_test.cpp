@@ -199,18 +199,69 @@ TEST(Runtime, LocatesLikeTheToolkitAtAnyMagnitude) {
   EXPECT_GT(checked, 1000u);
 }
 
-/// vc_pvs_open's answer for a file: 0, or the code with the message checked to name the file.
+/// vc_pvs_open's answer for a file: 0, or the code with the message checked to name the file;
+/// vc_pvs_open_compact must give the same.
 int open_code(const std::string& path) {
-  vc_pvs* p = nullptr;
-  char error[256] = "untouched";
-  const int code = vc_pvs_open(path.c_str(), &p, error, sizeof error);
-  if (code == 0) {
-    vc_pvs_close(p);
-  } else {
-    EXPECT_EQ(p, nullptr);
-    EXPECT_NE(std::string(error).find(path), std::string::npos) << error;
+  int codes[2];
+  for (int compact : {0, 1}) {
+    vc_pvs* p = nullptr;
+    char error[256] = "untouched";
+    const int code = compact ? vc_pvs_open_compact(path.c_str(), &p, error, sizeof error)
+                             : vc_pvs_open(path.c_str(), &p, error, sizeof error);
+    if (code == 0) {
+      EXPECT_EQ(vc_pvs_is_compact(p), compact);
+      vc_pvs_close(p);
+    } else {
+      EXPECT_EQ(p, nullptr);
+      EXPECT_NE(std::string(error).find(path), std::string::npos) << error;
+    }
+    codes[compact] = code;
   }
+  EXPECT_EQ(codes[0], codes[1]) << "the compact handle answers otherwise for " << path;
+  const int code = codes[0];
   return code;
+}
+
+TEST(Runtime, CompactHandleAnswersAsTheExpandedOne) {
+  const Level& l = level();
+  const runtime::PvsFile full(l.path), compact(l.path, true);
+  ASSERT_TRUE(compact.compact());
+  ASSERT_FALSE(full.compact());
+  ASSERT_EQ(compact.cell_count(), full.cell_count());
+  for (uint32_t c = 0; c < full.cell_count(); ++c) {
+    const int32_t cell = static_cast<int32_t>(c);
+    const std::vector<uint32_t> want = l.file.pvs.cell_pvs(c);
+    EXPECT_EQ(compact.objects_copy(cell), want) << "cell " << c;
+    EXPECT_EQ(full.objects_copy(cell), want) << "cell " << c;
+    EXPECT_EQ(compact.bits(cell), full.bits(cell));
+    for (uint32_t o = 0; o < l.file.object_count; ++o) EXPECT_EQ(compact.sees(cell, o), full.sees(cell, o));
+    // No expanded list to point at: NULL and 0, never a dangling pointer.
+    EXPECT_TRUE(compact.objects(cell).empty());
+    EXPECT_EQ(compact.objects(cell).data, nullptr);
+  }
+  // A short buffer gets the first ids and the full count.
+  const std::vector<uint32_t> first = l.file.pvs.cell_pvs(0);
+  ASSERT_GE(first.size(), 2u);
+  uint32_t two[2] = {0, 0};
+  EXPECT_EQ(vc_pvs_cell_objects_copy(compact.handle(), 0, two, 2), first.size());
+  EXPECT_EQ(two[0], first[0]);
+  EXPECT_EQ(two[1], first[1]);
+  EXPECT_EQ(vc_pvs_cell_objects_copy(compact.handle(), -1, two, 2), 0u);
+  EXPECT_EQ(vc_pvs_cell_objects_copy(compact.handle(), static_cast<int32_t>(compact.cell_count()), two, 2), 0u);
+  Rng rng(4);
+  const Box3& box = l.file.bsp.view_box;
+  for (int k = 0; k < 2000; ++k) {
+    const double x = rng.uniform(box.lo.x, box.hi.x), y = rng.uniform(box.lo.y, box.hi.y),
+                 z = rng.uniform(box.lo.z, box.hi.z);
+    int32_t cell = -2;
+    EXPECT_TRUE(compact.objects_at(x, y, z, &cell).empty());
+    EXPECT_EQ(cell, full.locate(x, y, z));
+  }
+  // The compact handle holds the coded lists and 8 bytes a hierarchy node: list_bytes (the
+  // toolkit's measure of a .pvs's lists) plus that index, and less than the expanded sets.
+  EXPECT_EQ(compact.list_bytes(), list_bytes(l.file.pvs.stored, l.file.object_count) + 8 * l.file.pvs.node_count());
+  EXPECT_LT(compact.list_bytes(), full.list_bytes());
+  EXPECT_LT(compact.memory_bytes(), full.memory_bytes());
 }
 
 TEST(Runtime, RefusesWhatIsNotAValidPvsFile) {
@@ -302,12 +353,13 @@ TEST(Runtime, ReadsVersionOneAndRefusesMalformedLists) {
   write_container(path, "VPVS", 1, with_lists(l.path, varints, &version));
   EXPECT_EQ(version, 2u) << "the toolkit writes version 2";
   const PvsFile v1 = read_pvs(path);
-  const runtime::PvsFile r1(path);
+  const runtime::PvsFile r1(path), c1(path, true);
   ASSERT_EQ(v1.pvs.cell_count, l.file.pvs.cell_count);
   for (uint32_t c = 0; c < v1.pvs.cell_count; ++c) {
     EXPECT_EQ(v1.pvs.cell_pvs(c), l.file.pvs.cell_pvs(c));
     const runtime::ObjectList got = r1.objects(static_cast<int32_t>(c));
     EXPECT_EQ(std::vector<uint32_t>(got.begin(), got.end()), l.file.pvs.cell_pvs(c));
+    EXPECT_EQ(c1.objects_copy(static_cast<int32_t>(c)), l.file.pvs.cell_pvs(c));
   }
   // recode rewrites it in the current format: the same PVSs in fewer bytes.
   const std::string recoded = test::temp_path("recoded.pvs");

@@ -434,11 +434,14 @@ class Tables(unittest.TestCase):
         opens = [{"name": "BM_Open", "run_type": "iteration", "real_time": 310.4, "time_unit": "ms",
                   "items_per_second": 3.2},
                  {"name": "BM_OpenFormat1", "run_type": "iteration", "real_time": 0.25, "time_unit": "s",
-                  "items_per_second": 4.0}]
+                  "items_per_second": 4.0},
+                 {"name": "BM_OpenCompact", "run_type": "iteration", "real_time": 200.0, "time_unit": "ms",
+                  "items_per_second": 5.0}]
         dump(f"{self.d}/o.json", dict(bench, benchmarks=bench["benchmarks"] + opens))
         to = run("runtime", f"{self.d}/o.json", 50000, 8100, 1000000, 2000000)
         self.assertIn("| 2 | 1,000,000 | 310 |", to)
         self.assertIn("| 1 | 2,000,000 | 250 |", to)
+        self.assertIn("| 2, compact handle | 1,000,000 | 200 |", to)
         skipped = dict(opens[1], error_occurred=True)
         dump(f"{self.d}/s.json", dict(bench, benchmarks=bench["benchmarks"] + [opens[0], skipped]))
         ts = run("runtime", f"{self.d}/s.json", 50000, 8100, 1000000, 2000000)

@@ -169,7 +169,7 @@ CutBytes write_cut(const std::string& path, const SubdivisionFile& file, const V
   pf.rule += "; PVS by agvs";
   if (lists) pf.pvs = compress_pvs(*file.history, set.cells, *lists);
   CutBytes b;
-  b.lists = list_bytes(pf.pvs.stored, pf.object_count);
+  b.lists = compact_pvs_bytes(pf.pvs, pf.object_count);
   if (!check) {
     b.file = pvs_file_bytes(pf);
     return b;

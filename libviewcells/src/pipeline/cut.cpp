@@ -49,7 +49,7 @@ ViewCellSet extract_by_file_size(const SubdivisionFile& file, uint64_t bytes, bo
   };
   auto bytes_of = [&](size_t count) {
     const PvsFile pf = pvs_file_for(file, cut(count));
-    return lists_only ? list_bytes(pf.pvs.stored, pf.object_count) : pvs_file_bytes(pf);
+    return lists_only ? compact_pvs_bytes(pf.pvs, pf.object_count) : pvs_file_bytes(pf);
   };
   const size_t n = largest_fitting(h.min_cells(), h.leaf_count, bytes, bytes_of);
   if (n == 0)

@@ -136,7 +136,7 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
     for (uint32_t i = 0; i < f.pvs.cell_count; ++i) lists[i] = f.pvs.cell_pvs(i);
     m.pvs = GlobalPvs::from_lists(f.object_count, lists);
     out.storage_bytes = std::filesystem::file_size(c.pvs_path);
-    out.pvs_bytes = list_bytes(f.pvs.stored, f.object_count);
+    out.pvs_bytes = compact_pvs_bytes(f.pvs, f.object_count);
     out.measured = c.pvs_path + " (" + std::to_string(f.pvs.cell_count) + " view cells: " + f.rule + ")";
     m.locator = std::make_unique<CellLocator>(f.bsp, f.leaf_cell, f.pvs.cell_count);
     const CellLocator* loc = m.locator.get();

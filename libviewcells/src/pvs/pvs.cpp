@@ -134,6 +134,10 @@ uint64_t list_bytes(const std::vector<std::vector<uint32_t>>& lists, uint32_t ob
   return id_lists::encoded_bytes(lists, object_count);
 }
 
+uint64_t compact_pvs_bytes(const PvsHierarchy& h, uint32_t object_count) {
+  return list_bytes(h.stored, object_count) + 8 * static_cast<uint64_t>(h.node_count());
+}
+
 std::string rle_row(const std::vector<uint32_t>& pvs, uint32_t object_count) {
   std::string bits((object_count + 7) / 8, '\0');
   for (uint32_t o : pvs) {

@@ -185,7 +185,7 @@ Q3Comparison compare_with_q3map2(const Scene& scene, const Q3Map& map, const Ray
   const MergeHistory& h = *out.ours.av_m;
   const size_t n = std::clamp<size_t>(out.cluster_count, h.min_cells(), h.leaf_count);
   const PvsFile f = make_pvs_file(s, leaf_pvs(s, out.ours.construction_segments), h, extract_by_count(h, n).cells);
-  out.ours_compressed_bytes = list_bytes(f.pvs.stored, static_cast<uint32_t>(scene.object_count()));
+  out.ours_compressed_bytes = compact_pvs_bytes(f.pvs, static_cast<uint32_t>(scene.object_count()));
   for (uint32_t c = 0; c < f.pvs.cell_count; ++c)
     out.ours_rle_bytes += rle_row(f.pvs.cell_pvs(c), static_cast<uint32_t>(scene.object_count())).size();
   return out;

@@ -29,7 +29,15 @@ typedef struct vc_pvs vc_pvs;
  * vc_pvs_close). On failure returns a non-zero code, sets *out to NULL and writes a message
  * naming the file into error (NUL-terminated, truncated to error_size; error may be NULL). */
 int vc_pvs_open(const char* path, vc_pvs** out, char* error, size_t error_size);
+/* As vc_pvs_open, validated as strictly, but the handle keeps the hierarchy's lists coded (the
+ * file's format 2 coding, plus 8 bytes per hierarchy node) instead of every cell's expanded
+ * visible set: a fraction of the memory, and each cell's set is decoded along its path to the
+ * root when asked for (vc_pvs_cell_objects_copy, _bits, _sees). A compact handle has no lists
+ * to point at: vc_pvs_cell_objects and vc_pvs_locate_objects give NULL and 0 for it. */
+int vc_pvs_open_compact(const char* path, vc_pvs** out, char* error, size_t error_size);
 void vc_pvs_close(vc_pvs* pvs);
+/* 1 for a handle from vc_pvs_open_compact, else 0. */
+int vc_pvs_is_compact(const vc_pvs* pvs);
 
 uint32_t vc_pvs_cell_count(const vc_pvs* pvs);
 uint32_t vc_pvs_object_count(const vc_pvs* pvs);
@@ -46,6 +54,9 @@ const char* vc_pvs_rule(const vc_pvs* pvs);
 const char* vc_pvs_object_name(const vc_pvs* pvs, uint32_t object);
 /* Bytes the handle holds in memory. */
 size_t vc_pvs_memory_bytes(const vc_pvs* pvs);
+/* Of those, the bytes of the visible sets: a compact handle's coded lists, bit offsets and
+ * parents; an expanded handle's ids and per-cell offsets. */
+size_t vc_pvs_list_bytes(const vc_pvs* pvs);
 
 /* The view cell containing (x, y, z), or -1 outside the view space (or for a non-finite
  * point). */
@@ -57,6 +68,10 @@ int32_t vc_pvs_locate_objects(const vc_pvs* pvs, double x, double y, double z, c
 /* The visible objects of `cell`: sets *objects to its sorted ids (owned by the handle) and
  * returns their count; 0 and NULL for a cell out of range. */
 size_t vc_pvs_cell_objects(const vc_pvs* pvs, int32_t cell, const uint32_t** objects);
+/* Copies the cell's sorted visible objects into objects (at most capacity of them; objects may
+ * be NULL with capacity 0) and returns how many it has: compact handles or not, and safe to call
+ * from several threads at once. 0 for a cell out of range. */
+size_t vc_pvs_cell_objects_copy(const vc_pvs* pvs, int32_t cell, uint32_t* objects, size_t capacity);
 /* Writes the cell's bit row (bit o of byte o / 8 set for each visible object o) into row,
  * which holds row_bytes bytes. Returns 0, or -1 when the cell is out of range or row_bytes
  * is less than vc_pvs_row_bytes (row is then left as it was). */

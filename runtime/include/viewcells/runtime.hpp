@@ -22,9 +22,13 @@ struct ObjectList {
 
 class PvsFile {
  public:
-  explicit PvsFile(const std::string& path) {
+  /// Opens the file; `compact` keeps its lists coded (vc_pvs_open_compact): read them with
+  /// objects_copy, bits or sees.
+  explicit PvsFile(const std::string& path, bool compact = false) {
     char error[512];
-    if (vc_pvs_open(path.c_str(), &handle_, error, sizeof error) != 0) throw std::runtime_error(error);
+    const int code = compact ? vc_pvs_open_compact(path.c_str(), &handle_, error, sizeof error)
+                             : vc_pvs_open(path.c_str(), &handle_, error, sizeof error);
+    if (code != 0) throw std::runtime_error(error);
   }
   ~PvsFile() { vc_pvs_close(handle_); }
   PvsFile(PvsFile&& o) noexcept : handle_(std::exchange(o.handle_, nullptr)) {}
@@ -42,6 +46,8 @@ class PvsFile {
   std::string rule() const { return vc_pvs_rule(handle_); }
   std::string object_name(uint32_t object) const { return vc_pvs_object_name(handle_, object); }
   size_t memory_bytes() const { return vc_pvs_memory_bytes(handle_); }
+  size_t list_bytes() const { return vc_pvs_list_bytes(handle_); }
+  bool compact() const { return vc_pvs_is_compact(handle_) != 0; }
 
   /// The view cell containing the point, or -1 outside the view space.
   int32_t locate(double x, double y, double z) const { return vc_pvs_locate(handle_, x, y, z); }
@@ -57,6 +63,12 @@ class PvsFile {
     ObjectList l;
     l.size = vc_pvs_cell_objects(handle_, cell, &l.data);
     return l;
+  }
+  /// The cell's visible objects, copied (any handle; empty for a cell out of range).
+  std::vector<uint32_t> objects_copy(int32_t cell) const {
+    std::vector<uint32_t> ids(object_count());  // a cell sees at most every object: one pass
+    ids.resize(vc_pvs_cell_objects_copy(handle_, cell, ids.data(), ids.size()));
+    return ids;
   }
   /// The cell's bit row, row_bytes() long; throws std::out_of_range for a cell out of range.
   std::vector<uint8_t> bits(int32_t cell) const {

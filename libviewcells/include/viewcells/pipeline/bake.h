@@ -51,7 +51,7 @@ struct BakeResult {
   bool agvs_resumed = false;
   bool agvs_in_view_space = false;  ///< a Quake 3 map: AGVS drew its points in the non-solid space
   uint64_t pvs_entries = 0, file_bytes = 0;
-  uint64_t list_bytes = 0;  ///< the compressed PVS lists of the file written (as coded there)
+  uint64_t list_bytes = 0;  ///< the visible sets of the file written as a compact handle holds them
   double mean_pvs = 0;
   double seconds = 0;
   int threads = 1;

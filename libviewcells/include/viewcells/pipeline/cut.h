@@ -31,8 +31,9 @@ size_t largest_fitting(size_t lo, size_t hi, uint64_t memory, const std::functio
 /// The most view cells of the history whose .pvs file, with the hierarchy's own PVSs (what
 /// compress writes: point location, hierarchy and compressed lists), is at most `bytes`
 /// long, measured. Error naming the smallest file when not even the coarsest cut fits. With
-/// `lists_only`, the budget holds for the compressed PVS lists alone (as the file codes them; no point
-/// location, names or container), what stands against a map compiler's vis rows.
+/// `lists_only`, the budget holds for the visible sets alone as a compact runtime handle holds
+/// them (compact_pvs_bytes; no point location, names or container), what stands against a map
+/// compiler's vis rows.
 ViewCellSet extract_by_file_size(const SubdivisionFile& file, uint64_t bytes, bool lists_only = false);
 
 /// Reads a hierarchy file that holds a merge history (Error naming the file otherwise).

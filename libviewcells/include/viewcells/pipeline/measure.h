@@ -69,8 +69,9 @@ struct MeasureResult {
   uint32_t cells = 0, objects = 0;
   uint64_t pvs_entries = 0;
   uint64_t storage_bytes = 0;     ///< the .pvs file, or q3map2's uncompressed cluster rows
-  /// The PVSs alone: a .pvs's hierarchy-compressed object lists (as the file codes them, before its
-  /// zstd; without point location and object names), or q3map2's rows.
+  /// The PVSs alone: a .pvs's visible sets as an engine's compact handle holds them
+  /// (compact_pvs_bytes: the coded lists and 8 bytes a hierarchy node; without point location
+  /// and object names), or q3map2's rows.
   uint64_t pvs_bytes = 0;
   uint64_t leaf_surface_bytes = 0;  ///< q3map2 only: the leaf -> surface lists its renderer also needs
   std::string camera_rule;

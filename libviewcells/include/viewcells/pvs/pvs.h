@@ -39,6 +39,11 @@ PvsHierarchy compress_pvs(const MergeHistory& h, const std::vector<int32_t>& cel
 /// varints of the differences).
 uint64_t list_bytes(const std::vector<std::vector<uint32_t>>& lists, uint32_t object_count, uint32_t format = 2);
 
+/// The bytes of the visible sets in an engine's compact handle of this hierarchy (the runtime's
+/// vc_pvs_open_compact): the coded lists (list_bytes) and 8 bytes a hierarchy node (where its
+/// list starts, its parent). What stands against a map compiler's vis rows.
+uint64_t compact_pvs_bytes(const PvsHierarchy& h, uint32_t object_count);
+
 /// One Quake-style row: bit o set for every object o of `pvs`, then zero bytes coded as
 /// (0, run length <= 255).
 std::string rle_row(const std::vector<uint32_t>& pvs, uint32_t object_count);
