@@ -1312,7 +1312,7 @@ def runtime(path, cells, objects, file_bytes=None, format1_bytes=None):
           f"{first['memory_MB']:.1f} MB once the file is open"
           + (f" ({first['list_MB']:.1f} MB of them the expanded visible sets), a compact handle "
              f"(`vc_pvs_open_compact`) {first['compact_memory_MB']:.1f} MB ({first['compact_list_MB']:.1f} MB of "
-             f"coded lists and their index)" if "compact_memory_MB" in first else "") + ". One core (taskset) of {ctx.get('num_cpus', '?')} at "
+             f"coded lists and their index)" if "compact_memory_MB" in first else "") + f". One core (taskset) of {ctx.get('num_cpus', '?')} at "
           f"{ctx.get('mhz_per_cpu', 0) / 1000:.1f} GHz, Google Benchmark; viewpoints uniform in the view box "
           f"(1M drawn once, seed 1) unless said: the worst case for caches, since every query lands somewhere new"
           + (f"; medians of {reps} repetitions" if medians else "") + ".\n")

@@ -53,7 +53,7 @@ class BitWriter {
 class BitReader {
  public:
   BitReader(const char* data, size_t size)
-      : p_(reinterpret_cast<const unsigned char*>(data)), end_(p_ + size) {}
+      : begin_(reinterpret_cast<const unsigned char*>(data)), p_(begin_), end_(p_ + size) {}
   /// The next `bits` bits (bits <= 56); zeros and `overrun()` once the stream has ended.
   uint64_t get(int bits) {
     while (filled_ < bits) {
@@ -70,10 +70,13 @@ class BitReader {
     return v;
   }
   bool overrun() const { return overrun_; }
+  /// Bits read so far.
+  uint64_t position() const { return 8 * static_cast<uint64_t>(p_ - begin_) - static_cast<uint64_t>(filled_); }
   /// True when every byte was read and the padding bits are zero.
   bool at_end() const { return !overrun_ && p_ == end_ && acc_ == 0; }
 
  private:
+  const unsigned char* begin_;
   const unsigned char* p_;
   const unsigned char* end_;
   uint64_t acc_ = 0;

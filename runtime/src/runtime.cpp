@@ -475,21 +475,29 @@ void read_lists(Reader& r, vc_pvs& f, uint64_t max_items, uint32_t version) {
     if (!lr.at_end()) throw FileError("corrupt file: trailing bytes after the PVS lists");
   } else {  // binary interpolative coding (id_lists.h)
     viewcells::id_lists::BitReader lr(lists.data(), lists.size());
-    for (size_t n = 0; n < total; ++n)
+    for (size_t n = 0; n < total; ++n) {
+      if (f.compact) f.node_bit.push_back(static_cast<uint32_t>(std::min<uint64_t>(lr.position(), std::numeric_limits<uint32_t>::max())));
       if (!viewcells::id_lists::get_list(lr, f.object_count, stored[n]))
         throw FileError("corrupt file: malformed PVS list of hierarchy node " + std::to_string(n));
+    }
     if (!lr.at_end()) throw FileError("corrupt file: trailing bytes after the PVS lists");
+    if (f.compact && 8 * static_cast<uint64_t>(lists.size()) > std::numeric_limits<uint32_t>::max())
+      throw FileError("the coded lists exceed 2^32 bits");
+    if (f.compact) f.coded = lists;
   }
   if (f.compact) {
-    // Each cell's path checked for repeats one cell at a time; only the coding is kept.
-    viewcells::id_lists::BitWriter w;
-    f.node_bit.reserve(total);
-    for (const auto& ids : stored) {
-      if (w.bits() > std::numeric_limits<uint32_t>::max()) throw FileError("the coded lists exceed 2^32 bits");
-      f.node_bit.push_back(static_cast<uint32_t>(w.bits()));
-      viewcells::id_lists::put_list(w, ids.data(), ids.size(), f.object_count);
+    // Format 1's lists coded as format 2's; each cell's path checked for repeats one cell at a
+    // time; only the coding is kept.
+    if (version == 1) {
+      viewcells::id_lists::BitWriter w;
+      f.node_bit.reserve(total);
+      for (const auto& ids : stored) {
+        if (w.bits() > std::numeric_limits<uint32_t>::max()) throw FileError("the coded lists exceed 2^32 bits");
+        f.node_bit.push_back(static_cast<uint32_t>(w.bits()));
+        viewcells::id_lists::put_list(w, ids.data(), ids.size(), f.object_count);
+      }
+      f.coded = w.finish();
     }
-    f.coded = w.finish();
     f.node_parent = parent;
     std::vector<uint32_t> cell;
     for (uint32_t c = 0; c < f.cell_count; ++c) {
@@ -661,10 +669,12 @@ int open_handle(const char* path, vc_pvs** out, char* error, size_t error_size, 
   return 0;
 }
 
-/// A compact handle's cell: the lists along its path decoded into `out`, sorted.
+/// A compact handle's cell: the lists along its path decoded into `out`, sorted. The lists of a
+/// path are disjoint and each sorted: they are merged through a bit row over the objects when
+/// that is short next to the ids (a scan of words), else sorted.
 void decode_cell(const vc_pvs* pvs, uint32_t cell, std::vector<uint32_t>& out) {
   out.clear();
-  std::vector<uint32_t> part;
+  thread_local std::vector<uint32_t> part;
   for (int32_t n = static_cast<int32_t>(cell); n >= 0; n = pvs->node_parent[n]) {
     const uint32_t bit = pvs->node_bit[n];
     viewcells::id_lists::BitReader r(pvs->coded.data() + bit / 8, pvs->coded.size() - bit / 8);
@@ -672,7 +682,18 @@ void decode_cell(const vc_pvs* pvs, uint32_t cell, std::vector<uint32_t>& out) {
     viewcells::id_lists::get_list(r, pvs->object_count, part);  // checked when the handle was opened
     out.insert(out.end(), part.begin(), part.end());
   }
-  std::sort(out.begin(), out.end());
+  const size_t words = (static_cast<size_t>(pvs->object_count) + 63) / 64;
+  if (words > 4 * out.size()) {
+    std::sort(out.begin(), out.end());
+    return;
+  }
+  thread_local std::vector<uint64_t> row;
+  row.assign(words, 0);
+  for (uint32_t o : out) row[o >> 6] |= uint64_t{1} << (o & 63);
+  size_t k = 0;
+  for (size_t w = 0; w < words; ++w)
+    for (uint64_t bits = row[w]; bits; bits &= bits - 1)
+      out[k++] = static_cast<uint32_t>(64 * w + static_cast<size_t>(__builtin_ctzll(bits)));
 }
 
 }  // namespace

@@ -429,6 +429,7 @@ class Tables(unittest.TestCase):
         self.assertIn("| point location only | 125 | 8.00 |", t)
         self.assertIn("| 200 | 5.00 |", t)
         self.assertIn("50,000 view cells over 8,100 objects (`compress --count 50,000`", t)
+        self.assertIn("One core (taskset) of 2 at 2.5 GHz", t)
         self.assertNotIn("ms to open", t)
         # Opening the file in both formats, a row each with its bytes; a skipped run is left out.
         opens = [{"name": "BM_Open", "run_type": "iteration", "real_time": 310.4, "time_unit": "ms",
