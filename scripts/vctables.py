@@ -959,7 +959,9 @@ def shipped(out, err, secs):
              "needs not counted). Ours: `viewcells bake MAP --cells "
              f"CLUSTERS --pixel-error {err} --time {secs}` (1M construction samples, AV-M cells at q3map2's cluster "
              "count, PVSs by AGVS until the estimated error is below the target or the time is up), its storage the "
-             "hierarchy-compressed object lists (binary interpolative coding; the .pvs file adds point location, object names and zstd).\n",
+             "visible sets as an engine's compact handle holds them (`vc_pvs_open_compact`: the hierarchy-compressed object "
+             "lists as .pvs format 2 codes them, and 8 bytes a hierarchy node; the .pvs file adds point location, object "
+             "names and zstd).\n",
              "| map | clusters | q3map2 cost / frame | ours | ours / q3map2 | q3map2 wrong px (mean) | ours wrong px "
              "(mean / median) | cameras wrong (ours) | AGVS estimate | q3map2 rows + leaf lists (B) | ours: lists / .pvs file (B) | bake (s) "
              "| within the rows: cells, ours / q3map2, wrong px | goal (rows / rows + leaf lists) |",
