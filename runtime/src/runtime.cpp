@@ -444,7 +444,8 @@ void read_bsp(Reader& r, vc_pvs& f, uint64_t max_items) {
   }
 }
 
-/// Decodes the kept lists of the hierarchy and expands every cell's visible set.
+/// Decodes the kept lists of the hierarchy and checks them; then expands every cell's visible
+/// set, or for a compact handle keeps the lists coded (format 2) with where each starts.
 void read_lists(Reader& r, vc_pvs& f, uint64_t max_items, uint32_t version) {
   f.cell_count = r.get<uint32_t>();
   const std::vector<int32_t> parent = r.get_array<int32_t>(max_items);
@@ -474,15 +475,15 @@ void read_lists(Reader& r, vc_pvs& f, uint64_t max_items, uint32_t version) {
     }
     if (!lr.at_end()) throw FileError("corrupt file: trailing bytes after the PVS lists");
   } else {  // binary interpolative coding (id_lists.h)
+    if (f.compact && 8 * static_cast<uint64_t>(lists.size()) > std::numeric_limits<uint32_t>::max())
+      throw FileError("the coded lists exceed 2^32 bits, more than a compact handle indexes");
     viewcells::id_lists::BitReader lr(lists.data(), lists.size());
     for (size_t n = 0; n < total; ++n) {
-      if (f.compact) f.node_bit.push_back(static_cast<uint32_t>(std::min<uint64_t>(lr.position(), std::numeric_limits<uint32_t>::max())));
+      if (f.compact) f.node_bit.push_back(static_cast<uint32_t>(lr.position()));
       if (!viewcells::id_lists::get_list(lr, f.object_count, stored[n]))
         throw FileError("corrupt file: malformed PVS list of hierarchy node " + std::to_string(n));
     }
     if (!lr.at_end()) throw FileError("corrupt file: trailing bytes after the PVS lists");
-    if (f.compact && 8 * static_cast<uint64_t>(lists.size()) > std::numeric_limits<uint32_t>::max())
-      throw FileError("the coded lists exceed 2^32 bits");
     if (f.compact) f.coded = lists;
   }
   if (f.compact) {
@@ -492,7 +493,8 @@ void read_lists(Reader& r, vc_pvs& f, uint64_t max_items, uint32_t version) {
       viewcells::id_lists::BitWriter w;
       f.node_bit.reserve(total);
       for (const auto& ids : stored) {
-        if (w.bits() > std::numeric_limits<uint32_t>::max()) throw FileError("the coded lists exceed 2^32 bits");
+        if (w.bits() > std::numeric_limits<uint32_t>::max())
+          throw FileError("the coded lists exceed 2^32 bits, more than a compact handle indexes");
         f.node_bit.push_back(static_cast<uint32_t>(w.bits()));
         viewcells::id_lists::put_list(w, ids.data(), ids.size(), f.object_count);
       }
