@@ -83,26 +83,40 @@ void BM_LocateAndList(benchmark::State& state) {
   counters(state);
 }
 
-/// A viewer walking: 1M steps of 0.2% of the view box's diagonal, turning at random and
-/// reflected at the box, as frames of a camera are (most steps stay in their cell).
-void BM_WalkAndList(benchmark::State& state) {
-  const Fixture& f = fixture();
-  double lo[3], hi[3], p[3], d[3] = {1, 0, 0};
-  vc_pvs_view_box(f.pvs->handle(), lo, hi);
-  const double step = 0.002 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
-  for (int k = 0; k < 3; ++k) p[k] = 0.5 * (lo[k] + hi[k]);
-  size_t i = 0, total = 0;
-  for (auto _ : state) {
+/// A viewer walking: steps of 0.2% of the view box's diagonal, turning at random (the
+/// fixture's points) and reflected at the box, as frames of a camera are (most steps stay in
+/// their cell).
+struct Walk {
+  double lo[3], hi[3], p[3], d[3] = {1, 0, 0}, step = 0;
+  size_t i = 0;
+
+  explicit Walk(const vc_pvs* pvs) {
+    vc_pvs_view_box(pvs, lo, hi);
+    step = 0.002 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                             (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    for (int k = 0; k < 3; ++k) p[k] = 0.5 * (lo[k] + hi[k]);
+  }
+  /// The next position.
+  const double* next(const Fixture& f) {
     const double* turn = &f.points[3 * i];  // uniform in the box: a direction change
     for (int k = 0; k < 3; ++k) {
       d[k] = 0.9 * d[k] + 0.1 * ((turn[k] - lo[k]) / (hi[k] - lo[k]) - 0.5);
       p[k] += step * d[k];
       if (p[k] < lo[k] || p[k] > hi[k]) d[k] = -d[k], p[k] = std::clamp(p[k], lo[k], hi[k]);
     }
+    i = (i + 1) & ((f.points.size() / 3) - 1);
+    return p;
+  }
+};
+
+void BM_WalkAndList(benchmark::State& state) {
+  const Fixture& f = fixture();
+  Walk walk(f.pvs->handle());
+  size_t total = 0;
+  for (auto _ : state) {
+    const double* p = walk.next(f);
     const viewcells::runtime::ObjectList l = f.pvs->objects_at(p[0], p[1], p[2]);
     total += l.size + (l.empty() ? 0 : l.data[l.size - 1]);
-    i = (i + 1) & ((f.points.size() / 3) - 1);
   }
   benchmark::DoNotOptimize(total);
   counters(state);
@@ -130,28 +144,18 @@ void BM_LocateAndCopyCompact(benchmark::State& state) {
 /// another cell (as an engine keeps the current cell's set).
 void BM_WalkAndCopyCompact(benchmark::State& state) {
   const Fixture& f = fixture();
-  double lo[3], hi[3], p[3], d[3] = {1, 0, 0};
-  vc_pvs_view_box(f.compact->handle(), lo, hi);
-  const double step = 0.002 * std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                                        (hi[2] - lo[2]) * (hi[2] - lo[2]));
-  for (int k = 0; k < 3; ++k) p[k] = 0.5 * (lo[k] + hi[k]);
+  Walk walk(f.compact->handle());
   std::vector<uint32_t> ids(f.compact->object_count());
   int32_t current = -2;
-  size_t i = 0, total = 0, count = 0;
+  size_t total = 0, count = 0;
   for (auto _ : state) {
-    const double* turn = &f.points[3 * i];
-    for (int k = 0; k < 3; ++k) {
-      d[k] = 0.9 * d[k] + 0.1 * ((turn[k] - lo[k]) / (hi[k] - lo[k]) - 0.5);
-      p[k] += step * d[k];
-      if (p[k] < lo[k] || p[k] > hi[k]) d[k] = -d[k], p[k] = std::clamp(p[k], lo[k], hi[k]);
-    }
+    const double* p = walk.next(f);
     const int32_t cell = f.compact->locate(p[0], p[1], p[2]);
     if (cell != current) {
       count = vc_pvs_cell_objects_copy(f.compact->handle(), cell, ids.data(), ids.size());
       current = cell;
     }
     total += count + (count ? ids[count - 1] : 0);
-    i = (i + 1) & ((f.points.size() / 3) - 1);
   }
   benchmark::DoNotOptimize(total);
   counters(state);

@@ -88,6 +88,15 @@ void put_varint(std::string& out, uint32_t v) {
   out.push_back(static_cast<char>(v));
 }
 
+std::string varint_lists(const std::vector<std::vector<uint32_t>>& lists) {
+  std::string out;
+  for (const auto& l : lists) {
+    put_varint(out, static_cast<uint32_t>(l.size()));
+    for (size_t i = 0; i < l.size(); ++i) put_varint(out, i ? l[i] - l[i - 1] - 1 : l[i]);
+  }
+  return out;
+}
+
 uint32_t get_varint(ByteReader& r) {
   uint32_t v = 0;
   for (int shift = 0; shift < 35; shift += 7) {
@@ -122,15 +131,7 @@ uint64_t list_bytes(const std::vector<std::vector<uint32_t>>& lists, uint32_t ob
   VC_CHECK(format == 1 || format == kVersion);
   for (const auto& l : lists)
     for (size_t i = 0; i < l.size(); ++i) VC_CHECK(l[i] < object_count && (i == 0 || l[i - 1] < l[i]));
-  if (format == 1) {
-    auto varint = [](uint32_t v) { return v < (1u << 7) ? 1 : v < (1u << 14) ? 2 : v < (1u << 21) ? 3 : v < (1u << 28) ? 4 : 5; };
-    uint64_t n = 0;
-    for (const auto& l : lists) {
-      n += varint(static_cast<uint32_t>(l.size()));
-      for (size_t i = 0; i < l.size(); ++i) n += varint(i ? l[i] - l[i - 1] - 1 : l[i]);
-    }
-    return n;
-  }
+  if (format == 1) return varint_lists(lists).size();
   return id_lists::encoded_bytes(lists, object_count);
 }
 
@@ -279,16 +280,7 @@ std::string pvs_payload(const PvsFile& f, uint32_t format) {
         throw Error("the PVS list of hierarchy node " + std::to_string(n) + " is not sorted ids below the " +
                     std::to_string(f.object_count) + " objects");
   }
-  if (format == 1) {
-    std::string lists;
-    for (const auto& l : f.pvs.stored) {
-      put_varint(lists, static_cast<uint32_t>(l.size()));
-      for (size_t i = 0; i < l.size(); ++i) put_varint(lists, i ? l[i] - l[i - 1] - 1 : l[i]);
-    }
-    w.put_string(lists);
-  } else {
-    w.put_string(id_lists::encode(f.pvs.stored, f.object_count));
-  }
+  w.put_string(format == 1 ? varint_lists(f.pvs.stored) : id_lists::encode(f.pvs.stored, f.object_count));
   return w.data();
 }
 
