@@ -190,6 +190,8 @@ struct BakeArgs {
   uint64_t agvs_seed = 1;
   std::string output, report, work;
   double checkpoint = 60;
+  double measured_error = 0;
+  uint32_t measure_cameras = 0;
 };
 
 int run_bake(BakeArgs a, const Common& c) {
@@ -205,7 +207,10 @@ int run_bake(BakeArgs a, const Common& c) {
   config.memory = a.memory.empty() ? 0 : parse_bytes(a.memory);
   if (a.memory_of != "file" && a.memory_of != "lists") throw Error("--memory-of is file or lists, not '" + a.memory_of + "'");
   config.memory_of_lists = a.memory_of == "lists";
-  if (!a.agvs.samples && !(a.agvs.seconds > 0) && !(a.agvs.pixel_error > 0)) a.agvs.pixel_error = 10;
+  if (!a.agvs.samples && !(a.agvs.seconds > 0) && !(a.agvs.pixel_error > 0) && !(a.measured_error > 0))
+    a.agvs.pixel_error = 10;
+  config.measured_error = a.measured_error;
+  config.measure_cameras = a.measure_cameras ? a.measure_cameras : a.measured_error > 0 ? 5000 : 0;
   config.agvs = a.agvs.config(c);
   config.agvs.seed = a.sampling.seed;
   config.output = a.output;
@@ -249,9 +254,21 @@ void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
                  "there when run again (0: only at the end)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
+  bk->add_option("--measured-error", a->measured_error,
+                 "Stop AGVS once cameras measure at most this many wrong pixels per 1024x1024 frame (mean over the "
+                 "cameras), instead of trusting the estimate: measured after one batch and at every doubling of the "
+                 "samples (a run may sample up to twice what it needed; --time and the other limits still apply)")
+      ->check(CLI::NonNegativeNumber);
+  bk->add_option("--measure-cameras", a->measure_cameras,
+                 "Cameras that measure the PVSs, placed and counted as `viewcells measure` does (on a Quake 3 map "
+                 "player eyes above floors reachable from the spawn points, else random points of the view box; "
+                 "64x48 pixels, seed 1): the report gives the written file's measured pixel error (default: 5000 "
+                 "with --measured-error, else none)")
+      ->check(whole(1, 1'000'000));
   bk->add_option("-o,--output", a->output, "The .pvs file to write")->required();
   bk->add_option("--report", a->report, "JSON report: budget, cells, file bytes, pixel error, samples, timings");
-  bk->footer("Without --pixel-error, --time or --agvs-samples, AGVS runs to an estimated pixel error of 10 (of 1024x1024).");
+  bk->footer("Without --pixel-error, --measured-error, --time or --agvs-samples, AGVS runs to an estimated pixel "
+             "error of 10 (of 1024x1024).");
   commands.push_back({bk, [a, &common] {
                         if (a->view_cells == 0 && a->memory.empty())
                           throw Error("bake needs a budget: --cells N or --memory BYTES");

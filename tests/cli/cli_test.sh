@@ -395,6 +395,19 @@ assert 'non-solid' in s['view_space'], s['view_space']
   expect_ok "$VC" bake "$MAPS/oa_dm2.bsp" --cells 40 --samples 50000 --max-cells 100 --merge-pvs samples \
     --agvs-samples 100000 -o dm2.pvs --report dm2bake.json -q
   [ "$(json_get dm2bake.json "['effects']['restricted_view_space']['enabled']")" = "True" ] && ok || bad "bake on a map: AGVS not in the view space"
+  # bake --measured-error: stops when the play cameras measure it, and measure agrees with its report.
+  expect_ok "$VC" bake "$MAPS/oa_dm2.bsp" --cells 40 --samples 50000 --max-cells 100 --merge-pvs samples \
+    --measured-error 300 --measure-cameras 300 -o dm2m.pvs --report dm2mbake.json -q
+  expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" dm2m.pvs --count 300 --report dm2mm.json -q
+  python3 -c "
+import json
+b, m = json.load(open('dm2mbake.json')), json.load(open('dm2mm.json'))
+e = b['measured_pixel_error']
+assert e['pixels'] <= 300 and e['cameras'] == 300 and 'spawn points' in e['placement'], e
+assert b['agvs']['stop_reason'].startswith('measured pixel error'), b['agvs']['stop_reason']
+assert b['measured_curve'][-1]['measured_pixels'] == e['pixels'], b['measured_curve']
+assert abs(m['pixel_error']['pixels'] - e['pixels']) <= 1e-9 * max(1, e['pixels']), (m['pixel_error'], e)
+" && ok || bad "bake --measured-error on oa_dm2: the report and measure disagree"
   expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" dm2.pvs --count 300 --report ourm.json -q
   [ "$(json_get ourm.json "['cells']")" = "40" ] && ok || bad "measure of a baked map: cells"
   [ "$(json_get ourm.json "['cameras']['placement']")" = "$(json_get q3m.json "['cameras']['placement']")" ] &&

@@ -11,6 +11,7 @@
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pipeline/bake.h"
 #include "viewcells/pipeline/cut.h"
+#include "viewcells/pipeline/measure.h"
 #include "viewcells/pipeline/pvs.h"
 #include "viewcells/pipeline/report.h"
 #include "viewcells/runtime.hpp"
@@ -146,6 +147,66 @@ TEST(Pipeline, BakeRefusesNoBudgetOrTwo) {
   EXPECT_THROW(pipeline::bake(c, quiet), Error);
   c.cells = 4;
   c.memory = 100000;
+  EXPECT_THROW(pipeline::bake(c, quiet), Error);
+}
+
+/// bake --measured-error: AGVS stops at the first measurement whose cameras' mean error is
+/// within the target (after one batch, then at every doubling), and the error the report gives
+/// is what `viewcells measure` finds in the file written with the same cameras, also when a
+/// memory budget coarsened the cells after sampling.
+TEST(Pipeline, BakeStopsAtAMeasuredErrorAndReportsWhatMeasureFinds) {
+  auto measured_by_measure = [](const std::string& pvs, const pipeline::BakeConfig& c) {
+    pipeline::MeasureConfig m;
+    m.scene.path = office();
+    m.pvs_path = pvs;
+    m.cameras = c.cameras;
+    m.cameras.count = c.measure_cameras;
+    m.frame = c.frame;
+    return pipeline::measure(m, quiet).error.pixels;
+  };
+  const std::string out = test::temp_path("bake-measured.pvs");
+  pipeline::BakeConfig c = small_bake(out);
+  c.cells = 60;
+  c.agvs.max_samples = 0;
+  c.agvs.batch_size = 1000;
+  c.measure_cameras = 16;
+  c.frame.width = c.frame.height = 128;  // one wrong pixel is 64 of 1024 x 1024, 4 in the mean of 16 cameras
+  c.measured_error = 1;                  // so: no wrong pixel at all
+  const pipeline::BakeResult r = pipeline::bake(c, quiet);
+  ASSERT_GE(r.measured_curve.size(), 2u) << "one batch of 1,000 samples does not see everything";
+  EXPECT_EQ(r.measured_curve.front().samples, 1000u);
+  for (size_t k = 0; k + 1 < r.measured_curve.size(); ++k) {
+    EXPECT_GT(r.measured_curve[k].measured.pixels, c.measured_error) << "measurement " << k;
+    EXPECT_GE(r.measured_curve[k + 1].samples, 2 * r.measured_curve[k].samples) << "measurement " << k;
+  }
+  EXPECT_TRUE(r.measured_stop);
+  EXPECT_NE(r.agvs.stop_reason.find("measured pixel error"), std::string::npos) << r.agvs.stop_reason;
+  EXPECT_EQ(r.agvs.samples, r.measured_curve.back().samples) << "no sample after the last measurement";
+  ASSERT_TRUE(r.measured);
+  EXPECT_LE(r.measured->pixels, c.measured_error);
+  EXPECT_EQ(r.measured->pixels, measured_by_measure(out, c));
+  const auto j = nlohmann::json::parse(pipeline::report_json(r));
+  EXPECT_EQ(j["measured_pixel_error"]["pixels"], r.measured->pixels);
+  EXPECT_EQ(j["measured_curve"].size(), r.measured_curve.size());
+
+  // A memory budget below the sampled cells' file: coarser cells, each camera's found again in
+  // them, and the file written measured as `measure` measures it.
+  const std::string small = test::temp_path("bake-measured-small.pvs");
+  pipeline::BakeConfig m = c;
+  m.cells = 0;
+  m.memory = 4000;
+  m.output = small;
+  m.measured_error = 0;
+  m.agvs.max_samples = 20000;  // few: the last sampled cells still miss pixels
+  const pipeline::BakeResult coarse = pipeline::bake(m, quiet);
+  ASSERT_LT(coarse.cells, coarse.agvs_cells) << "the budget was to coarsen the cells sampled";
+  ASSERT_TRUE(coarse.measured);
+  EXPECT_TRUE(coarse.measured_curve.empty());
+  EXPECT_EQ(coarse.measured->pixels, measured_by_measure(small, m));
+  EXPECT_EQ(coarse.measured->cameras, 16u);
+
+  // A measured error needs cameras.
+  c.measure_cameras = 0;
   EXPECT_THROW(pipeline::bake(c, quiet), Error);
 }
 

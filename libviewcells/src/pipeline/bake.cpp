@@ -87,9 +87,10 @@ SubdivisionFile hierarchy(const BakeConfig& c, LoadedScene& loaded, uint32_t max
 
 /// The AGVS PVSs of the view cells `set`, continued from the work directory's state when it
 /// belongs to them, and saved there.
+/// With `cams`, the measured error can stop it (BakeConfig::measured_error).
 std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, const LoadedScene& loaded, const PvsFile& pf,
+                                              const CellLocator& cells, const std::optional<CameraSet>& cams,
                                               BakeResult& out, const Log& log) {
-  const CellLocator cells(pf.bsp, pf.leaf_cell, pf.pvs.cell_count);
   AgvsConfig agvs = c.agvs;
   use_map_view_space(loaded.map, agvs);
   out.agvs_in_view_space = static_cast<bool>(agvs.view_space);
@@ -111,7 +112,16 @@ std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, const LoadedS
   // batches, saves, and goes on, which changes nothing of its samples (a resumed state
   // continues exactly), so a bake cut off mid-way continues from the last checkpoint.
   const AgvsConfig& a = c.agvs;
-  while (true) {
+  if (cams && c.measured_error > 0) {
+    // Measured at every doubling of the samples; the state is saved before each measurement.
+    const SolverMeasuring m{*loaded.scene, *loaded.caster, *cams, c.frame};
+    out.measured_stop = run_to_measured_error(solver, a, c.measured_error, m, out.measured_curve, log, [&] {
+      if (state.empty()) return;
+      const UnbatchedWrites now;
+      solver.save(state, identity);
+    });
+  }
+  while (!(cams && c.measured_error > 0)) {
     const double until = solver.stats().seconds + c.checkpoint_seconds;
     const bool sliced = !state.empty() && c.checkpoint_seconds > 0 && (!(a.max_seconds > 0) || until < a.max_seconds);
     solver.set_limits(a.max_samples, sliced ? until : a.max_seconds, a.pixel_error);
@@ -124,6 +134,9 @@ std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, const LoadedS
     log("viewcells: bake: checkpoint after " + std::to_string(solver.stats().samples) + " samples -> " + state);
   }
   out.agvs = solver.stats();
+  if (out.measured_stop)
+    out.agvs.stop_reason = "measured pixel error at most " + fmt(c.measured_error, 3) + " (mean of " +
+                           std::to_string(cams->cameras.size()) + " cameras)";
   out.pixel_error = solver.pixel_error();
   out.pixel_error_bound = solver.pixel_error_bound();
   std::vector<std::vector<uint32_t>> lists(cells.cell_count());
@@ -201,8 +214,13 @@ ViewCellSet first_cut(const BakeConfig& c, const SubdivisionFile& file, const Lo
 
 BakeResult bake(const BakeConfig& c, const Log& log) {
   if ((c.cells > 0) == (c.memory > 0)) throw Error("bake needs one budget: --cells N or --memory BYTES");
-  if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0))
-    throw Error("give when the PVSs are good enough: a pixel error, a time or a number of AGVS samples");
+  if (!(c.measured_error >= 0) || !std::isfinite(c.measured_error))
+    throw Error("the measured pixel error must be a finite number >= 0");
+  if (c.measured_error > 0 && !c.measure_cameras)
+    throw Error("a measured pixel error needs measuring cameras");
+  if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0) && !(c.measured_error > 0))
+    throw Error("give when the PVSs are good enough: a pixel error (estimated or measured), a time or a number of "
+                "AGVS samples");
   Stopwatch total;
   BakeResult out;
   out.config = c;
@@ -216,7 +234,20 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   out.scene_fingerprint = file.scene_fingerprint;
   out.object_count = file.object_count;
   const ViewCellSet set = first_cut(c, file, log);
-  const std::vector<std::vector<uint32_t>> lists = sample_pvs(c, loaded, pvs_file_for(file, set), out, log);
+  const PvsFile sampled = pvs_file_for(file, set);
+  const CellLocator cells(sampled.bsp, sampled.leaf_cell, sampled.pvs.cell_count);
+  std::optional<CameraSet> cams;
+  if (c.measure_cameras) {
+    Stopwatch sw;
+    CameraConfig cc = c.cameras;
+    cc.count = c.measure_cameras;
+    cams = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), cc,
+                        [&cells](const Vec3& p) { return cells.cell_at(p); }, &cells, c.output);
+    out.camera_rule = cams->rule;
+    log("viewcells: bake: " + std::to_string(cams->cameras.size()) + " measuring cameras (" + cams->rule + ") in " +
+        fmt(sw.seconds(), 2) + " s");
+  }
+  const std::vector<std::vector<uint32_t>> lists = sample_pvs(c, loaded, sampled, cells, cams, out, log);
   out.agvs_cells = static_cast<uint32_t>(set.cells.size());
   ViewCellSet written = set;
   std::vector<std::vector<uint32_t>> written_lists = lists;
@@ -239,6 +270,25 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     written_lists = coarsen(h, set.cells, lists, written.cells);
     bytes = write_cut(c.output, file, written, &written_lists, true);
   }
+  if (cams) {
+    if (written.cells.size() == set.cells.size() && !out.measured_curve.empty()) {
+      out.measured = out.measured_curve.back().measured;  // the PVSs written, measured last
+    } else {
+      // The cells written (coarser when the budget coarsened them): each camera's is found again.
+      CameraSet in_written = *cams;
+      if (written.cells.size() != set.cells.size()) {
+        const PvsFile wf = pvs_file_for(file, written);
+        const CellLocator located(wf.bsp, wf.leaf_cell, wf.pvs.cell_count);
+        for (size_t i = 0; i < in_written.cameras.size(); ++i) in_written.cells[i] = located.cell_at(in_written.cameras[i].eye);
+      }
+      Stopwatch sw;
+      out.measured = measure_frames(*loaded.scene, *loaded.caster, in_written.cameras, in_written.cells,
+                                    GlobalPvs::from_lists(file.object_count, written_lists), c.frame);
+      out.measured->wrong.clear();
+      log("viewcells: bake: measured pixel error " + fmt(out.measured->pixels, 3) + " (median camera " +
+          fmt(out.measured->median_pixels, 3) + ") in " + fmt(sw.seconds(), 1) + " s");
+    }
+  }
   out.file_bytes = bytes.file;
   out.list_bytes = bytes.lists;
   out.cells = static_cast<uint32_t>(written.cells.size());
@@ -252,6 +302,9 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
       (!std::isnan(err)     ? fmt(err, 2)
        : !std::isnan(bound) ? "below " + fmt(bound, 2) + " (90% bound)"
                             : std::string("not known")) +
+      (out.measured ? ", measured " + fmt(out.measured->pixels, 2) + " (median camera " +
+                          fmt(out.measured->median_pixels, 2) + ")"
+                    : std::string()) +
       " after " + std::to_string(out.agvs.samples) + " samples (" + out.agvs.stop_reason + "); " + c.output + ": " +
       std::to_string(out.file_bytes) + " bytes in " + fmt(out.seconds, 1) + " s");
   return out;

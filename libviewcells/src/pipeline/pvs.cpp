@@ -121,22 +121,8 @@ FrameConfig measuring_frame(const PvsConfig& c, const PvsResult& out) {
   return FrameConfig{c.measure_size, c.measure_size, 90.0, out.agvs.resolution};
 }
 
-/// The solver's PVSs now, measured by the cameras, appended to out.measured_curve.
-const MeasuredPoint& measure_now(const PvsConfig& c, const Scenes& s, const CameraSet& cams, const AgvsSolver& solver,
-                                 PvsResult& out, const Log& log) {
-  const AgvsStats& st = solver.stats();
-  MeasuredPoint p;
-  p.samples = st.samples;
-  p.rays = st.rays;
-  p.seconds = st.seconds;
-  p.mean_pvs = solver.mean_pvs();
-  p.estimated = solver.pixel_error();
-  p.measured = measure_frames(s.scene, *s.caster, cams.cameras, cams.cells, solver.pvs(), measuring_frame(c, out));
-  p.measured.wrong.clear();
-  log("viewcells: after " + std::to_string(p.samples) + " samples (" + fmt(p.seconds, 2) + " s): measured pixel error " +
-      fmt(p.measured.pixels, 3) + " (median camera " + fmt(p.measured.median_pixels, 3) + ")");
-  out.measured_curve.push_back(std::move(p));
-  return out.measured_curve.back();
+SolverMeasuring measuring(const PvsConfig& c, const Scenes& s, const CameraSet& cams, const PvsResult& out) {
+  return SolverMeasuring{s.scene, *s.caster, cams, measuring_frame(c, out)};
 }
 
 /// Runs the solver up to each of c.measure_at and measures its PVSs there.
@@ -147,35 +133,10 @@ void measured_run(const PvsConfig& c, const Scenes& s, const CameraSet& cams, Ag
     if (a.max_samples && n > a.max_samples) break;
     solver.set_limits(n, a.max_seconds, 0);
     solver.run();
-    measure_now(c, s, cams, solver, out, log);
+    out.measured_curve.push_back(measure_solver(measuring(c, s, cams, out), solver, log));
     if (a.max_seconds > 0 && solver.stats().seconds >= a.max_seconds) break;
   }
   solver.set_limits(a.max_samples, a.max_seconds, a.pixel_error);
-}
-
-/// The stopping rule by measured error: the solver run to one batch, then to every doubling of
-/// its samples, and measured each time, until the cameras' mean wrong pixels (the paper's pixel
-/// error, which the estimator estimates) are at most c.measured_error or another limit stops
-/// it. Returns whether the measured error stopped it.
-bool run_to_measured_error(const PvsConfig& c, const Scenes& s, const CameraSet& cams, AgvsSolver& solver,
-                           PvsResult& out, const Log& log) {
-  const AgvsConfig& a = c.agvs;
-  uint64_t next = std::max<uint64_t>(solver.stats().samples + 1, a.batch_size);
-  while (true) {
-    const uint64_t until = a.max_samples ? std::min(next, a.max_samples) : next;
-    solver.set_limits(until, a.max_seconds, a.pixel_error);
-    solver.run();
-    const AgvsStats& st = solver.stats();
-    if (measure_now(c, s, cams, solver, out, log).measured.pixels <= c.measured_error) return true;
-    // Another limit: the samples, the time, or the estimator's error (the solver's own stop).
-    const double estimated = solver.pixel_error(), bound = solver.pixel_error_bound();
-    if (st.samples < until || (a.max_samples && st.samples >= a.max_samples) ||
-        (a.max_seconds > 0 && st.seconds >= a.max_seconds) ||
-        (a.pixel_error > 0 && ((!std::isnan(estimated) && estimated <= a.pixel_error) ||
-                               (!std::isnan(bound) && bound <= a.pixel_error))))
-      return false;
-    next = 2 * st.samples;
-  }
 }
 
 /// Measures the pixel error of the PVSs written (and of the unfiltered ones, when filtered).
@@ -205,6 +166,43 @@ std::string describe_stop(const PvsConfig& c) {
 }
 
 }  // namespace
+
+MeasuredPoint measure_solver(const SolverMeasuring& m, const AgvsSolver& solver, const Log& log) {
+  const AgvsStats& st = solver.stats();
+  MeasuredPoint p;
+  p.samples = st.samples;
+  p.rays = st.rays;
+  p.seconds = st.seconds;
+  p.mean_pvs = solver.mean_pvs();
+  p.estimated = solver.pixel_error();
+  p.measured = measure_frames(m.scene, m.caster, m.cameras.cameras, m.cameras.cells, solver.pvs(), m.frame);
+  p.measured.wrong.clear();
+  log("viewcells: after " + std::to_string(p.samples) + " samples (" + fmt(p.seconds, 2) + " s): measured pixel error " +
+      fmt(p.measured.pixels, 3) + " (median camera " + fmt(p.measured.median_pixels, 3) + ")");
+  return p;
+}
+
+bool run_to_measured_error(AgvsSolver& solver, const AgvsConfig& a, double target, const SolverMeasuring& m,
+                           std::vector<MeasuredPoint>& curve, const Log& log, const std::function<void()>& after_run) {
+  uint64_t next = std::max<uint64_t>(solver.stats().samples + 1, a.batch_size);
+  while (true) {
+    const uint64_t until = a.max_samples ? std::min(next, a.max_samples) : next;
+    solver.set_limits(until, a.max_seconds, a.pixel_error);
+    solver.run();
+    if (after_run) after_run();
+    const AgvsStats& st = solver.stats();
+    curve.push_back(measure_solver(m, solver, log));
+    if (curve.back().measured.pixels <= target) return true;
+    // Another limit: the samples, the time, or the estimator's error (the solver's own stop).
+    const double estimated = solver.pixel_error(), bound = solver.pixel_error_bound();
+    if (st.samples < until || (a.max_samples && st.samples >= a.max_samples) ||
+        (a.max_seconds > 0 && st.seconds >= a.max_seconds) ||
+        (a.pixel_error > 0 && ((!std::isnan(estimated) && estimated <= a.pixel_error) ||
+                               (!std::isnan(bound) && bound <= a.pixel_error))))
+      return false;
+    next = 2 * st.samples;
+  }
+}
 
 PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   check_config(c);
@@ -259,7 +257,8 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   }
   bool measured_stop = false;
   if (cams && c.measured_error > 0) {
-    measured_stop = run_to_measured_error(c, scenes, *cams, *solver, out, log);
+    measured_stop =
+        run_to_measured_error(*solver, c.agvs, c.measured_error, measuring(c, scenes, *cams, out), out.measured_curve, log);
   } else {
     if (cams && !c.measure_at.empty()) measured_run(c, scenes, *cams, *solver, out, log);
     solver->run();

@@ -13,6 +13,7 @@
 #include "viewcells/agvs/agvs.h"
 #include "viewcells/merge/merge.h"
 #include "viewcells/pipeline/build.h"
+#include "viewcells/pipeline/pvs.h"
 
 namespace viewcells::pipeline {
 
@@ -28,6 +29,17 @@ struct BakeConfig {
   /// compiler's vis rows), not the whole file with point location and object names.
   bool memory_of_lists = false;
   AgvsConfig agvs;                 ///< stopping rule (pixel error, time, samples), seed, batch
+  /// Cameras that measure the PVSs as `viewcells measure` does (its placement, seed and
+  /// frames: on a Quake 3 map player eyes above reachable floors); 0: none. The file
+  /// written is measured, and its measured pixel error reported.
+  uint32_t measure_cameras = 0;
+  CameraConfig cameras;                      ///< placement and seed (count: measure_cameras)
+  FrameConfig frame{64, 48, 90.0, 1024 * 1024};  ///< the measuring frames, as `measure`'s
+  /// With measure_cameras: stop AGVS once the cameras' mean wrong pixels per 1024 x 1024
+  /// frame are at most this (measured after one batch and at every doubling of the samples;
+  /// the other limits still apply). Coarsening for a memory budget only unites PVSs, so the
+  /// file written is measured again and never shows more. 0: not used.
+  double measured_error = 0;
   std::string output;              ///< .pvs
   std::string work_dir;            ///< empty: nothing kept between runs
   double checkpoint_seconds = 60;  ///< with a work directory: AGVS state saved this often (0: at the end)
@@ -48,6 +60,10 @@ struct BakeResult {
   std::string rule;
   AgvsStats agvs;
   double pixel_error = 0, pixel_error_bound = 0;  ///< NaN: not known
+  std::optional<PixelErrorMeasure> measured;  ///< of the file written, by the measuring cameras
+  std::string camera_rule;                    ///< how they were placed
+  std::vector<MeasuredPoint> measured_curve;  ///< with measured_error: every measurement of the run
+  bool measured_stop = false;                 ///< the measured error stopped AGVS
   bool agvs_resumed = false;
   bool agvs_in_view_space = false;  ///< a Quake 3 map: AGVS drew its points in the non-solid space
   uint64_t pvs_entries = 0, file_bytes = 0;

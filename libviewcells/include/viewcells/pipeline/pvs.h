@@ -3,6 +3,7 @@
 /// SGVS and REF variants), optionally continued from a saved state, across a dynamic edit of
 /// the scene, filtered, measured by cameras; written compressed as .pvs.
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "viewcells/agvs/agvs.h"
 #include "viewcells/eval/frames.h"
 #include "viewcells/pipeline/cut.h"
+#include "viewcells/pipeline/measure.h"
 
 namespace viewcells::pipeline {
 
@@ -51,6 +53,28 @@ struct MeasuredPoint {
   double estimated = 0;        ///< the estimator's pixel error then (NaN: none)
   PixelErrorMeasure measured;  ///< `wrong` left empty
 };
+
+/// What measures a solver's PVSs part-way through a run: the scene it samples, its caster,
+/// the cameras (each with its view cell among the solver's cells) and their frames.
+struct SolverMeasuring {
+  const Scene& scene;
+  const RayCaster& caster;
+  const CameraSet& cameras;
+  FrameConfig frame;
+};
+
+/// The solver's PVSs now, measured by the cameras (logged).
+MeasuredPoint measure_solver(const SolverMeasuring& m, const AgvsSolver& solver, const Log& log);
+
+/// The stopping rule by measured error: the solver run to one batch, then to every doubling
+/// of its samples, and measured each time (appended to `curve`), until the cameras' mean
+/// wrong pixels (the paper's pixel error, which the estimator estimates) are at most
+/// `target`, or one of `limits`' own limits (samples, seconds, estimated error) stops it
+/// first. `after_run`, when given, is called after each run, before measuring (a checkpoint).
+/// Returns whether the measured error stopped it.
+bool run_to_measured_error(AgvsSolver& solver, const AgvsConfig& limits, double target, const SolverMeasuring& m,
+                           std::vector<MeasuredPoint>& curve, const Log& log,
+                           const std::function<void()>& after_run = {});
 
 struct PvsResult {
   PvsConfig config;
