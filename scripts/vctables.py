@@ -47,14 +47,17 @@ def set_ratios(sets, meth, ref, counts):
 
 def merge_start_text(m, leaves=None):
     """The validated merge's chosen history: "greedy from / barrier" per piece (a later piece
-    starts where the one before ends, at its barrier; 'AV-S' is the subdivision's own order)."""
+    starts where the one before ends, at its barrier; 'AV-S' is the subdivision's own order;
+    "refined": the barrier's blocks, and those of every halving below, refined by moving cells
+    between neighbouring blocks)."""
     chain = m.get("chain")
     if not chain:
         return f"{m.get('greedy_from_cells', leaves or 0):,} / {m.get('barrier_cells') or '-'}"
     parts = []
     for p in chain:
         parts.append("AV-S" if p["greedy_from_cells"] <= 1 else
-                     f"{p['greedy_from_cells']:,} / {p['barrier_cells'] or '-'}")
+                     f"{p['greedy_from_cells']:,} / {p['barrier_cells'] or '-'}"
+                     + (" refined" if p.get("refined") else ""))
     return ", then ".join(parts)
 
 def command(args):

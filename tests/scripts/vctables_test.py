@@ -63,6 +63,8 @@ class Tables(unittest.TestCase):
         self.assertEqual(vctables.merge_start_text({"chain": chain}), "5,000 / 78, then 39 / -")
         chain[1]["greedy_from_cells"] = 1
         self.assertEqual(vctables.merge_start_text({"chain": chain}), "5,000 / 78, then AV-S")
+        chain[1].update({"greedy_from_cells": 312, "barrier_cells": 64, "refined": True})
+        self.assertEqual(vctables.merge_start_text({"chain": chain}), "5,000 / 78, then 312 / 64 refined")
         # Reports from before the chain: the single start.
         self.assertEqual(vctables.merge_start_text({"greedy_from_cells": 156, "barrier_cells": 39}), "156 / 39")
         self.assertEqual(vctables.merge_start_text({}, 2000), "2,000 / -")

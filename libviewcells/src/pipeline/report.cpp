@@ -153,7 +153,11 @@ json cost_curve(const Subdivision& sub) {
 json starts_json(const std::vector<MergeStart>& starts) {
   json out = json::array();
   for (const MergeStart& st : starts)
-    out.push_back({{"cells", st.cells}, {"barrier", st.barrier}, {"score", st.score}, {"worst", st.worst}});
+    out.push_back({{"cells", st.cells},
+                   {"barrier", st.barrier},
+                   {"refined", st.refined},
+                   {"score", st.score},
+                   {"worst", st.worst}});
   return out;
 }
 
@@ -161,7 +165,7 @@ json chain_json(const MergeSummary& v) {
   json out = json::array();
   for (const MergePiece& p : v.chain)
     out.push_back({{"from_cells", p.from}, {"to_cells", p.to}, {"greedy_from_cells", p.start.cells},
-                   {"barrier_cells", p.start.barrier}});
+                   {"barrier_cells", p.start.barrier}, {"refined", p.start.refined}});
   return out;
 }
 

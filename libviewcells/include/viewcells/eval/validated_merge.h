@@ -56,6 +56,9 @@ struct MergeStart {
   uint32_t barrier = 0;  ///< within the blocks of its cut at this many cells until there (0: none)
   double score = 0;      ///< mean log(cost / AV-S cost) on the validation PVSs (< 0: better)
   double worst = 0;      ///< the largest log(cost / AV-S cost) among the counts scored
+  /// The barrier's blocks refined first (refine_blocks, on the PVSs merging decides on), the
+  /// cells of the cut at `cells` being the units moved: the cut at `barrier` is then not AV-S's.
+  bool refined = false;
 };
 
 /// One piece of the chosen history: candidate `start`'s merges from `from` cells (a cut that

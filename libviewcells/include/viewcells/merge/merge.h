@@ -106,6 +106,26 @@ std::vector<std::pair<int32_t, int32_t>> subdivision_prefix(const Subdivision& s
 /// `cells` cells that holds it (MergeConfig::block).
 std::vector<int32_t> subdivision_blocks(const Subdivision& s, size_t cells);
 
+/// What refine_blocks did: passes over the units, units moved, and the blocks' c(S) (sum of
+/// weight x r(PVS), not normalised) before and after.
+struct RefineStats {
+  uint32_t passes = 0;
+  uint64_t moves = 0;
+  double cost_before = 0, cost_after = 0;
+};
+
+/// Boundary refinement of a partition's blocks (a greedy Kernighan-Lin pass, as multilevel
+/// graph partitioners refine their coarsened cuts). The partition's cells are grouped into
+/// units (`unit`, a label per cell), and the units into blocks (`block`, a label per cell,
+/// the same for every cell of a unit). A unit moves to a neighbouring block while that lowers
+/// the blocks' sum of weight x r(PVS) (the PVS of a block: the union of its cells'), and
+/// only when its own block stays connected and not empty; passes over the units in order
+/// until none moves or `max_passes`. Deterministic. Returns the refined block per cell (the
+/// same labels). Not with the pixel term (Error).
+std::vector<int32_t> refine_blocks(const Scene& scene, const CellPartition& partition, const CostModel& model,
+                                   const std::vector<int32_t>& unit, const std::vector<int32_t>& block,
+                                   uint32_t max_passes = 20, RefineStats* stats = nullptr);
+
 /// Every merge of `h`, in order, each cell named by the least leaf under it. A cell of a cut
 /// is a set of leaves, so these names hold across histories whose cuts agree: merges of one
 /// history down to a count where its cut equals another's, followed by the other's merges
