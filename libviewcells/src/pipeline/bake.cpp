@@ -85,9 +85,9 @@ SubdivisionFile hierarchy(const BakeConfig& c, LoadedScene& loaded, uint32_t max
   return std::move(built.file);
 }
 
-/// The AGVS PVSs of the view cells `set`, continued from the work directory's state when it
-/// belongs to them, and saved there.
-/// With `cams`, the measured error can stop it (BakeConfig::measured_error).
+/// The AGVS PVSs of the view cells `pf` (located by `cells`), continued from the work
+/// directory's state when it belongs to them, and saved there. With `cams` and a measured
+/// error, the cameras' measurements stop it (BakeConfig::measured_error).
 std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, const LoadedScene& loaded, const PvsFile& pf,
                                               const CellLocator& cells, const std::optional<CameraSet>& cams,
                                               BakeResult& out, const Log& log) {
@@ -279,7 +279,8 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
       if (written.cells.size() != set.cells.size()) {
         const PvsFile wf = pvs_file_for(file, written);
         const CellLocator located(wf.bsp, wf.leaf_cell, wf.pvs.cell_count);
-        for (size_t i = 0; i < in_written.cameras.size(); ++i) in_written.cells[i] = located.cell_at(in_written.cameras[i].eye);
+        for (size_t i = 0; i < in_written.cameras.size(); ++i)
+          in_written.cells[i] = located.cell_at(in_written.cameras[i].eye);
       }
       Stopwatch sw;
       out.measured = measure_frames(*loaded.scene, *loaded.caster, in_written.cameras, in_written.cells,

@@ -257,8 +257,8 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   }
   bool measured_stop = false;
   if (cams && c.measured_error > 0) {
-    measured_stop =
-        run_to_measured_error(*solver, c.agvs, c.measured_error, measuring(c, scenes, *cams, out), out.measured_curve, log);
+    measured_stop = run_to_measured_error(*solver, c.agvs, c.measured_error, measuring(c, scenes, *cams, out),
+                                          out.measured_curve, log);
   } else {
     if (cams && !c.measure_at.empty()) measured_run(c, scenes, *cams, *solver, out, log);
     solver->run();
