@@ -1,6 +1,7 @@
 // Boundary refinement of blocks of a partition (merge/merge.h: refine_blocks).
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include "viewcells/core/error.h"
 #include "viewcells/merge/merge.h"
@@ -27,15 +28,29 @@ std::vector<int32_t> refine_blocks(const Scene& scene, const CellPartition& part
   }
   const size_t u = names.size();
   std::vector<double> w(u, 0.0);
-  std::vector<std::vector<uint32_t>> pvs(u);
-  for (size_t c = 0; c < n; ++c) {
-    w[id[c]] += partition.weight[c];
-    auto& l = pvs[id[c]];
-    l.insert(l.end(), partition.pvs[c].begin(), partition.pvs[c].end());
+  // Each unit's PVS, the union of its cells': cells grouped by unit, objects deduplicated by
+  // a stamp per object (linear in the cells' entries; only the unions are sorted).
+  std::vector<uint32_t> first(u + 1, 0), cells_by_unit(n);
+  for (size_t c = 0; c < n; ++c) ++first[id[c] + 1];
+  for (size_t x = 0; x < u; ++x) first[x + 1] += first[x];
+  {
+    std::vector<uint32_t> at(first.begin(), first.end() - 1);
+    for (size_t c = 0; c < n; ++c) cells_by_unit[at[id[c]]++] = static_cast<uint32_t>(c);
   }
-  for (auto& l : pvs) {
+  std::vector<std::vector<uint32_t>> pvs(u);
+  std::vector<uint32_t> stamp(r.size(), UINT32_MAX);
+  for (size_t x = 0; x < u; ++x) {
+    auto& l = pvs[x];
+    for (uint32_t i = first[x]; i < first[x + 1]; ++i) {
+      const uint32_t c = cells_by_unit[i];
+      w[x] += partition.weight[c];
+      for (uint32_t o : partition.pvs[c])
+        if (stamp[o] != x) {
+          stamp[o] = static_cast<uint32_t>(x);
+          l.push_back(o);
+        }
+    }
     std::sort(l.begin(), l.end());
-    l.erase(std::unique(l.begin(), l.end()), l.end());
   }
   std::vector<std::vector<int32_t>> next(u);
   for (const auto& [a, b] : partition.neighbours) {
