@@ -307,7 +307,8 @@ std::string describe_chain(const MergeSummary& summary) {
     out += "greedy merging from the subdivision's own cut at " + std::to_string(p.start.cells) + " cells";
     if (p.start.barrier && p.start.refined)
       out += ", within its cut at " + std::to_string(p.start.barrier) +
-             " cells refined by moving cells between neighbouring blocks until there, and so at every halving below";
+             " cells refined by moving cells between neighbouring blocks until there" +
+             (p.to ? std::string() : ", and so at every halving below");
     else if (p.start.barrier)
       out += ", within its cut at " + std::to_string(p.start.barrier) + " cells until there";
   }
