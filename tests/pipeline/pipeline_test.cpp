@@ -150,6 +150,19 @@ TEST(Pipeline, BakeRefusesNoBudgetOrTwo) {
   EXPECT_THROW(pipeline::bake(c, quiet), Error);
 }
 
+/// The measured stopping rule's curve: first after one batch, then at every doubling of the
+/// samples, each measurement above the target but the last, which is within it.
+void expect_stopped_at_measured_error(const std::vector<pipeline::MeasuredPoint>& curve, uint64_t batch,
+                                      double target) {
+  ASSERT_GE(curve.size(), 2u) << "one batch of " << batch << " samples does not see all the cameras show";
+  EXPECT_EQ(curve.front().samples, batch);
+  for (size_t k = 0; k + 1 < curve.size(); ++k) {
+    EXPECT_GT(curve[k].measured.pixels, target) << "measurement " << k;
+    EXPECT_GE(curve[k + 1].samples, 2 * curve[k].samples) << "measurement " << k;
+  }
+  EXPECT_LE(curve.back().measured.pixels, target);
+}
+
 /// bake --measured-error: AGVS stops at the first measurement whose cameras' mean error is
 /// within the target (after one batch, then at every doubling), and the error the report gives
 /// is what `viewcells measure` finds in the file written with the same cameras, also when a
@@ -174,12 +187,7 @@ TEST(Pipeline, BakeStopsAtAMeasuredErrorAndReportsWhatMeasureFinds) {
   c.measured_error = 0.5;                // so: no wrong pixel at all
   const pipeline::BakeResult r = pipeline::bake(c, quiet);
   // (With 16 cameras, one batch of 1,000 samples saw all they show on one kernel.)
-  ASSERT_GE(r.measured_curve.size(), 2u) << "one batch of 250 samples does not see all that 64 cameras show";
-  EXPECT_EQ(r.measured_curve.front().samples, 250u);
-  for (size_t k = 0; k + 1 < r.measured_curve.size(); ++k) {
-    EXPECT_GT(r.measured_curve[k].measured.pixels, c.measured_error) << "measurement " << k;
-    EXPECT_GE(r.measured_curve[k + 1].samples, 2 * r.measured_curve[k].samples) << "measurement " << k;
-  }
+  expect_stopped_at_measured_error(r.measured_curve, 250, c.measured_error);
   EXPECT_TRUE(r.measured_stop);
   EXPECT_NE(r.agvs.stop_reason.find("measured pixel error"), std::string::npos) << r.agvs.stop_reason;
   EXPECT_EQ(r.agvs.samples, r.measured_curve.back().samples) << "no sample after the last measurement";
@@ -237,13 +245,7 @@ TEST(Pipeline, PvsStopsAtAMeasuredError) {
   c.measured_error = 1;  // so: no wrong pixel at all
   c.output = test::temp_path("measured.pvs");
   const pipeline::PvsResult r = pipeline::compute_pvs(c, quiet);
-  ASSERT_GE(r.measured_curve.size(), 2u) << "one batch of 1,000 samples does not see everything";
-  EXPECT_EQ(r.measured_curve.front().samples, 1000u);
-  for (size_t k = 0; k + 1 < r.measured_curve.size(); ++k) {
-    EXPECT_GT(r.measured_curve[k].measured.pixels, c.measured_error) << "measurement " << k;
-    EXPECT_GE(r.measured_curve[k + 1].samples, 2 * r.measured_curve[k].samples) << "measurement " << k;
-  }
-  EXPECT_LE(r.measured_curve.back().measured.pixels, c.measured_error);
+  expect_stopped_at_measured_error(r.measured_curve, 1000, c.measured_error);
   EXPECT_EQ(r.stats.samples, r.measured_curve.back().samples) << "no sample after the last measurement";
   EXPECT_NE(r.stats.stop_reason.find("measured pixel error"), std::string::npos) << r.stats.stop_reason;
   ASSERT_TRUE(r.measured);
