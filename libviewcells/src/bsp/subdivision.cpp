@@ -801,7 +801,7 @@ class Builder {
     const RawVector<SegRef>& refs = refs_[node];
     const size_t n = refs.size();
     // Chunks of at least kGrain parts, a few per thread (the result does not depend on them).
-    constexpr size_t kGrain = 1 << 10;
+    constexpr size_t kGrain = 1 << 16;
     const size_t threads = std::min<size_t>(
         static_cast<size_t>(std::max(1, tbb::this_task_arena::max_concurrency())),
         tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
@@ -976,9 +976,10 @@ class Builder {
     RawVector<double> storage;
     const double* r = candidate_costs(node, storage);
     Candidate results[4];
+    const std::array<std::vector<double>, 3> positions = axis_positions(node, out_.cells[node].bounds());
     auto task = [&](int t) {
       if (t < 3) {
-        results[t] = best_axis_candidate(node, t, *ext, ev, r);
+        results[t] = best_axis_candidate(node, t, positions[t], *ext, ev, r);
       } else if (ga_) {
         results[3] = best_geometry_candidate(node, ev, r);
       }
@@ -1056,57 +1057,70 @@ class Builder {
     return best;
   }
 
-  /// The coordinate along `axis` of the end i of a node's segment parts: the low end of part
-  /// i / 2 for even i, its high end for odd i.
-  double part_end(const RawVector<SegRef>& refs, size_t i, int axis) const {
-    const SegRef& s = refs[i >> 1];
-    const SegEnds& e = ends_[s.id];
-    const double c0 = e.at(s.t0)[axis], c1 = e.at(s.t1)[axis];
-    return (i & 1) ? std::max(c0, c1) : std::min(c0, c1);
-  }
-
-  /// The axis-aligned positions tried in `node` along `axis` (sorted, distinct, strictly inside
-  /// the cell's bounds): all segment ends when there are at most max_axis_candidates, else a
-  /// random choice, reproducible per node and axis (SubdivisionConfig::exact_candidates).
-  std::vector<double> axis_positions(int32_t node, int axis, double lo_b, double hi_b) const {
+  /// The axis-aligned positions tried in `node` along each axis (sorted, distinct, strictly
+  /// inside the cell's bounds): all segment ends when there are at most max_axis_candidates,
+  /// else a random choice, reproducible per node (SubdivisionConfig::exact_candidates).
+  ///
+  /// The random choice reads the node's parts in their order from a random one on (wrapping),
+  /// and takes both ends of each, along every axis that still needs positions, until each has
+  /// k distinct ones or 2k parts are read (walls, where many segments end, repeat). The parts
+  /// name their segments in the order they were sampled, which does not depend on where they
+  /// are, so a run of parts is as random a choice as parts drawn one by one; and each part
+  /// read (a cache miss for its segment) serves the three axes, where drawing an end per axis
+  /// cost two dependent misses per position.
+  std::array<std::vector<double>, 3> axis_positions(int32_t node, const Box3& bounds) const {
     const RawVector<SegRef>& refs = refs_[node];
     const size_t k = config_.max_axis_candidates;
+    const size_t n = refs.size();
+    std::array<std::vector<double>, 3> positions;
+    if (config_.exact_candidates || 2 * n <= 4 * k) {
+      for (int axis = 0; axis < 3; ++axis) positions[axis] = all_axis_positions(node, axis, bounds);
+      return positions;
+    }
+    Rng rng(config_.seed, static_cast<uint64_t>(node) << 2);
+    const size_t first = rng.below(n);
+    std::array<DrawnSet, 3>& drawn = drawn_.local();
+    for (int axis = 0; axis < 3; ++axis) {
+      drawn[axis].reset(k);
+      positions[axis].reserve(k);
+    }
+    constexpr size_t kAhead = 16;
+    for (size_t read = 0; read < 2 * k; ++read) {
+      __builtin_prefetch(&ends_[refs[(first + read + kAhead) % n].id]);
+      const SegRef& part = refs[(first + read) % n];
+      const SegEnds& e = ends_[part.id];
+      const Vec3 p0 = e.at(part.t0), p1 = e.at(part.t1);
+      bool wanted = false;
+      for (int axis = 0; axis < 3; ++axis) {
+        std::vector<double>& at = positions[axis];
+        for (double c : {p0[axis], p1[axis]})
+          if (at.size() < k && c > bounds.lo[axis] && c < bounds.hi[axis] && drawn[axis].insert(c)) at.push_back(c);
+        wanted |= at.size() < k;
+      }
+      if (!wanted || read + 1 == n) break;
+    }
+    for (std::vector<double>& at : positions) std::sort(at.begin(), at.end());
+    return positions;
+  }
+
+  /// Every segment end of the node along `axis` strictly inside the bounds, sorted and
+  /// distinct; a uniform random subset of k of them when there are more (paper, section 4.2).
+  std::vector<double> all_axis_positions(int32_t node, int axis, const Box3& bounds) const {
+    const RawVector<SegRef>& refs = refs_[node];
+    const size_t k = config_.max_axis_candidates;
+    const double lo_b = bounds.lo[axis], hi_b = bounds.hi[axis];
     Rng rng(config_.seed, (static_cast<uint64_t>(node) << 2) | static_cast<uint64_t>(axis));
     std::vector<double> positions;
-    const size_t ends = 2 * refs.size();
-    if (!config_.exact_candidates && ends > 4 * k) {
-      // Random segment ends (those on the cell's bounds rejected) until k distinct ones or 4k
-      // draws (walls, where many segments end, repeat): O(k), then sorted, not O(n log n).
-      DrawnSet& drawn = drawn_.local();
-      drawn.reset(k);
-      positions.reserve(k);
-      // Drawn a block at a time, their parts and then their segments fetched ahead (each is a
-      // cache miss); the stream is the same, and nothing else draws from it here.
-      constexpr size_t kBlock = 64;
-      size_t block[kBlock];
-      for (size_t draw = 0; draw < 4 * k && positions.size() < k;) {
-        const size_t m = std::min(kBlock, 4 * k - draw);
-        for (size_t j = 0; j < m; ++j) __builtin_prefetch(&refs[(block[j] = rng.below(ends)) >> 1]);
-        for (size_t j = 0; j < m; ++j) __builtin_prefetch(&ends_[refs[block[j] >> 1].id]);
-        for (size_t j = 0; j < m && positions.size() < k; ++j, ++draw) {
-          const double c = part_end(refs, block[j], axis);
-          if (c > lo_b && c < hi_b && drawn.insert(c)) positions.push_back(c);
-        }
-      }
-      std::sort(positions.begin(), positions.end());
-    } else {
-      positions.reserve(ends);
-      for (size_t i = 0; i < refs.size(); ++i) {
-        prefetch_ends(refs, i);
-        const SegEnds& e = ends_[refs[i].id];
-        for (double c : {e.at(refs[i].t0)[axis], e.at(refs[i].t1)[axis]})
-          if (c > lo_b && c < hi_b) positions.push_back(c);
-      }
-      std::sort(positions.begin(), positions.end());
-      positions.erase(std::unique(positions.begin(), positions.end()), positions.end());
+    positions.reserve(2 * refs.size());
+    for (size_t i = 0; i < refs.size(); ++i) {
+      prefetch_ends(refs, i);
+      const SegEnds& e = ends_[refs[i].id];
+      for (double c : {e.at(refs[i].t0)[axis], e.at(refs[i].t1)[axis]})
+        if (c > lo_b && c < hi_b) positions.push_back(c);
     }
+    std::sort(positions.begin(), positions.end());
+    positions.erase(std::unique(positions.begin(), positions.end()), positions.end());
     if (positions.size() > k) {
-      // A uniform random subset of the distinct positions (paper, section 4.2; fast: of those drawn).
       for (size_t i = 0; i < k; ++i) std::swap(positions[i], positions[i + rng.below(positions.size() - i)]);
       positions.resize(k);
       std::sort(positions.begin(), positions.end());
@@ -1209,11 +1223,11 @@ class Builder {
   }
 
   /// The best axis-aligned split of `node` along `axis` among its candidate positions.
-  Candidate best_axis_candidate(int32_t node, int axis, const NodeExtents& ext, Evaluation& ev, const double* r) {
+  Candidate best_axis_candidate(int32_t node, int axis, const std::vector<double>& positions, const NodeExtents& ext,
+                                Evaluation& ev, const double* r) {
     const ConvexPolyhedron& cell = out_.cells[node];
     const Box3 bounds = cell.bounds();
     const double lo_b = bounds.lo[axis], hi_b = bounds.hi[axis];
-    const std::vector<double> positions = axis_positions(node, axis, lo_b, hi_b);
     if (positions.empty()) return {};
     const size_t k = positions.size();
     std::vector<double> left, right;
@@ -1443,7 +1457,7 @@ class Builder {
   tbb::enumerable_thread_specific<std::pair<Marks, Marks>> side_pair_marks_;  ///< geometry-aligned: both sides
   tbb::enumerable_thread_specific<Marks> triangle_marks_;  ///< geometry-aligned: triangles hit in a cell
   tbb::enumerable_thread_specific<std::vector<uint32_t>> extreme_entry_;  ///< geometry-aligned: see extremes
-  mutable tbb::enumerable_thread_specific<DrawnSet> drawn_;
+  mutable tbb::enumerable_thread_specific<std::array<DrawnSet, 3>> drawn_;
 };
 
 }  // namespace
