@@ -13,15 +13,7 @@ size="${3:-23}"
 source scripts/bench-setup.sh  # builds the current tree (Release), sets $vc and $dir
 city=$(bench_scene city "$size")
 sha=$(git rev-parse --short "$old")
-tree="out/ab/$sha"
-if [ ! -x "$tree/b/cli/viewcells" ]; then
-  rm -rf "$tree"
-  git worktree prune
-  git worktree add -f "$tree" "$sha" >/dev/null
-  cmake -S "$tree" -B "$tree/b" -G Ninja -DCMAKE_BUILD_TYPE=Release -DVIEWCELLS_BUILD_TESTS=OFF >/dev/null
-  cmake --build "$tree/b" -j "$(nproc)" --target viewcells >/dev/null
-fi
-declare -A bin=([old]="$tree/b/cli/viewcells" [new]="$vc")
+declare -A bin=([old]="$(bench_old_build "$sha")" [new]="$vc")
 results="$dir/ab.tsv"
 : >"$results"
 office=$(bench_scene office 4)

@@ -19,3 +19,18 @@ bench_level() {
   mkdir -p "$3"
   "$vc" build "$1" --samples 500000 --max-cells $((4 * $2)) --seed 1 -q -o "$3/level.vcells"
 }
+# bench_old_build COMMIT: builds COMMIT (Release, the viewcells executable) in a git worktree
+# under out/ab/ once, and prints the executable's path.
+bench_old_build() {
+  local sha tree
+  sha=$(git rev-parse --short "$1")
+  tree="out/ab/$sha"
+  if [ ! -x "$tree/b/cli/viewcells" ]; then
+    rm -rf "$tree"
+    git worktree prune
+    git worktree add -f "$tree" "$sha" >/dev/null
+    cmake -S "$tree" -B "$tree/b" -G Ninja -DCMAKE_BUILD_TYPE=Release -DVIEWCELLS_BUILD_TESTS=OFF >/dev/null
+    cmake --build "$tree/b" -j "$(nproc)" --target viewcells >/dev/null
+  fi
+  echo "$tree/b/cli/viewcells"
+}

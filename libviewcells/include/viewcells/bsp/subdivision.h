@@ -73,10 +73,10 @@ struct SubdivisionConfig {
   /// How the axis-aligned positions of a cell are drawn when it has more segment ends than
   /// max_axis_candidates. Exact (the paper's): a uniform random subset of the distinct end
   /// coordinates, which needs them all sorted (O(n log n) per cell and axis). Fast (the
-  /// default, once a cell has more than 4 x max_axis_candidates ends): random segment ends
-  /// until max_axis_candidates distinct ones (or 4 x as many draws), so coordinates where many
-  /// segments end (walls) are likelier: O(k log k). Either way every chosen position is
-  /// evaluated exactly.
+  /// default, once a cell has more than 4 x max_axis_candidates ends): the ends of a run of
+  /// the cell's parts from a random one on, until max_axis_candidates distinct ones per axis
+  /// (or 2 x as many parts read), so coordinates where many segments end (walls) are likelier:
+  /// O(k log k). Either way every chosen position is evaluated exactly.
   bool exact_candidates = false;
   GeometryAlignedMode geometry_aligned = GeometryAlignedMode::kAuto;
   uint32_t ga_candidates = 150;       ///< geometry-aligned planes per node at most (paper: 150)

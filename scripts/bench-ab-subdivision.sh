@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# A/B of the subdivision at the subdivision issue's size, against an earlier commit, measured
+# in one run: the city, SEGMENTS segments to CELLS cells (no stagnation stop, no merge, two
+# threads, fast candidate positions), alternating the old and the new build RUNS times, so that
+# the machine's drift over an hour (up to 1.6x here) falls on both alike. Prints each run's
+# subdivision seconds and final construction cost, the medians and their ratio new / old; the
+# old commit is built (Release) in a git worktree under out/ab/ (as scripts/bench-ab.sh does).
+# Usage: scripts/bench-ab-subdivision.sh OLD_COMMIT [RUNS] [CITY_SIZE] [SEGMENTS] [CELLS]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+old="${1:?usage: scripts/bench-ab-subdivision.sh OLD_COMMIT [RUNS] [CITY_SIZE] [SEGMENTS] [CELLS]}"
+runs="${2:-3}"
+size="${3:-23}"
+segments="${4:-1500000}"
+cells="${5:-50000}"
+source scripts/bench-setup.sh  # builds the current tree (Release), sets $vc and $dir
+city=$(bench_scene city "$size")
+sha=$(git rev-parse --short "$old")
+declare -A bin=([old]="$(bench_old_build "$sha")" [new]="$vc")
+results="$dir/ab-subdivision.tsv"
+: >"$results"
+for r in $(seq "$runs"); do
+  for side in old new; do
+    "${bin[$side]}" -q --threads 2 build "$city" --segments "$segments" --max-cells "$cells" --min-reduction 0 --seed 1 \
+      --no-merge --report "$dir/ab-sub.json"
+    python3 - "$side" "$dir/ab-sub.json" >>"$results" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[2]))
+print(sys.argv[1], r["timings"]["subdivision_seconds"], r["subdivision"]["final_cost"], sep="\t")
+PY
+  done
+done
+python3 - "$results" "$sha" "$runs" "$size" "$segments" "$cells" <<'PY'
+import statistics, sys
+path, sha, runs, size, segments, cells = sys.argv[1:]
+rows = [line.split("\t") for line in open(path).read().split("\n") if line]
+t = {s: [float(x[1]) for x in rows if x[0] == s] for s in ("old", "new")}
+c = {s: [float(x[2]) for x in rows if x[0] == s] for s in ("old", "new")}
+print(f"City size {size}, {int(segments):,} segments to {int(cells):,} cells, {runs} alternating runs of the old "
+      f"({sha}) and the new build, two threads.")
+for s in ("old", "new"):
+    print(f"{s}: subdivision s " + ", ".join(f"{x:.2f}" for x in t[s]) + f"; median {statistics.median(t[s]):.2f}; "
+          f"final construction cost {statistics.median(c[s]):,.0f}")
+print(f"new / old (medians): {statistics.median(t['new']) / statistics.median(t['old']):.3f}")
+PY
