@@ -519,6 +519,10 @@ struct Evaluation {
 
 class Builder {
  public:
+  /// Nodes of at least this many parts evaluate their axes (and sort their positions) in
+  /// parallel; smaller ones in one thread, their siblings beside them. The same results.
+  static constexpr size_t kParallelParts = 1 << 13;
+
   Builder(const Scene& scene, const SegmentSet& segs, const CostModel& model, const SubdivisionConfig& config,
           Subdivision& out)
       : scene_(scene),
@@ -989,7 +993,6 @@ class Builder {
       }
     };
     // Small nodes in this thread (their sibling is evaluated beside them); the same results.
-    constexpr size_t kParallelParts = 1 << 13;
     if (refs.size() < kParallelParts && !ga_) {
       for (int t = 0; t < 3; ++t) task(t);
     } else {
@@ -1065,9 +1068,10 @@ class Builder {
   /// inside the cell's bounds): all segment ends when there are at most max_axis_candidates,
   /// else a random choice, reproducible per node (SubdivisionConfig::exact_candidates).
   ///
-  /// The random choice reads the node's parts in their order from a random one on (wrapping),
-  /// and takes both ends of each, along every axis that still needs positions, until each has
-  /// k distinct ones or 2k parts are read (walls, where many segments end, repeat). The parts
+  /// The random choice reads the node's parts in their order from a random one on (wrapping;
+  /// such a node has more than 2k parts), and takes both ends of each, along every axis that
+  /// still needs positions, until each has k distinct ones or 2k parts are read (walls, where
+  /// many segments end, repeat). The parts
   /// name their segments in the order they were sampled, which does not depend on where they
   /// are, so a run of parts is as random a choice as parts drawn one by one; and each part
   /// read (a cache miss for its segment) serves the three axes, where drawing an end per axis
@@ -1078,7 +1082,13 @@ class Builder {
     const size_t n = refs.size();
     std::array<std::vector<double>, 3> positions;
     if (config_.exact_candidates || 2 * n <= 4 * k) {
-      for (int axis = 0; axis < 3; ++axis) positions[axis] = all_axis_positions(node, axis, bounds);
+      // Each axis sorts all the node's ends: the three at once in a large node.
+      auto axis_task = [&](int axis) { positions[axis] = all_axis_positions(node, axis, bounds); };
+      if (n < kParallelParts) {
+        for (int axis = 0; axis < 3; ++axis) axis_task(axis);
+      } else {
+        tbb::parallel_for(0, 3, axis_task);
+      }
       return positions;
     }
     Rng rng(config_.seed, static_cast<uint64_t>(node) << 2);
@@ -1101,7 +1111,7 @@ class Builder {
           if (at.size() < k && c > bounds.lo[axis] && c < bounds.hi[axis] && drawn[axis].insert(c)) at.push_back(c);
         wanted |= at.size() < k;
       }
-      if (!wanted || read + 1 == n) break;
+      if (!wanted) break;
     }
     for (std::vector<double>& at : positions) std::sort(at.begin(), at.end());
     return positions;
