@@ -15,8 +15,7 @@ segments="${4:-1500000}"
 cells="${5:-50000}"
 source scripts/bench-setup.sh  # builds the current tree (Release), sets $vc and $dir
 city=$(bench_scene city "$size")
-sha=$(git rev-parse --short "$old")
-declare -A bin=([old]="$(bench_old_build "$sha")" [new]="$vc")
+bench_ab_binaries "$old"
 results="$dir/ab-subdivision.tsv"
 : >"$results"
 for r in $(seq "$runs"); do

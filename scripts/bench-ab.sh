@@ -12,8 +12,7 @@ runs="${2:-3}"
 size="${3:-23}"
 source scripts/bench-setup.sh  # builds the current tree (Release), sets $vc and $dir
 city=$(bench_scene city "$size")
-sha=$(git rev-parse --short "$old")
-declare -A bin=([old]="$(bench_old_build "$sha")" [new]="$vc")
+bench_ab_binaries "$old"
 results="$dir/ab.tsv"
 : >"$results"
 office=$(bench_scene office 4)

@@ -34,3 +34,9 @@ bench_old_build() {
   fi
   echo "$tree/b/cli/viewcells"
 }
+# bench_ab_binaries COMMIT: sets sha (COMMIT, short) and bin[old] / bin[new] (that commit's
+# executable, built by bench_old_build, and the current tree's), for the A/B scripts.
+bench_ab_binaries() {
+  sha=$(git rev-parse --short "$1")
+  declare -gA bin=([old]="$(bench_old_build "$sha")" [new]="$vc")
+}
