@@ -212,6 +212,7 @@ SubdivisionConfig CellOptions::subdivision(const Common& c, uint64_t seed) const
   config.exact_candidates = exact_candidates;
   config.min_reduction = min_reduction;
   config.density = parse_density_band(density_band);
+  config.play_space = play_space;
   config.seed = seed;
   config.show_progress = !c.quiet;
   return config;
@@ -284,6 +285,10 @@ void add_cell_options(CLI::App* cmd, CellOptions& a, const std::string& max_cell
       ->capture_default_str();
   cmd->add_option("--density-band", a.density_band,
                   "Viewpoint density zlo,zhi[,outside]: weight 1 between the heights, outside (default 0.1) elsewhere");
+  cmd->add_flag("--play-space", a.play_space,
+                "Quake 3 maps: weigh cells by their volume where a player's eye can be (non-solid leaves reachable "
+                "from the spawn points, at most 112 units above a walkable floor) instead of all non-solid space, so "
+                "merging spends the cells where players are");
 }
 
 pipeline::CutRule CutOptions::rule() const {

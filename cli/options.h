@@ -98,6 +98,7 @@ struct CellOptions {
   std::string screen = "1024x768";
   double fov = 90;
   std::string density_band;
+  bool play_space = false;
 
   CostModel model() const;
   SubdivisionConfig subdivision(const Common& c, uint64_t seed) const;

@@ -6,15 +6,27 @@
 # play cameras. For a table made before maps-shipped.sh made that bake: the table's other bakes
 # stay as they are. Writes docs/results/q3-shipped-leaf.md and .csv and the section
 # "q3shippedleaf" of docs/results.md.
-# Usage: scripts/maps-shipped-leaf.sh [PIXEL_ERROR] [SECONDS]   (defaults 1, 45: the table's)
+# With --play-space: the maps that still miss after that bake, baked the same way with
+# `--play-space` (cells weighed, and AGVS's points drawn, where a player's eye can be), to
+# docs/results/q3-shipped-play.md and .csv and the section "q3shippedplay".
+# Usage: scripts/maps-shipped-leaf.sh [PIXEL_ERROR] [SECONDS] [--play-space]   (defaults 1, 45: the table's)
 set -euo pipefail
 err="${1:-1}"
 secs="${2:-45}"
+play="${3:-}"
 source "$(dirname "$0")/shipped-setup.sh"
-out=out/shipped-leaf
 table=docs/results/q3-shipped.csv
+if [ "$play" = --play-space ]; then
+  kind=play out=out/shipped-play bake=fit-play flags=(--play-space)
+  mapfile -t names < <(python3 scripts/vctables.py shipped-misses "$table" docs/results/q3-shipped-leaf.csv)
+elif [ -z "$play" ]; then
+  kind=leaf out=out/shipped-leaf bake=fit-leaf flags=()
+  mapfile -t names < <(python3 scripts/vctables.py shipped-misses "$table")
+else
+  echo "maps-shipped-leaf.sh: the third argument is --play-space or nothing (got $play)" >&2
+  exit 2
+fi
 mkdir -p "$out"
-mapfile -t names < <(python3 scripts/vctables.py shipped-misses "$table")
 i=0
 for name in "${names[@]}"; do
   i=$((i + 1))
@@ -24,10 +36,10 @@ for name in "${names[@]}"; do
   [ -f "$d/q3map2.json" ] || "$vc" measure "$map" --report "$d/q3map2.json" -q 2> "$d/err"
   budget=$(python3 scripts/vctables.py shipped-budget "$d")
   echo "shipped-leaf: [$i/${#names[@]}] $name: within $budget bytes"
-  shipped_fit "$map" "$d" "$budget" fit-leaf "q3map2's rows and leaf surface lists"
+  shipped_fit "$map" "$d" "$budget" "$bake" "q3map2's rows and leaf surface lists" "${flags[@]}"
 done
-python3 scripts/vctables.py shipped-leaf "$out" "$table" "$err" "$secs"
-echo "scripts/maps-shipped-leaf.sh $err $secs" > docs/results/q3-shipped-leaf.command
-python3 scripts/vctables.py replace-section docs/results.md q3shippedleaf "$(cat docs/results/q3-shipped-leaf.command)" \
-  docs/results/q3-shipped-leaf.md
-echo "shipped-leaf: docs/results.md (section q3shippedleaf), docs/results/q3-shipped-leaf.csv"
+python3 scripts/vctables.py shipped-leaf "$out" "$table" "$err" "$secs" $play
+echo "scripts/maps-shipped-leaf.sh $err $secs $play" | sed 's/ *$//' > "docs/results/q3-shipped-$kind.command"
+python3 scripts/vctables.py replace-section docs/results.md "q3shipped$kind" "$(cat "docs/results/q3-shipped-$kind.command")" \
+  "docs/results/q3-shipped-$kind.md"
+echo "shipped-leaf: docs/results.md (section q3shipped$kind), docs/results/q3-shipped-$kind.csv"

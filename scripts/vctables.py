@@ -1281,21 +1281,31 @@ def shipped_ratio(d, name):
     print(f"{_shipped_bake(json.load(open(f'{d}/q3map2.json')), f'{d}/{name}.json')['ratio']:.3f}")
 
 
-@command("CSV")
-def shipped_misses(path):
-    """The maps of a q3-shipped.csv that miss the goal against q3map2's rows and leaf lists, one a line."""
+def _shipped_rescued(leaf_csv):
+    """The maps a q3-shipped-leaf.csv's bakes brought to the goal."""
+    return {r["map"] for r in csv.DictReader(open(leaf_csv)) if r["met"] == "True"} if leaf_csv else set()
+
+
+@command("CSV [LEAF_CSV]")
+def shipped_misses(path, leaf_csv=None):
+    """The maps of a q3-shipped.csv that miss the goal against q3map2's rows and leaf lists (and, given
+    a q3-shipped-leaf.csv, that its bakes did not bring to it), one a line."""
+    rescued = _shipped_rescued(leaf_csv)
     for r in csv.DictReader(open(path)):
-        if r["goal_leaf"] != "True":
+        if r["goal_leaf"] != "True" and r["map"] not in rescued:
             print(r["map"])
 
 
-@command("OUT_DIR CSV PIXEL_ERROR SECONDS")
-def shipped_leaf(out, path, err, secs):
-    """docs/results/q3-shipped-leaf.md and .csv: the misses of q3-shipped.csv baked within q3map2's rows and leaf lists."""
+@command("OUT_DIR CSV PIXEL_ERROR SECONDS [--play-space]")
+def shipped_leaf(out, path, err, secs, play=None):
+    """docs/results/q3-shipped-leaf.md and .csv: the misses of q3-shipped.csv baked within q3map2's rows and leaf
+    lists; with --play-space, q3-shipped-play.md and .csv: those still missing after that, baked with --play-space."""
+    kind, name = ("play", "fit-play") if play else ("leaf", "fit-leaf")
+    rescued = _shipped_rescued("docs/results/q3-shipped-leaf.csv" if play else None)
     table = list(csv.DictReader(open(path)))
     rows = []
     for t in table:
-        if t["goal_leaf"] == "True":
+        if t["goal_leaf"] == "True" or t["map"] in rescued:
             continue
         d = f"{out}/{t['map']}"
         q = json.load(open(f"{d}/q3map2.json"))
@@ -1303,27 +1313,37 @@ def shipped_leaf(out, path, err, secs):
             raise SystemExit(f"vctables: {t['map']}: q3map2's cost per frame is {q['frame']['cost']} now, "
                              f"{t['q3_cost']} in {path}: not the same cameras")
         budget = q["storage_bytes"] + q.get("leaf_surface_bytes", 0)
-        b = _shipped_bake(q, f"{d}/fit-leaf.json")
-        bake = json.load(open(f"{d}/fit-leaf-bake.json")) if b else None
+        b = _shipped_bake(q, f"{d}/{name}.json")
+        bake = json.load(open(f"{d}/{name}-bake.json")) if b else None
         rows.append(dict(map=t["map"], clusters=int(t["clusters"]), budget=budget, ratio_at_count=float(t["ratio"]),
                          bytes_at_count=int(t["ours_bytes"]), cells=b["cells"] if b else "",
                          ratio=b["ratio"] if b else "", err=b["err"] if b else "", median=b["median"] if b else "",
                          bytes=b["bytes"] if b else "",
                          bake_s=bake["timings"]["total_seconds"] if bake else "",
                          met=bool(b) and _shipped_meets(b, budget)))
-    with open("docs/results/q3-shipped-leaf.csv", "w", newline="") as f:
+    with open(f"docs/results/q3-shipped-{kind}.csv", "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(rows[0].keys() if rows else ["map"])
         for r in rows:
             w.writerow(r.values())
-    before = sum(t["goal_leaf"] == "True" for t in table)
+    before = sum(t["goal_leaf"] == "True" for t in table) + len(rescued)
     met = sum(r["met"] for r in rows)
-    lines = [f"The {len(rows)} maps of the table above that miss the goal against q3map2's rows and leaf surface "
-             f"lists, baked again: `viewcells bake MAP --memory ROWS+LEAF_LISTS --memory-of lists --pixel-error {err} "
-             f"--time {secs}` (the most cells whose compressed lists fit those bytes; fewer cells than the clusters "
-             "where the lists at the cluster count exceed them, more where they leave room), measured by the same "
-             "5,000 play cameras (q3map2's side measured again: the same cost per frame on every map, checked). "
-             "The table above was made before maps-shipped.sh made this bake itself; its other bakes are as they were.\n",
+    flag = " with --play-space" if play else ""
+    lines = [(f"The {len(rows)} maps that still miss the goal after the bakes above, baked once more within q3map2's "
+              f"rows and leaf surface lists with `--play-space`: `viewcells bake MAP --memory ROWS+LEAF_LISTS "
+              f"--memory-of lists --pixel-error {err} --time {secs} --play-space`. The cells are weighed by their "
+              "volume in the play space (the non-solid leaves reachable from the spawn points that hold a point at "
+              "most 112 units above a walkable floor with free space up to it: where a player's eye can be, "
+              "jumping included) instead of all non-solid space, in the division (200,000 points uniform in those "
+              "leaves) and in merging, and AGVS draws its points in those leaves, so that its error estimate is "
+              "that of cameras where players are. Measured by the same 5,000 play cameras.\n") if play else
+             (f"The {len(rows)} maps of the table above that miss the goal against q3map2's rows and leaf surface "
+              f"lists, baked again: `viewcells bake MAP --memory ROWS+LEAF_LISTS --memory-of lists --pixel-error {err} "
+              f"--time {secs}` (the most cells whose compressed lists fit those bytes; fewer cells than the clusters "
+              "where the lists at the cluster count exceed them, more where they leave room), measured by the same "
+              "5,000 play cameras (q3map2's side measured again: the same cost per frame on every map, checked). "
+              "The table above was made before maps-shipped.sh made this bake itself; its other bakes are as they "
+              "were.\n"),
              "| map | clusters | q3map2 rows + leaf lists (B) | at the cluster count: ours / q3map2, lists (B) | cells | "
              "ours / q3map2 | wrong px (mean / median) | lists (B) | bake (s) | goal |",
              "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |"]
@@ -1333,11 +1353,11 @@ def shipped_leaf(out, path, err, secs):
         lines.append(f"| {r['map']} | {r['clusters']:,} | {r['budget']:,} | {r['ratio_at_count']:.3f}, "
                      f"{r['bytes_at_count']:,} | {got} | {'yes' if r['met'] else 'no'} |")
     lines.append("")
-    lines.append(f"**{met} of these {len(rows)} maps meet all three within q3map2's rows and leaf surface lists: with "
-                 f"the {before} that met it before, {before + met} of {len(table)} maps** (cost at most half of "
+    lines.append(f"**{met} of these {len(rows)} maps meet all three within q3map2's rows and leaf surface lists{flag}: "
+                 f"with the {before} that met it before, {before + met} of {len(table)} maps** (cost at most half of "
                  "q3map2's per frame, median camera at most 1 wrong pixel, lists within the bytes).\n")
-    lines.append("Per map in docs/results/q3-shipped-leaf.csv.\n")
-    open("docs/results/q3-shipped-leaf.md", "w").write("\n".join(lines))
+    lines.append(f"Per map in docs/results/q3-shipped-{kind}.csv.\n")
+    open(f"docs/results/q3-shipped-{kind}.md", "w").write("\n".join(lines))
 
 
 @command("FILE NAME COMMAND TABLE_FILE")

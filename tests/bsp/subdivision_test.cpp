@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <tuple>
 
 #include "support/test_scenes.h"
@@ -299,6 +300,64 @@ TEST(Subdivision, ViewpointDensityConcentratesCellsInTheBand) {
   };
   EXPECT_GT(cells_touching_band(banded), cells_touching_band(uniform) + 20)
       << "cells gather where the viewpoints are";
+}
+
+TEST(Subdivision, ViewpointPointsWeighCellsByTheirShare) {
+  // Viewpoints in the ground floor's western half only (a rotated office: geometry-aligned
+  // planes are counted too): cells gather there, cells without one weigh nothing.
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 2, 4});
+  const SegmentSet segs = sample(scene, 30000);
+  const Box3 box = segs.view_box;
+  auto points = std::make_shared<std::vector<Vec3>>();
+  Rng rng(5);
+  const double mid_x = 0.5 * (box.lo.x + box.hi.x);
+  for (int i = 0; i < 20000; ++i)
+    points->push_back({rng.uniform(box.lo.x, mid_x), rng.uniform(box.lo.y, box.hi.y), rng.uniform(box.lo.z, 2.0)});
+  points->push_back(box.hi + Vec3{1, 1, 1});  // outside the box: not counted
+  SubdivisionConfig config;
+  config.max_cells = 120;
+  config.show_progress = false;
+  config.geometry_aligned = GeometryAlignedMode::kOn;
+  config.viewpoints = points;
+  auto build_points = [&] { return subdivide(scene, segs, CostModel{}, config); };
+  const Subdivision s = build_points();
+  expect_invariants(scene, segs, s);
+  // The root weighs the box's volume; each point weighs volume / points in the box; children
+  // add up; a leaf weighs its points (located as Subdivision::locate puts them).
+  EXPECT_NEAR(s.nodes[0].weight, box.volume(), 1e-9 * box.volume());
+  std::map<int32_t, int> in_leaf;
+  for (size_t i = 0; i + 1 < points->size(); ++i) ++in_leaf[s.locate((*points)[i])];
+  const double unit = box.volume() / 20000.0;
+  int empty = 0, west = 0, east = 0;
+  for (int32_t l : s.leaves()) {
+    EXPECT_NEAR(s.nodes[l].weight, in_leaf[l] * unit, 1e-9 * box.volume()) << "leaf " << l;
+    empty += in_leaf[l] == 0;
+    const Box3 c = s.cells[l].bounds();
+    west += c.hi.x <= mid_x + 1e-9;
+    east += c.lo.x >= mid_x - 1e-9;
+  }
+  for (const BspNode& n : s.nodes)
+    if (n.plane >= 0)
+      EXPECT_NEAR(s.nodes[n.child[0]].weight + s.nodes[n.child[1]].weight, n.weight, 1e-9 * box.volume());
+  EXPECT_GT(west, 4 * std::max(east, 1)) << "cells gather where the viewpoints are";
+  EXPECT_GT(empty, 0);
+  // The same tree for one and for two threads.
+  Subdivision one, two;
+  {
+    ThreadLimit t(1);
+    one = build_points();
+  }
+  {
+    ThreadLimit t(2);
+    two = build_points();
+  }
+  expect_same_tree(one, two);
+  // Points and a height band are two densities: one at a time.
+  config.density = {true, 1.0, 2.0, 0.01};
+  EXPECT_THROW(build_points(), Error);
+  config.density = {};
+  config.viewpoints = std::make_shared<std::vector<Vec3>>(1, box.hi + Vec3{1, 1, 1});
+  EXPECT_THROW(build_points(), Error);  // none in the box
 }
 
 TEST(Subdivision, ReplayGivesEveryCellCount) {

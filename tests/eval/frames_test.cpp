@@ -2,6 +2,7 @@
 // by hand, and cameras placed where players stand on OpenArena's oa_dm2 (q3/play.h) with the
 // map's own PVS measured by them.
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <cmath>
 #include <cstdlib>
@@ -78,14 +79,29 @@ TEST(Frames, PlayerCameraIsLevel) {
   EXPECT_NEAR(std::asin(c.forward.z), 0.2, 1e-12);
 }
 
-std::string oa_dm2() { return test::oa_dm2_path(VIEWCELLS_DATA_DIR); }
+/// oa_dm2, its scene and a caster, loaded once; null when the map is not fetched.
+struct Dm2 {
+  Q3Map map;
+  Scene scene;
+  std::unique_ptr<RayCaster> caster;
+};
+const Dm2* dm2() {
+  static const std::unique_ptr<Dm2> loaded = []() -> std::unique_ptr<Dm2> {
+    const std::string path = test::oa_dm2_path(VIEWCELLS_DATA_DIR);
+    if (path.empty()) return nullptr;
+    auto d = std::make_unique<Dm2>(Dm2{read_q3bsp(path), load_scene(path), nullptr});
+    d->caster = make_embree_caster(d->scene);
+    return d;
+  }();
+  return loaded.get();
+}
 
 TEST(Q3PlayCameras, PlayersStandOnReachableFloorsAndQ3map2sPvsShowsWhatTheySee) {
-  const std::string path = oa_dm2();
-  if (path.empty()) GTEST_SKIP() << "oa_dm2.bsp not fetched (scripts/fetch-maps.sh)";
-  const Q3Map map = read_q3bsp(path);
-  const Scene scene = load_scene(path);
-  const auto caster = make_embree_caster(scene);
+  const Dm2* d = dm2();
+  if (!d) GTEST_SKIP() << "oa_dm2.bsp not fetched (scripts/fetch-maps.sh)";
+  const Q3Map& map = d->map;
+  const Scene& scene = d->scene;
+  const RayCaster* caster = d->caster.get();
   PlayCameraConfig config;
   config.count = 400;
   const PlayCameras play = q3_play_cameras(map, scene, *caster, config);
@@ -119,6 +135,46 @@ TEST(Q3PlayCameras, PlayersStandOnReachableFloorsAndQ3map2sPvsShowsWhatTheySee) 
   const PixelErrorMeasure m = measure_frames(scene, *caster, play.cameras, clusters,
                                              GlobalPvs::from_lists(scene.object_count(), admitted), FrameConfig{64, 48});
   EXPECT_LE(m.share, 1e-5) << m.wrong.size() << " (camera, object) pairs wrong";
+}
+
+
+TEST(Q3PlaySpace, HoldsEveryPlayCameraAndIsTheSameForAnyThreadCount) {
+  const Dm2* d = dm2();
+  if (!d) GTEST_SKIP() << "oa_dm2.bsp not fetched (scripts/fetch-maps.sh)";
+  const Q3Map& map = d->map;
+  const Scene& scene = d->scene;
+  const RayCaster* caster = d->caster.get();
+  PlaySpaceConfig config;
+  config.columns = 200000;
+  const PlaySpace play = q3_play_space(map, scene, *caster, config);
+  const std::vector<bool> reachable = q3_reachable_leaves(map);
+  ASSERT_EQ(play.leaves.size(), map.leaves.size());
+  size_t count = 0;
+  for (size_t l = 0; l < map.leaves.size(); ++l) {
+    count += play.leaves[l];
+    if (play.leaves[l]) ASSERT_TRUE(reachable[l]) << "leaf " << l;
+  }
+  EXPECT_EQ(count, play.play_leaves);
+  EXPECT_GT(play.play_leaves, 0u);
+  EXPECT_GT(play.play_volume, 0);
+  EXPECT_LT(play.play_volume, play.open_volume);  // the space high above the floors is not play
+  // Every eye of a player standing on a floor is in it (cameras from another seed).
+  PlayCameraConfig cams;
+  cams.count = 2000;
+  cams.seed = 7;
+  const PlayCameras eyes = q3_play_cameras(map, scene, *caster, cams);
+  size_t outside = 0;
+  for (int32_t l : eyes.leaves) outside += !play.leaves[l];
+  EXPECT_LE(outside, 2u) << outside << " of 2000 play cameras outside the play space";
+  // One thread: the same leaves.
+  tbb::task_arena one(1);
+  const PlaySpace serial = one.execute([&] { return q3_play_space(map, scene, *caster, config); });
+  EXPECT_EQ(serial.leaves, play.leaves);
+  // Weights of the play leaves alone: the root weighs their volume.
+  Subdivision q3 = q3_subdivision(map, q3_view_box(map));
+  keep_leaf_weights(q3, map, play.leaves);
+  EXPECT_NEAR(q3.nodes[0].weight, play.play_volume, 1e-9 * play.play_volume);
+  EXPECT_THROW(keep_leaf_weights(q3, map, std::vector<bool>(3, true)), Error);
 }
 
 }  // namespace

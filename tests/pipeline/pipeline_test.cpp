@@ -2,6 +2,7 @@
 // bake under budgets, the PVSs of coarser cuts, reports.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
@@ -14,6 +15,10 @@
 #include "viewcells/pipeline/measure.h"
 #include "viewcells/pipeline/pvs.h"
 #include "viewcells/pipeline/report.h"
+#include "viewcells/pipeline/sampling.h"
+#include "viewcells/q3/play.h"
+#include "viewcells/q3/view_space.h"
+#include "viewcells/core/rng.h"
 #include "viewcells/runtime.hpp"
 #include "viewcells/scene/generators.h"
 
@@ -55,6 +60,71 @@ TEST(Pipeline, BuildWritesWhatItReturnsAndReportsIt) {
   EXPECT_EQ(j["subdivision"]["cells"], r.file.subdivision.leaf_count());
   EXPECT_TRUE(j.contains("embree_isa"));
   EXPECT_EQ(j["counts"]["valid_segments"], r.sampling.result.stats.valid_segments);
+}
+
+TEST(Pipeline, PlaySpaceNeedsAMapAndIsTheOnlyDensity) {
+  pipeline::BuildConfig c = small_build("");
+  c.subdivision.play_space = true;
+  try {
+    pipeline::build(c, quiet);
+    ADD_FAILURE() << "--play-space on an OBJ was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("--play-space needs a Quake 3 map"), std::string::npos) << e.what();
+  }
+  c.scene.path = "level.bsp";  // checked before the file is read
+  c.subdivision.density = {true, 0.0, 2.0, 0.1};
+  EXPECT_THROW(pipeline::build(c, quiet), Error);
+}
+
+TEST(Pipeline, PlaySpaceWeighsCellsWherePlayersAreAndAgvsDrawsThere) {
+  const std::string path = test::oa_dm2_path(VIEWCELLS_DATA_DIR);
+  if (path.empty()) GTEST_SKIP() << "oa_dm2.bsp not fetched (scripts/fetch-maps.sh)";
+  pipeline::BuildConfig c;
+  c.scene.path = path;
+  c.sampling.samples = 30000;
+  c.sampling.show_progress = false;
+  c.subdivision.max_cells = 150;
+  c.subdivision.show_progress = false;
+  c.subdivision.play_space = true;
+  const pipeline::BuildResult r = pipeline::build(c, quiet);
+  const auto j = nlohmann::json::parse(pipeline::report_json(r));
+  EXPECT_TRUE(j["effects"]["viewpoint_density"]["enabled"]) << j["effects"].dump();
+  // Each cell weighs its volume in the play space's leaves: in all, the play space's volume.
+  const pipeline::LoadedScene& loaded = r.sampling.loaded;
+  const PlaySpace play = q3_play_space(*loaded.map, *loaded.scene, *loaded.caster, PlaySpaceConfig{});
+  const Subdivision& s = r.file.subdivision;
+  double total = 0;
+  for (int32_t l : s.leaves()) total += s.nodes[l].weight;
+  EXPECT_NEAR(total, play.play_volume, 1e-6 * play.play_volume);
+  EXPECT_LT(total, 0.99 * play.open_volume);
+  // AGVS's points: in the play space's leaves, uniform over them by volume (the share in the
+  // leaves west of the middle against their share of the volume, within 5 sigma).
+  AgvsConfig a;
+  pipeline::use_play_view_space(loaded, a);
+  ASSERT_TRUE(a.view_point_map && a.view_space);
+  const Q3Map& map = *loaded.map;
+  const Subdivision q3 = q3_subdivision(map, q3_view_box(map));
+  const size_t inner = map.nodes.size();
+  double west_volume = 0;
+  const double mid = q3_view_box(map).center().x;
+  for (size_t l = 0; l < map.leaves.size(); ++l)
+    if (play.leaves[l] && !q3.cells[inner + l].empty() && q3.cells[inner + l].bounds().center().x < mid)
+      west_volume += q3.nodes[inner + l].volume;
+  Rng rng(3);
+  int drawn = 0, kept = 0, west = 0;
+  for (; drawn < 40000; ++drawn) {
+    const Vec3 p = a.view_point_map(rng.uniform(), rng.uniform(), rng.uniform());
+    if (std::isnan(p.x)) continue;
+    ++kept;
+    const int32_t l = map.leaf_at(p);
+    ASSERT_TRUE(play.leaves[l]) << "a point outside the play space";
+    ASSERT_TRUE(a.view_space(p));
+    ASSERT_TRUE(q3_in_view_space(map, p));
+    west += q3.cells[inner + l].bounds().center().x < mid;
+  }
+  ASSERT_GT(kept, drawn / 10);
+  const double share = west_volume / play.play_volume;
+  EXPECT_NEAR(static_cast<double>(west) / kept, share, 5 * std::sqrt(share * (1 - share) / kept));
 }
 
 TEST(Pipeline, CoarserCutsSeeTheUnionOfTheirParts) {

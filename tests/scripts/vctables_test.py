@@ -358,38 +358,63 @@ class Tables(unittest.TestCase):
                                     "cameras_with_wrong_pixels": 3},
                     "storage_bytes": pvs_bytes + 10, "pvs_bytes": pvs_bytes, "leaf_surface_bytes": 100}
         bake = {"estimated_pixel_error": None, "pixel_error_bound": 1.5, "agvs": {"samples": 1000}}
-        # m1: ours at the clusters fits the rows; m2: it does not, and the bake that fits costs 0.6;
-        # m3: it does not and nothing fits, but rows + leaf lists hold it; m5: it fits but costs 0.6,
-        # and the most cells that fit (20) cost 0.45.
-        for name, ours_cost, ours_bytes, fit in [("m1", 40.0, 900, None), ("m2", 30.0, 2000, (5, 60.0, 950)),
-                                                 ("m3", 45.0, 1050, None), ("m5", 60.0, 700, (20, 45.0, 990))]:
+        # m1: ours at the clusters fits the rows; m2: it does not, the bake that fits the rows costs
+        # 0.6, the one within rows + leaf lists (1,110 bytes) 0.48; m3: it does not and nothing fits,
+        # but rows + leaf lists hold it; m5: it fits but costs 0.6, and the most cells that fit (20)
+        # cost 0.45; m6: it fits and costs 0.7, nothing else made.
+        for name, ours_cost, ours_bytes, fit, fit_leaf in [
+                ("m1", 40.0, 900, None, None), ("m2", 30.0, 2000, (5, 60.0, 950), (8, 48.0, 1080)),
+                ("m3", 45.0, 1050, None, None), ("m5", 60.0, 700, (20, 45.0, 990), None),
+                ("m6", 70.0, 900, None, None)]:
             dump(f"{out}/{name}/q3map2.json", measured(10, 100.0, 0.0, 0.0, 1000, {"far": 4}))
             dump(f"{out}/{name}/ours.json", measured(10, ours_cost, 2.0, 0.0, ours_bytes))
             dump(f"{out}/{name}/bake.json", bake)
             open(f"{out}/{name}/bake_wall_seconds", "w").write("12.5")
             if fit:
                 dump(f"{out}/{name}/fit.json", measured(fit[0], fit[1], 3.0, 0.0, fit[2]))
+            if fit_leaf:
+                dump(f"{out}/{name}/fit-leaf.json", measured(fit_leaf[0], fit_leaf[1], 3.0, 0.0, fit_leaf[2]))
         os.makedirs(f"{out}/m4")
         open(f"{out}/m4.skipped", "w").write("no visibility data")
+        # What maps-shipped.sh asks before the third bake.
+        self.assertEqual(run("shipped-budget", f"{out}/m2").strip(), "1110")
+        self.assertEqual(run("shipped-met", f"{out}/m6", 1100).strip(), "no")
+        self.assertEqual(run("shipped-met", f"{out}/m1", 1100).strip(), "yes")
+        self.assertEqual(run("shipped-ratio", f"{out}/m2", "fit-leaf").strip(), "0.480")
         cwd = os.getcwd()
         os.makedirs(f"{self.d}/docs/results")
         os.chdir(self.d)
         try:
             run("shipped", out, 1, 45)
             md = open("docs/results/q3-shipped.md").read()
+            misses = run("shipped-misses", "docs/results/q3-shipped.csv").split()
+            # The third bake for m6 (as maps-shipped-leaf.sh makes it), within its 1,110 bytes.
+            leaf = f"{self.d}/leaf"
+            dump(f"{leaf}/m6/q3map2.json", measured(10, 100.0, 0.0, 0.0, 1000))
+            dump(f"{leaf}/m6/fit-leaf.json", measured(12, 49.0, 0.5, 0.0, 1090))
+            dump(f"{leaf}/m6/fit-leaf-bake.json", {"timings": {"total_seconds": 30.0}})
+            run("shipped-leaf", leaf, "docs/results/q3-shipped.csv", 1, 45)
+            leaf_md = open("docs/results/q3-shipped-leaf.md").read()
+            still = run("shipped-misses", "docs/results/q3-shipped.csv", "docs/results/q3-shipped-leaf.csv").split()
         finally:
             os.chdir(cwd)
-        self.assertIn("4 maps (1 without vis data skipped)", md)
+        self.assertIn("5 maps (1 without vis data skipped)", md)
         self.assertEqual(row(md, "m1")[4], "0.400")
         self.assertEqual(row(md, "m2")[12], "5, 0.600, 3.00")
+        self.assertEqual(row(md, "m2")[13], "8, 0.480, 3.00")
         self.assertEqual(row(md, "m3")[12], "none")
         self.assertEqual(row(md, "m5")[12], "20, 0.450, 3.00")
-        self.assertEqual([row(md, m)[13] for m in ("m1", "m2", "m3", "m5")],
-                         ["yes / yes", "no / no", "no / yes", "yes / yes"])
-        self.assertIn("median over maps; range 0.300 to 0.600", md)
+        self.assertEqual([row(md, m)[14] for m in ("m1", "m2", "m3", "m5", "m6")],
+                         ["yes / yes", "no / yes", "no / yes", "yes / yes", "no / no"])
+        self.assertIn("median over maps; range 0.300 to 0.700", md)
         self.assertIn("All three (cost at most half, median camera at most 1 wrong pixel, within the rows' bytes, by "
-                      "either bake): 2 of 4 maps", md)
-        self.assertIn("16 far", md)
+                      "either bake): 2 of 5 maps", md)
+        self.assertIn("20 far", md)
+        self.assertEqual(misses, ["m6"])
+        self.assertEqual(row(leaf_md, "m6")[4:7], ["12", "0.490", "0.50 / 0"])
+        self.assertIn("1 of these 1 maps meet all three", leaf_md)
+        self.assertIn("with the 4 that met it before, 5 of 5 maps", leaf_md)
+        self.assertEqual(still, [])
 
     def test_agvs_measured_time_to_error(self):
         out = f"{self.d}/am"

@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 #include <numbers>
 
 namespace viewcells {
@@ -54,7 +55,7 @@ void AgvsSolver::Impl::view_points(int d, int dim, uint32_t attempts, std::vecto
   index.assign(attempts, kNoIndex);
   point.assign(attempts, Vec3{});
   auto at = [&](uint64_t i) { return view_point(h.at(i, dim), h.at(i, dim + 1), h.at(i, dim + 2)); };
-  if (!config.view_space) {
+  if (!config.view_space && !config.view_point_map) {
     const uint64_t first = halton_index[d];
     halton_index[d] += attempts;
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, attempts, 256), [&](const tbb::blocked_range<uint32_t>& r) {
@@ -81,7 +82,7 @@ void AgvsSolver::Impl::view_points(int d, int dim, uint32_t attempts, std::vecto
     tbb::parallel_for(tbb::blocked_range<size_t>(0, block, 256), [&](const tbb::blocked_range<size_t>& r) {
       for (size_t j = r.begin(); j < r.end(); ++j) {
         candidates[j] = at(first + j);
-        inside[j] = config.view_space(candidates[j]) ? 1 : 0;
+        inside[j] = !std::isnan(candidates[j].x) && (!config.view_space || config.view_space(candidates[j])) ? 1 : 0;
       }
     });
     size_t used = 0;

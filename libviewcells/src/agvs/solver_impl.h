@@ -130,6 +130,7 @@ struct AgvsSolver::Impl {
   Vec3 object_point(double u0, double u1, double u2, double u3, Vec3& normal) const;
 
   Vec3 view_point(double u0, double u1, double u2) const {
+    if (config.view_point_map) return config.view_point_map(u0, u1, u2);
     const Box3& b = cells.view_box();
     const Vec3 e = b.extent();
     return {b.lo.x + e.x * u0, b.lo.y + e.y * u1, b.lo.z + e.z * u2};

@@ -537,6 +537,7 @@ class Builder {
   void run() {
     const auto start = std::chrono::steady_clock::now();
     out_.view_box = segs_.view_box;
+    points_ = static_cast<bool>(config_.viewpoints);
     if (config_.strategy == SplitStrategy::kCost) {
       out_.stats.geometry_aligned = use_geometry_aligned(scene_, config_, out_.stats.geometry_aligned_reason);
     } else {
@@ -573,6 +574,17 @@ class Builder {
       tris_.push_back(std::move(inside));
     }
     add_node(-1, std::move(root), std::move(refs));
+    if (points_) {
+      // Weighted by the viewpoints in the box: together they weigh its volume.
+      std::vector<uint32_t> inside;
+      const std::vector<Vec3>& p = *config_.viewpoints;
+      for (uint32_t i = 0; i < p.size(); ++i)
+        if (b.contains(p[i])) inside.push_back(i);
+      if (inside.empty()) throw Error("none of the " + std::to_string(p.size()) + " viewpoints lies in the view box");
+      point_weight_ = total_volume_ / static_cast<double>(inside.size());
+      out_.nodes[0].weight = total_volume_;
+      pts_.push_back(std::move(inside));
+    }
     total_weight_ = out_.nodes[0].weight;
     pvs_budget_ = config_.pvs_budget_share * out_.nodes[0].pvs_cost;
     if (!(total_weight_ > 0)) throw Error("the viewpoint density is zero everywhere in the view space");
@@ -896,6 +908,7 @@ class Builder {
     Partition parts;
     BspNode measured[2];
     std::vector<uint32_t> tri_side[2];  ///< the polygon BSP baseline: the polygons of each side
+    std::vector<uint32_t> point_side[2];  ///< with viewpoints: those of each side
   };
 
   /// What splitting a cell by its plane gives, without changing any node: its parts divided
@@ -923,6 +936,11 @@ class Builder {
     for (int k = 0; k < 2; ++k)
       p.measured[k] = measure_node(node, k == 0 ? p.halves->first : p.halves->second, p.parts.side[k],
                                    extents ? &p.parts.ext[k] : nullptr);
+    if (points_) {
+      const std::vector<Vec3>& at = *config_.viewpoints;
+      for (uint32_t i : pts_[node]) p.point_side[plane.side(at[i]) > 0 ? 1 : 0].push_back(i);
+      for (int k = 0; k < 2; ++k) p.measured[k].weight = static_cast<double>(p.point_side[k].size()) * point_weight_;
+    }
   }
 
   /// Adds the two children of a prepared split as the next nodes (ids in the order added).
@@ -935,6 +953,7 @@ class Builder {
         pending_ext_[c] = std::make_unique<NodeExtents>(std::move(p.parts.ext[k]));
       }
       if (config_.strategy == SplitStrategy::kPolygonBsp) tris_.push_back(std::move(p.tri_side[k]));
+      if (points_) pts_.push_back(std::move(p.point_side[k]));
     }
   }
 
@@ -945,6 +964,7 @@ class Builder {
     refs_[node].clear();
     refs_[node].shrink_to_fit();
     if (config_.strategy == SplitStrategy::kPolygonBsp) tris_[node] = {};
+    if (points_) pts_[node] = {};
     out_.cells[node] = ConvexPolyhedron();
     out_.nodes[node].child[0] = c0;
     out_.nodes[node].child[1] = c0 + 1;
@@ -960,6 +980,7 @@ class Builder {
     best_.resize(n);
     if (pending_ext_.size() > n) pending_ext_.resize(n);
     if (tris_.size() > n) tris_.resize(n);
+    if (pts_.size() > n) pts_.resize(n);
   }
 
   /// Adds what evaluating a node of the tree took to the statistics (counted once the node is
@@ -1259,6 +1280,18 @@ class Builder {
       return area * (density.outside * ((x - lo_b) - in_band) + in_band);
     };
     const ConvexPolyhedron part = (!box && density.enabled) ? density.band_part(cell) : ConvexPolyhedron();
+    // With viewpoints, the weight below each position from the node's points: a point is
+    // below every position at or above it (the positions are sorted).
+    std::vector<double> points_below;
+    if (points_) {
+      std::vector<uint32_t> first_at(k + 1, 0);
+      const std::vector<Vec3>& at = *config_.viewpoints;
+      for (uint32_t i : pts_[node])
+        ++first_at[std::lower_bound(positions.begin(), positions.end(), at[i][axis]) - positions.begin()];
+      points_below.resize(k);
+      uint64_t below = 0;
+      for (size_t j = 0; j < k; ++j) points_below[j] = static_cast<double>(below += first_at[j]) * point_weight_;
+    }
     bool found = false;
     size_t best_j = 0;
     double best_reduction = 0;
@@ -1268,7 +1301,8 @@ class Builder {
       if (!(vl > kMinPart * volume && volume - vl > kMinPart * volume)) continue;
       // Without a density the weight below is the volume below, just computed (weight_below
       // would clip the cell again for the same number).
-      const double wl = box                ? box_weight_below(positions[j])
+      const double wl = points_            ? points_below[j]
+                        : box              ? box_weight_below(positions[j])
                         : density.enabled ? density.weight_below(cell, part, Plane::axis_aligned(axis, positions[j]))
                                           : vl;
       const double wr = weight - wl;
@@ -1368,7 +1402,14 @@ class Builder {
           if (to & 2) cr += pos.add(e.object_a, r) + pos.add(e.object_b, r);
         }
       }
-      const double wl = config_.density.enabled ? config_.density.weight_below(cell, part, plane) : vl;
+      double wl = vl;
+      if (points_) {
+        uint64_t below = 0;
+        for (uint32_t i : pts_[node]) below += plane.side((*config_.viewpoints)[i]) <= 0;
+        wl = static_cast<double>(below) * point_weight_;
+      } else if (config_.density.enabled) {
+        wl = config_.density.weight_below(cell, part, plane);
+      }
       return own - (wl * cl + (weight - wl) * cr) / total_weight_;
     };
     // In a cell of more than kBoundedParts parts, every plane is first bounded from its
@@ -1457,6 +1498,11 @@ class Builder {
   std::vector<SegEnds> ends_;  ///< per segment, as segs_
   std::vector<uint32_t> depth_;              ///< per node
   std::vector<std::vector<uint32_t>> tris_;  ///< BSP baseline: per node, the polygons in it
+  /// With viewpoints (points_): per node, the viewpoints in it (those of split nodes freed),
+  /// and the weight of one.
+  std::vector<std::vector<uint32_t>> pts_;
+  bool points_ = false;
+  double point_weight_ = 0;
   double pvs_budget_ = 0;
   uint64_t slivers_refused_ = 0;
   uint64_t splits_undone_ = 0;
@@ -1484,6 +1530,8 @@ Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const Cost
   if (config.density.enabled &&
       !(config.density.lo < config.density.hi && config.density.outside >= 0 && std::isfinite(config.density.outside)))
     throw Error("viewpoint density band needs lo < hi and a finite, non-negative outside weight");
+  if (config.viewpoints && config.density.enabled)
+    throw Error("the viewpoint density is either a height band or points, not both");
   for (size_t i = 0; i < segments.size(); ++i)
     for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
       if (o != kNoObject && o >= scene.objects.size())

@@ -35,7 +35,7 @@ std::string hierarchy_key(const BakeConfig& c, uint32_t max_cells) {
     << ' ' << c.model.screen_width << ' ' << c.model.screen_height << ' ' << c.model.fov_degrees << "\ncells "
     << max_cells << " ga " << static_cast<int>(d.geometry_aligned) << ' ' << d.ga_candidates << ' '
     << d.max_axis_candidates << (d.exact_candidates ? " exact" : " fast") << " min reduction " << d.min_reduction << " density " << d.density.enabled << ' '
-    << d.density.lo << ' ' << d.density.hi << ' ' << d.density.outside << '\n';
+    << d.density.lo << ' ' << d.density.hi << ' ' << d.density.outside << (d.play_space ? " play space" : "") << '\n';
   if (c.merge_agvs)
     k << "merge agvs " << c.merge_agvs->seed << ' ' << c.merge_agvs->max_samples << ' ' << c.merge_agvs->pixel_error << ' '
       << c.merge_agvs->batch_size << '\n';
@@ -93,6 +93,7 @@ std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, const LoadedS
                                               BakeResult& out, const Log& log) {
   AgvsConfig agvs = c.agvs;
   use_map_view_space(loaded.map, agvs);
+  if (c.subdivision.play_space) use_play_view_space(loaded, agvs);
   out.agvs_in_view_space = static_cast<bool>(agvs.view_space);
   AgvsSolver solver(*loaded.scene, *loaded.caster, cells, agvs);
   const uint64_t identity = pvs_state_identity(loaded.scene->fingerprint(), pf);

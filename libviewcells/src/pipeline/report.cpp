@@ -188,7 +188,8 @@ json build_effects(const BuildResult& r) {
   e["geometry_aligned_candidates"] = effect(sub.stats.geometry_aligned, sub.stats.geometry_aligned_reason);
   e["pixel_cost_term"] = effect(model.pixel_term(), model.describe_pixel_term());
   e["viewpoint_density"] =
-      config.density.enabled
+      !r.play_space.empty() ? effect(true, "--play-space: p(i) is the share of " + r.play_space + " in the cell")
+      : config.density.enabled
           ? effect(true, "--density-band: weight 1 for " + fmt(config.density.lo, 2) + " <= z <= " +
                              fmt(config.density.hi, 2) + ", " + fmt(config.density.outside, 3) + " elsewhere")
           : effect(false, "uniform: p(i) = V_i / V (no --density-band)");
@@ -381,9 +382,12 @@ json agvs_curve(const AgvsStats& st, size_t references) {
   return curve;
 }
 
-json agvs_view_space(bool restricted) {
-  return effect(restricted, restricted ? "a Quake 3 map: AGVS's points are drawn in its non-solid space"
-                                       : "AGVS's points are drawn in the whole view box");
+json agvs_view_space(bool restricted, bool play = false) {
+  return effect(restricted, play         ? "--play-space: AGVS's points are drawn in the play space's leaves (those "
+                                           "reachable from the spawn points with a point at most 112 units above a "
+                                           "walkable floor)"
+                            : restricted ? "a Quake 3 map: AGVS's points are drawn in its non-solid space"
+                                         : "AGVS's points are drawn in the whole view box");
 }
 
 json pvs_effects(const PvsResult& r) {
@@ -567,6 +571,7 @@ std::string report_json(const BakeResult& r) {
                 {{"construction_samples", c.sampling.samples},
                  {"seed", c.sampling.seed},
                  {"elementary_cells", r.elementary_cells},
+                 {"play_space", c.subdivision.play_space},
                  {"pixel_error", c.agvs.pixel_error},
                  {"measured_error", c.measured_error},
                  {"max_seconds", c.agvs.max_seconds},
@@ -590,7 +595,7 @@ std::string report_json(const BakeResult& r) {
                                                            "are the unions of their parts"
                                                      : "the file fits the budget as sampled")},
                  {"empty_space_detection", effect(st.empty_space.enabled, st.empty_space.reason)},
-                 {"restricted_view_space", agvs_view_space(r.agvs_in_view_space)}}},
+                 {"restricted_view_space", agvs_view_space(r.agvs_in_view_space, c.subdivision.play_space)}}},
                {"scene_fingerprint", r.scene_fingerprint},
                {"objects", r.object_count},
                {"cells", r.cells},

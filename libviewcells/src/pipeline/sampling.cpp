@@ -8,6 +8,7 @@
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/io/scene_io.h"
+#include "viewcells/q3/play.h"
 #include "viewcells/q3/view_space.h"
 #include "viewcells/sampling/segments.h"
 
@@ -50,6 +51,45 @@ void use_map_view_space(LoadedScene& s, SamplerConfig& config) {
 void use_map_view_space(const std::shared_ptr<const Q3Map>& map, AgvsConfig& config) {
   if (!map) return;
   config.view_space = [map](const Vec3& p) { return q3_in_view_space(*map, p); };
+}
+
+void use_play_view_space(const LoadedScene& s, AgvsConfig& config) {
+  if (!s.map) throw Error("the play space needs a Quake 3 map");
+  std::shared_ptr<const Q3Map> map = s.map;
+  auto play = std::make_shared<const std::vector<bool>>(q3_play_space(*map, *s.scene, *s.caster, PlaySpaceConfig{}).leaves);
+  // The play leaves' bounds, drawn by volume: a point of leaf l's bounds counts when it lies in
+  // l (and outside its detail brushes), so the points are uniform over the play leaves however
+  // their bounds overlap.
+  const Subdivision q3 = q3_subdivision(*map, q3_view_box(*map));
+  const int32_t inner = static_cast<int32_t>(map->nodes.size());
+  struct Leaf {
+    double upto;  ///< the bounds' volume of the leaves so far, this one's included
+    int32_t leaf;
+    Box3 bounds;
+  };
+  auto leaves = std::make_shared<std::vector<Leaf>>();
+  double total = 0;
+  for (int32_t l = 0; l < static_cast<int32_t>(play->size()); ++l) {
+    if (!(*play)[l] || q3.cells[inner + l].empty()) continue;
+    const Box3 b = q3.cells[inner + l].bounds();
+    if (!(b.volume() > 0)) continue;
+    leaves->push_back({total += b.volume(), l, b});
+  }
+  if (leaves->empty()) throw Error(map->path, 0, "the play space is empty: no leaf a player's eye can be in");
+  config.view_point_map = [map, leaves, total](double u0, double u1, double u2) {
+    const double at = u0 * total;
+    const auto it = std::lower_bound(leaves->begin(), leaves->end(), at,
+                                     [](const Leaf& x, double v) { return x.upto <= v; });
+    const Leaf& x = it == leaves->end() ? leaves->back() : *it;
+    const double from = x.upto - x.bounds.volume();
+    const double f = std::clamp((at - from) / x.bounds.volume(), 0.0, 1.0);
+    const Vec3 e = x.bounds.extent();
+    const Vec3 p{x.bounds.lo.x + e.x * f, x.bounds.lo.y + e.y * u1, x.bounds.lo.z + e.z * u2};
+    if (map->leaf_at(p) != x.leaf || !q3_in_view_space(*map, p)) return Vec3{std::nan(""), 0, 0};
+    return p;
+  };
+  // REF draws its points in cells, and reports ask whether the points are restricted.
+  config.view_space = [map, play](const Vec3& p) { return (*play)[map->leaf_at(p)] && q3_in_view_space(*map, p); };
 }
 
 SamplingRun load_and_sample(const SceneSource& source, const SamplerConfig& config, const Log& log) {

@@ -1,6 +1,10 @@
 #include "viewcells/q3/play.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numbers>
 
@@ -10,6 +14,39 @@
 #include "viewcells/q3/view_space.h"
 
 namespace viewcells {
+
+namespace {
+
+/// The walkable surfaces, by area: rendered occluders facing up at least `walk_normal` (sky and
+/// brush hulls are not rendered, water does not stop rays).
+class WalkableFloors {
+ public:
+  WalkableFloors(const Scene& scene, double walk_normal) {
+    for (uint32_t t = 0; t < scene.triangles.size(); ++t) {
+      const ObjectInfo& o = scene.objects[scene.triangle_object[t]];
+      if (!o.rendered || !o.occluder) continue;
+      const Vec3 n = scene.triangle_normal(t);
+      const double twice_area = length(n);
+      if (!(twice_area > 0) || n.z < walk_normal * twice_area) continue;
+      total_ += 0.5 * twice_area;
+      floors_.emplace_back(total_, t);
+    }
+  }
+  bool empty() const { return floors_.empty(); }
+  /// The point of the floors for three uniform numbers in [0, 1): uniform by area.
+  Vec3 point(const Scene& scene, double pick, double u, double v) const {
+    const auto it = std::lower_bound(floors_.begin(), floors_.end(), std::make_pair(pick * total_, uint32_t{0}));
+    const auto& tri = scene.triangles[(it == floors_.end() ? floors_.back() : *it).second];
+    const double su = std::sqrt(u);
+    return scene.vertices[tri[0]] * (1 - su) + scene.vertices[tri[1]] * (su * (1 - v)) + scene.vertices[tri[2]] * (su * v);
+  }
+
+ private:
+  std::vector<std::pair<double, uint32_t>> floors_;  ///< (area so far, triangle)
+  double total_ = 0;
+};
+
+}  // namespace
 
 std::vector<bool> q3_reachable_leaves(const Q3Map& map, size_t* spawn_points) {
   const Box3 box = q3_view_box(map);
@@ -54,6 +91,52 @@ std::vector<bool> q3_reachable_leaves(const Q3Map& map, size_t* spawn_points) {
   return reached;
 }
 
+PlaySpace q3_play_space(const Q3Map& map, const Scene& scene, const RayCaster& caster, const PlaySpaceConfig& config) {
+  if (config.columns == 0 || !(config.reach > 0) || !(config.step > 0) || !(config.walk_normal > 0 && config.walk_normal <= 1))
+    throw Error("play space: columns, reach, step and walkable normal must be positive (the normal at most 1)");
+  PlaySpace out;
+  const std::vector<bool> reachable = q3_reachable_leaves(map);
+  const WalkableFloors floors(scene, config.walk_normal);
+  if (floors.empty()) throw Error(map.path, 0, "play space: the map has no walkable surface");
+  // Marks are only ever set, so the columns may mark them in any order: the same leaves for
+  // any number of threads.
+  std::vector<std::atomic<uint8_t>> marked(map.leaves.size());
+  const Vec3 up{0, 0, 1};
+  constexpr double kLift = 0.25;  // off the floor, so the floor itself is not what the ray meets
+  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, config.columns, 1024), [&](const tbb::blocked_range<uint32_t>& r) {
+    for (uint32_t i = r.begin(); i < r.end(); ++i) {
+      Rng rng(config.seed, (uint64_t{92} << 40) | i);
+      const double pick = rng.uniform(), u = rng.uniform(), v = rng.uniform();
+      const Vec3 f = floors.point(scene, pick, u, v);
+      const Hit hit = caster.intersect(Ray{f + up * kLift, up, 0, config.reach - kLift});
+      const double top = hit.hit() ? kLift + hit.t : config.reach;
+      for (double h = kLift; h < top; h += config.step) {
+        const int32_t l = map.leaf_at(f + up * h);
+        if (reachable[l] && !marked[l].load(std::memory_order_relaxed)) marked[l].store(1, std::memory_order_relaxed);
+      }
+    }
+  });
+  out.leaves.assign(map.leaves.size(), false);
+  const Subdivision s = q3_subdivision(map, q3_view_box(map));
+  const size_t inner = map.nodes.size();
+  for (size_t l = 0; l < map.leaves.size(); ++l) {
+    if (map.leaves[l].cluster < 0) continue;
+    const double volume = s.nodes[inner + l].volume;
+    ++out.open_leaves;
+    out.open_volume += volume;
+    if (!marked[l].load()) continue;
+    out.leaves[l] = true;
+    ++out.play_leaves;
+    out.play_volume += volume;
+  }
+  out.rule = "the non-solid leaves reachable from the spawn points that hold a point at most " + fmt(config.reach, 0) +
+             " units above a walkable floor (normal z >= " + fmt(config.walk_normal, 2) + ") with free space up to it (" +
+             std::to_string(out.play_leaves) + " of " + std::to_string(out.open_leaves) + " leaves, " +
+             fmt(100 * out.play_volume / std::max(out.open_volume, 1e-300), 1) + "% of the non-solid volume; " +
+             std::to_string(config.columns) + " columns)";
+  return out;
+}
+
 PlayCameras q3_play_cameras(const Q3Map& map, const Scene& scene, const RayCaster& caster,
                             const PlayCameraConfig& config) {
   if (config.count == 0) throw Error("play cameras: the count must be positive");
@@ -71,19 +154,7 @@ PlayCameras q3_play_cameras(const Q3Map& map, const Scene& scene, const RayCaste
     const int32_t l = map.leaf_at(p);
     return reachable[l] && q3_in_view_space(map, p);
   };
-  // The walkable surfaces, by area: rendered occluders facing up (sky and brush hulls are not
-  // rendered, water does not stop rays).
-  std::vector<std::pair<double, uint32_t>> floors;
-  double total = 0;
-  for (uint32_t t = 0; t < scene.triangles.size(); ++t) {
-    const ObjectInfo& o = scene.objects[scene.triangle_object[t]];
-    if (!o.rendered || !o.occluder) continue;
-    const Vec3 n = scene.triangle_normal(t);
-    const double twice_area = length(n);
-    if (!(twice_area > 0) || n.z < config.walk_normal * twice_area) continue;
-    total += 0.5 * twice_area;
-    floors.emplace_back(total, t);
-  }
+  const WalkableFloors floors(scene, config.walk_normal);
   if (floors.empty()) throw Error(map.path, 0, "play cameras: the map has no walkable surface");
   const Vec3 up{0, 0, 1};
   const double pitch = config.max_pitch_degrees * std::numbers::pi / 180;
@@ -98,12 +169,9 @@ PlayCameras q3_play_cameras(const Q3Map& map, const Scene& scene, const RayCaste
                       " found in " + std::to_string(out.points_drawn) +
                       " points of walkable surfaces (none reachable from the spawn points?)");
     ++out.points_drawn;
-    const double pick = rng.uniform() * total, su = std::sqrt(rng.uniform()), v = rng.uniform();
+    const double pick = rng.uniform(), su = rng.uniform(), v = rng.uniform();
     const double yaw = 2 * std::numbers::pi * rng.uniform(), look = pitch * (2 * rng.uniform() - 1);
-    const auto it = std::lower_bound(floors.begin(), floors.end(), std::make_pair(pick, uint32_t{0}));
-    const auto& tri = scene.triangles[(it == floors.end() ? floors.back() : *it).second];
-    const Vec3 f = scene.vertices[tri[0]] * (1 - su) + scene.vertices[tri[1]] * (su * (1 - v)) +
-                   scene.vertices[tri[2]] * (su * v);
+    const Vec3 f = floors.point(scene, pick, su, v);
     // Free space for a player: nothing above the floor up to the player's height.
     if (caster.intersect(Ray{f + up * 0.25, up, 0, config.player_height - 0.25}).hit()) continue;
     const Vec3 eye = f + up * config.eye_height;

@@ -106,6 +106,29 @@ Subdivision q3_subdivision(const Q3Map& map, const Box3& box) {
   return s;
 }
 
+void keep_leaf_weights(Subdivision& q3, const Q3Map& map, const std::vector<bool>& keep) {
+  if (keep.size() != map.leaves.size() || q3.nodes.size() != map.nodes.size() + map.leaves.size())
+    throw Error("keep_leaf_weights: the leaves do not belong to this map's subdivision");
+  const size_t inner = map.nodes.size();
+  for (size_t l = 0; l < keep.size(); ++l)
+    if (!keep[l]) q3.nodes[inner + l].weight = 0;
+  // Inner nodes from their children (iterative post-order: map nodes need not be in any order).
+  std::vector<std::pair<int32_t, bool>> stack{{0, false}};
+  while (!stack.empty()) {
+    auto [n, expanded] = stack.back();
+    stack.pop_back();
+    BspNode& b = q3.nodes[n];
+    if (b.plane < 0) continue;
+    if (!expanded) {
+      stack.emplace_back(n, true);
+      stack.emplace_back(b.child[0], false);
+      stack.emplace_back(b.child[1], false);
+    } else {
+      b.weight = q3.nodes[b.child[0]].weight + q3.nodes[b.child[1]].weight;
+    }
+  }
+}
+
 double view_space_volume(const Subdivision& q3, const ConvexPolyhedron& cell) {
   if (cell.empty()) return 0.0;
   double v = 0;

@@ -91,6 +91,12 @@ struct AgvsConfig {
   /// points outside are skipped), so no samples are spent in solid space and the pixel error
   /// estimator's cameras stand where viewers do.
   std::function<bool(const Vec3&)> view_space;
+  /// Where those points come from: a map of the unit cube's (Halton) points to points of the
+  /// view space, uniform over it where it returns a point; a point with a NaN coordinate is
+  /// skipped like one outside view_space. Empty: the view box, scaled. A view space that fills
+  /// little of its box (a map's play space) is drawn this way at the cost of the points it
+  /// skips rather than of all the box's.
+  std::function<Vec3(double, double, double)> view_point_map;
   /// Keep the visibility filter's sampling densities (segments per cell; per cell and object,
   /// those that hit it: 2 bytes per cell and object). Required by the object space filter.
   bool filter_statistics = false;

@@ -12,6 +12,7 @@
 /// Deterministic: the same inputs and seed give the same tree for any number of threads.
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -93,6 +94,15 @@ struct SubdivisionConfig {
   uint32_t split_round = 16;
   bool show_progress = true;
   HeightBandDensity density;  ///< uniform (p(i) = V_i / V) unless enabled
+  /// A viewpoint density given by points of equal weight (on a map: player eyes): a cell
+  /// weighs the share of them in it times the view box's volume (a point on a splitting plane
+  /// counts on its negative side, as Subdivision::locate puts it), so that a cell without
+  /// any weighs nothing and gains nothing from being divided. Not with `density`. Null: the
+  /// density above.
+  std::shared_ptr<const std::vector<Vec3>> viewpoints;
+  /// On a Quake 3 map: the pipeline draws `viewpoints` as player eyes (q3/play.h), so p(i) is
+  /// where players are rather than all non-solid space.
+  bool play_space = false;
 };
 
 struct BspNode {

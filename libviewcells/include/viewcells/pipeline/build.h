@@ -47,6 +47,7 @@ struct BuildResult {
   SubdivisionConfig subdivision_config;  ///< as used (geometry-aligned decided)
   bool merge = true;
   MergeSummary merge_summary;  ///< what merging chose, and its seconds (with a history)
+  std::string play_space;      ///< with SubdivisionConfig::play_space: the play space, in words
   /// The hierarchy: the subdivision (its cells and per-leaf segments dropped once written),
   /// the leaves' PVSs and, when merged, the merge history.
   SubdivisionFile file;

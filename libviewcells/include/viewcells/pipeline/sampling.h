@@ -49,6 +49,9 @@ void use_map_view_space(LoadedScene& loaded, SamplerConfig& config);
 
 /// On a Quake 3 map (`map` not null), AGVS draws its points in the map's non-solid space too.
 void use_map_view_space(const std::shared_ptr<const Q3Map>& map, AgvsConfig& config);
+/// On a Quake 3 map, AGVS draws its points in the play space's leaves (q3_play_space), so that
+/// its pixel error estimate is that of cameras where players are (with --play-space).
+void use_play_view_space(const LoadedScene& loaded, AgvsConfig& config);
 
 /// Loading and sampling, with what a report needs.
 struct SamplingRun {

@@ -40,6 +40,32 @@ struct PlayCameras {
 /// per map leaf, whether reachable.
 std::vector<bool> q3_reachable_leaves(const Q3Map& map, size_t* spawn_points = nullptr);
 
+/// Where a player's eye can be, as map leaves: the leaves reachable from the spawn points
+/// (q3_reachable_leaves) that hold a point at most `reach` units above a walkable floor with
+/// the space up to it free. Found by columns: `columns` uniform points of the walkable surfaces
+/// (as the cameras draw them), each marking the leaves it passes every `step` units up to
+/// `reach` or the first surface above. Quake 3's eye is 50 units above the floor and a jump
+/// lifts it about 46 more (JUMP_VELOCITY 270, gravity 800), so the default reach of 112 takes
+/// in a jumping player's eye with a margin; jump pads, falls and swimming are not play here.
+struct PlaySpaceConfig {
+  uint32_t columns = 1000000;
+  uint64_t seed = 1;
+  double reach = 112;
+  double step = 8;
+  double walk_normal = 0.7;
+};
+
+struct PlaySpace {
+  std::vector<bool> leaves;       ///< per map leaf: a player's eye can be there
+  size_t play_leaves = 0, open_leaves = 0;
+  double play_volume = 0, open_volume = 0;  ///< of those leaves, and of all non-solid leaves
+  std::string rule;               ///< in words
+};
+
+/// The play space of `map` (deterministic for a seed, for any number of threads). `caster`
+/// casts against the scene made from the map. Error when the map has no walkable surface.
+PlaySpace q3_play_space(const Q3Map& map, const Scene& scene, const RayCaster& caster, const PlaySpaceConfig& config);
+
 /// `config.count` play cameras, drawn serially from `config.seed` (reproducible): a uniform
 /// point of the walkable surfaces (rendered, occluding triangles whose normal points up at
 /// least walk_normal; drawn by area), kept when player_height above it is free and the eye,

@@ -33,6 +33,11 @@ inline int32_t q3_leaf_of_node(const Q3Map& map, int32_t n) {
   return n >= static_cast<int32_t>(map.nodes.size()) ? n - static_cast<int32_t>(map.nodes.size()) : -1;
 }
 
+/// Keeps the weight of the map leaves `keep` (per map leaf) of `q3` (a q3_subdivision), sets the
+/// other leaves' to 0 and sums the inner nodes again: p(i) over that part of the view space
+/// (such as the play space) for weight_by_view_space.
+void keep_leaf_weights(Subdivision& q3, const Q3Map& map, const std::vector<bool>& keep);
+
 /// Volume of the part of `cell` in the non-solid leaves of `q3` (a q3_subdivision).
 double view_space_volume(const Subdivision& q3, const ConvexPolyhedron& cell);
 
