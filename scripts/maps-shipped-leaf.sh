@@ -9,14 +9,21 @@
 # With --play-space: the maps that still miss after that bake, baked the same way with
 # `--play-space` (cells weighed, and AGVS's points drawn, where a player's eye can be), to
 # docs/results/q3-shipped-play.md and .csv and the section "q3shippedplay".
-# Usage: scripts/maps-shipped-leaf.sh [PIXEL_ERROR] [SECONDS] [--play-space]   (defaults 1, 45: the table's)
+# With --play-space and map names: those maps instead (maps that met the goal without it, to
+# see what it does to them), to docs/results/q3-shipped-play-check.md and .csv and the section
+# "q3shippedplaycheck".
+# Usage: scripts/maps-shipped-leaf.sh [PIXEL_ERROR] [SECONDS] [--play-space [MAP_NAME...]]   (defaults 1, 45: the table's)
 set -euo pipefail
 err="${1:-1}"
 secs="${2:-45}"
 play="${3:-}"
+shift $(($# < 3 ? $# : 3))
 source "$(dirname "$0")/shipped-setup.sh"
 table=docs/results/q3-shipped.csv
-if [ "$play" = --play-space ]; then
+if [ "$play" = --play-space ] && [ $# -gt 0 ]; then
+  kind=play-check out=out/shipped-play bake=fit-play flags=(--play-space)
+  names=("$@")
+elif [ "$play" = --play-space ]; then
   kind=play out=out/shipped-play bake=fit-play flags=(--play-space)
   mapfile -t names < <(python3 scripts/vctables.py shipped-misses "$table" docs/results/q3-shipped-leaf.csv)
 elif [ -z "$play" ]; then
@@ -38,8 +45,8 @@ for name in "${names[@]}"; do
   echo "shipped-leaf: [$i/${#names[@]}] $name: within $budget bytes"
   shipped_fit "$map" "$d" "$budget" "$bake" "q3map2's rows and leaf surface lists" "${flags[@]}"
 done
-python3 scripts/vctables.py shipped-leaf "$out" "$table" "$err" "$secs" $play
-echo "scripts/maps-shipped-leaf.sh $err $secs $play" | sed 's/ *$//' > "docs/results/q3-shipped-$kind.command"
-python3 scripts/vctables.py replace-section docs/results.md "q3shipped$kind" "$(cat "docs/results/q3-shipped-$kind.command")" \
+python3 scripts/vctables.py shipped-leaf "$out" "$table" "$err" "$secs" $play "$@"
+echo "scripts/maps-shipped-leaf.sh $err $secs $play $*" | sed 's/ *$//' > "docs/results/q3-shipped-$kind.command"
+python3 scripts/vctables.py replace-section docs/results.md "q3shipped${kind//-/}" "$(cat "docs/results/q3-shipped-$kind.command")" \
   "docs/results/q3-shipped-$kind.md"
-echo "shipped-leaf: docs/results.md (section q3shipped$kind), docs/results/q3-shipped-$kind.csv"
+echo "shipped-leaf: docs/results.md (section q3shipped${kind//-/}), docs/results/q3-shipped-$kind.csv"

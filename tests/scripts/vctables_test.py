@@ -396,6 +396,13 @@ class Tables(unittest.TestCase):
             run("shipped-leaf", leaf, "docs/results/q3-shipped.csv", 1, 45)
             leaf_md = open("docs/results/q3-shipped-leaf.md").read()
             still = run("shipped-misses", "docs/results/q3-shipped.csv", "docs/results/q3-shipped-leaf.csv").split()
+            # --play-space on a map that met the goal without it.
+            pc = f"{self.d}/pc"
+            dump(f"{pc}/m1/q3map2.json", measured(10, 100.0, 0.0, 0.0, 1000))
+            dump(f"{pc}/m1/fit-play.json", measured(11, 35.0, 0.2, 0.0, 1000))
+            dump(f"{pc}/m1/fit-play-bake.json", {"timings": {"total_seconds": 20.0}})
+            run("shipped-leaf", pc, "docs/results/q3-shipped.csv", 1, 45, "--play-space", "m1")
+            check_md = open("docs/results/q3-shipped-play-check.md").read()
         finally:
             os.chdir(cwd)
         self.assertIn("5 maps (1 without vis data skipped)", md)
@@ -415,6 +422,10 @@ class Tables(unittest.TestCase):
         self.assertIn("1 of these 1 maps meet all three", leaf_md)
         self.assertIn("with the 4 that met it before, 5 of 5 maps", leaf_md)
         self.assertEqual(still, [])
+        self.assertEqual(row(check_md, "m1")[4:6], ["11", "0.350"])
+        self.assertIn("1 of these 1 maps meet all three within q3map2's rows and leaf surface lists with --play-space",
+                      check_md)
+        self.assertIn("median 0.875", check_md)
 
     def test_agvs_measured_time_to_error(self):
         out = f"{self.d}/am"
