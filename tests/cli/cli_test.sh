@@ -88,6 +88,8 @@ expect_error "truncated.off" "$VC" info truncated.off
 expect_error "unknown scene kind" "$VC" generate castle -o x.obj
 expect_error "view-box" "$VC" sample office.obj --view-box 1,2,3
 expect_error "min < max" "$VC" sample office.obj --view-box 0,0,0,1,1,0
+expect_error "office.obj: --play-space needs a Quake 3 map" "$VC" build office.obj --play-space -o play.vcells
+expect_error "office.obj: --play-space needs a Quake 3 map" "$VC" bake office.obj --play-space --cells 10 -o play.pvs
 expect_error "empty-space" "$VC" sample office.obj --empty-space maybe
 expect_error "samples" "$VC" sample office.obj --samples 0
 

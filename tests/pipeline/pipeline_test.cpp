@@ -74,6 +74,9 @@ TEST(Pipeline, PlaySpaceNeedsAMapAndIsTheOnlyDensity) {
   c.scene.path = "level.bsp";  // checked before the file is read
   c.subdivision.density = {true, 0.0, 2.0, 0.1};
   EXPECT_THROW(pipeline::build(c, quiet), Error);
+  c.subdivision.density = {};
+  c.sampling.view_box = Box3{{0, 0, 0}, {1, 1, 1}};
+  EXPECT_THROW(pipeline::build(c, quiet), Error);
 }
 
 TEST(Pipeline, PlaySpaceWeighsCellsWherePlayersAreAndAgvsDrawsThere) {

@@ -423,7 +423,7 @@ class Tables(unittest.TestCase):
         self.assertIn("with the 4 that met it before, 5 of 5 maps", leaf_md)
         self.assertEqual(still, [])
         self.assertEqual(row(check_md, "m1")[4:6], ["11", "0.350"])
-        self.assertIn("1 of these 1 maps meet all three within q3map2's rows and leaf surface lists with --play-space",
+        self.assertIn("1 of these 1 maps meet all three within q3map2's rows and leaf surface lists with --play-space** (1 met",
                       check_md)
         self.assertIn("median 0.875", check_md)
 

@@ -144,6 +144,8 @@ void check_for_scene(const BuildConfig& config) {
                 "and floors to find it from");
   if (config.subdivision.play_space && config.subdivision.density.enabled)
     throw Error("--play-space and --density-band are two viewpoint densities: give one");
+  if (config.subdivision.play_space && !config.sampling.view_box.empty())
+    throw Error("--play-space takes the map's whole view box (the play space says where viewpoints are): drop --view-box");
 }
 
 }  // namespace
