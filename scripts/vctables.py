@@ -1318,6 +1318,7 @@ def shipped_leaf(out, path, err, secs, play=None, *check):
         b = _shipped_bake(q, f"{d}/{name}.json")
         bake = json.load(open(f"{d}/{name}-bake.json")) if b else None
         rows.append(dict(map=t["map"], clusters=int(t["clusters"]), budget=budget, ratio_at_count=float(t["ratio"]),
+                         err_at_count=float(t["ours_err"]),
                          met_without=t["goal_leaf"] == "True" or t["map"] in rescued,
                          bytes_at_count=int(t["ours_bytes"]), cells=b["cells"] if b else "",
                          ratio=b["ratio"] if b else "", err=b["err"] if b else "", median=b["median"] if b else "",
@@ -1369,7 +1370,10 @@ def shipped_leaf(out, path, err, secs, play=None, *check):
         lines.append(f"**{met} of these {len(rows)} maps meet all three within q3map2's rows and leaf surface lists "
                      f"with --play-space** ({before} met them without it). Ours / q3map2 with it against the "
                      f"cluster-count bake without it (more cells and the play space together): median "
-                     f"{statistics.median(r['ratio'] / r['ratio_at_count'] for r in rows if r['cells'] != ''):.3f}.\n")
+                     f"{statistics.median(r['ratio'] / r['ratio_at_count'] for r in rows if r['cells'] != ''):.3f}. "
+                     "Mean wrong pixels per 1024x1024 frame, median over these maps: "
+                     f"{statistics.median(r['err'] for r in rows if r['cells'] != ''):.2f} with it, "
+                     f"{statistics.median(r['err_at_count'] for r in rows):.2f} at the cluster count without it.\n")
     else:
         lines.append(f"**{met} of these {len(rows)} maps meet all three within q3map2's rows and leaf surface lists{flag}: "
                      f"with the {before} that met it before, {before + met} of {len(table)} maps** (cost at most half of "
