@@ -24,6 +24,7 @@ packages=(
   libopenmpi-dev openmpi-bin   # several ranks (VIEWCELLS_MPI; the tests build with it)
   libgtest-dev libgmock-dev libbenchmark-dev   # tests and micro-benchmarks
   gnuplot-nox                                  # plots of comparisons and studies (scripts/plot-*.sh)
+  valgrind               # instruction counts of an A/B benchmark (scripts/bench-ab-instructions.sh)
 )
 
 # scripts/fuzz.sh also needs clang with libFuzzer's runtime.
