@@ -11,8 +11,10 @@
 # docs/results/q3-shipped-play.md and .csv and the section "q3shippedplay".
 # With --play-space and map names: those maps instead (maps that met the goal without it, to
 # see what it does to them), to docs/results/q3-shipped-play-check.md and .csv and the section
-# "q3shippedplaycheck".
-# Usage: scripts/maps-shipped-leaf.sh [PIXEL_ERROR] [SECONDS] [--play-space [MAP_NAME...]]   (defaults 1, 45: the table's)
+# "q3shippedplaycheck". With --play-space all: every map of the table, in one run, to
+# docs/results/q3-shipped-play-all.md and .csv and the section "q3shippedplayall" (one bake
+# setting on every map: what BENCHMARKS.md leads with).
+# Usage: scripts/maps-shipped-leaf.sh [PIXEL_ERROR] [SECONDS] [--play-space [all | MAP_NAME...]]   (defaults 1, 45: the table's)
 set -euo pipefail
 err="${1:-1}"
 secs="${2:-45}"
@@ -20,7 +22,10 @@ play="${3:-}"
 shift $(($# < 3 ? $# : 3))
 source "$(dirname "$0")/shipped-setup.sh"
 table=docs/results/q3-shipped.csv
-if [ "$play" = --play-space ] && [ $# -gt 0 ]; then
+if [ "$play" = --play-space ] && [ "${1:-}" = all ]; then
+  kind=play-all out=out/shipped-play-all bake=fit-play flags=(--play-space)
+  mapfile -t names < <(python3 -c 'import csv, sys; [print(r["map"]) for r in csv.DictReader(open(sys.argv[1]))]' "$table")
+elif [ "$play" = --play-space ] && [ $# -gt 0 ]; then
   kind=play-check out=out/shipped-play bake=fit-play flags=(--play-space)
   names=("$@")
 elif [ "$play" = --play-space ]; then

@@ -51,10 +51,21 @@ compares the products.
 Not generated yet: run scripts/maps-shipped.sh.
 <!-- q3shipped:end -->
 EOF_SHIPPED
-if [ -f docs/results/q3-shipped.md ] && [ -f docs/results/q3-shipped.command ]; then
-  python3 scripts/vctables.py replace-section docs/results.md q3shipped "$(cat docs/results/q3-shipped.command)" \
-    docs/results/q3-shipped.md
-fi
+# The shipped tables' subsections (scripts/maps-shipped-leaf.sh), each where its table exists.
+shipped_sections=(
+  "|q3shipped"
+  "leaf|q3shippedleaf|Within q3map2's rows and leaf surface lists"
+  "play|q3shippedplay|With --play-space"
+  "play-check|q3shippedplaycheck|--play-space where the default already met the goal"
+  "play-all|q3shippedplayall|One bake setting on every map: --play-space within q3map2's rows and leaf surface lists"
+)
+for entry in "${shipped_sections[@]}"; do
+  IFS='|' read -r kind section title <<<"$entry"
+  base=docs/results/q3-shipped${kind:+-$kind}
+  [ -f "$base.md" ] && [ -f "$base.command" ] || continue
+  [ -n "$title" ] && printf '\n### %s\n\n<!-- %s:begin -->\n<!-- %s:end -->\n' "$title" "$section" "$section" >> docs/results.md
+  python3 scripts/vctables.py replace-section docs/results.md "$section" "$(cat "$base.command")" "$base.md"
+done
 printf '\n## Real game levels: OpenArena maps against q3map2\n\n<!-- q3maps:begin -->\nNot generated yet: run scripts/maps-table.sh.\n<!-- q3maps:end -->\n' >> docs/results.md
 if [ -f docs/results/q3-maps.md ] && [ -f docs/results/q3-maps.command ]; then
   python3 scripts/vctables.py replace-section docs/results.md q3maps "$(cat docs/results/q3-maps.command)" docs/results/q3-maps.md

@@ -403,6 +403,17 @@ class Tables(unittest.TestCase):
             dump(f"{pc}/m1/fit-play-bake.json", {"timings": {"total_seconds": 20.0}})
             run("shipped-leaf", pc, "docs/results/q3-shipped.csv", 1, 45, "--play-space", "m1")
             check_md = open("docs/results/q3-shipped-play-check.md").read()
+            # --play-space on every map of the table (maps-shipped-leaf.sh --play-space all): m6's cut
+            # misses half the cost, m3's bake made no cut.
+            pa = f"{self.d}/pa"
+            for name, got in [("m1", (11, 35.0, 0.2, 1000)), ("m2", (9, 45.0, 0.4, 1100)), ("m3", None),
+                              ("m5", (21, 40.0, 0.3, 1000)), ("m6", (13, 55.0, 2.5, 1050))]:
+                dump(f"{pa}/{name}/q3map2.json", measured(10, 100.0, 0.0, 0.0, 1000))
+                if got:
+                    dump(f"{pa}/{name}/fit-play.json", measured(got[0], got[1], got[2], 0.0, got[3]))
+                    dump(f"{pa}/{name}/fit-play-bake.json", {"timings": {"total_seconds": 30.0}})
+            run("shipped-leaf", pa, "docs/results/q3-shipped.csv", 1, 45, "--play-space", "all")
+            all_md = open("docs/results/q3-shipped-play-all.md").read()
         finally:
             os.chdir(cwd)
         self.assertIn("5 maps (1 without vis data skipped)", md)
@@ -426,6 +437,13 @@ class Tables(unittest.TestCase):
         self.assertIn("1 of these 1 maps meet all three within q3map2's rows and leaf surface lists with --play-space** (1 met",
                       check_md)
         self.assertIn("median 0.875", check_md)
+        self.assertEqual([row(all_md, m)[9] for m in ("m1", "m2", "m3", "m5", "m6")], ["yes", "yes", "no", "yes", "no"])
+        self.assertIn("**3 of 5 maps meet all three within q3map2's rows and leaf surface lists with this one bake "
+                      "setting** (cost at most half of q3map2's per frame, median camera at most 1 wrong pixel, lists "
+                      "within the bytes; goal: 5)", all_md)
+        self.assertIn("Ours / q3map2: median 0.425", all_md)
+        self.assertIn("largest 2.50 (m6)", all_md)
+        self.assertIn("Missing the goal: m3 (no cut fits), m6 (0.550, median 0 px).", all_md)
 
     def test_agvs_measured_time_to_error(self):
         out = f"{self.d}/am"

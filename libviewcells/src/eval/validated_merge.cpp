@@ -41,6 +41,7 @@ std::vector<int32_t> cut_labels(const Merges& merges, size_t leaves, size_t k) {
 /// mean over the held-out sets of log(cost / AV-S's cost), and the largest of them.
 struct CountScores {
   std::vector<double> log_ratio, worst;
+  std::vector<uint8_t> scored;  ///< 1 where the history and AV-S both reach the count
 };
 
 /// The held-out leaf PVS sets (B, and C when drawn), AV-S's costs on each, and the counts scored.
@@ -51,7 +52,8 @@ struct HeldOut {
   size_t av_s_min_cells = 1;
 
   CountScores score(const Scene& scene, const Subdivision& s, const MergeHistory& h, const CostModel& model) const {
-    CountScores out{std::vector<double>(counts.size(), 0.0), std::vector<double>(counts.size(), 0.0)};
+    CountScores out{std::vector<double>(counts.size(), 0.0), std::vector<double>(counts.size(), 0.0),
+                    std::vector<uint8_t>(counts.size(), 0)};
     for (size_t k = 0; k < pvs.size(); ++k) {
       const CostCurve curve = evaluate_merge_history(scene, s, h, *pvs[k], model);
       for (size_t j = 0; j < counts.size(); ++j) {
@@ -60,6 +62,7 @@ struct HeldOut {
         const double r = std::log(curve.at(n) / av_s[k].at(n));
         out.log_ratio[j] += r / static_cast<double>(pvs.size());
         out.worst[j] = k ? std::max(out.worst[j], r) : r;
+        out.scored[j] = 1;
       }
     }
     return out;
@@ -94,6 +97,10 @@ struct Tail {
 };
 
 }  // namespace
+
+bool merge_piece_allowed(double sum, double worst, size_t counts, double worst_allowed) {
+  return worst <= worst_allowed && (counts == 0 || worst <= -sum / static_cast<double>(counts));
+}
 
 LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Subdivision& s,
                           std::vector<std::vector<uint32_t>> base, const CostModel& model,
@@ -222,29 +229,35 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   auto tail_at = [&](uint32_t c) -> const Tail& {
     return tails[static_cast<size_t>(std::lower_bound(ends.begin(), ends.end(), c) - ends.begin())];
   };
+  struct Piece {
+    double sum = 0, worst = 0;
+    size_t counts = 0;
+  };
   auto piece = [&](size_t i, uint32_t below, uint32_t upto) {  // sum and worst on counts in (below, upto]
-    std::pair<double, double> sum_worst{0.0, 0.0};
+    Piece p;
     for (size_t j = 0; j < counts.size(); ++j)
       if (counts[j] > below && counts[j] <= upto) {
-        sum_worst.first += scored[i].at.log_ratio[j];
-        sum_worst.second = std::max(sum_worst.second, scored[i].at.worst[j]);
+        p.sum += scored[i].at.log_ratio[j];
+        p.worst = std::max(p.worst, scored[i].at.worst[j]);
+        p.counts += scored[i].at.scored[j];
       }
-    return sum_worst;
+    return p;
   };
   constexpr double kGain = 1e-9;  // a split must beat the whole by more than rounding
+  auto allowed = [&](const Piece& p) { return merge_piece_allowed(p.sum, p.worst, p.counts, config.worst_allowed); };
   for (size_t e = 0; e < ends.size(); ++e) {
     const uint32_t c = ends[e];
     Tail best;  // AV-S's own order: 0
     for (size_t i = 0; i < candidates.size(); ++i) {
       const MergeStart& st = candidates[i];
       if (st.cells > c) continue;
-      const auto [whole, whole_worst] = piece(i, 0, c);
-      if (whole_worst <= config.worst_allowed && whole < best.sum) best = {whole, whole_worst, static_cast<int>(i), false};
+      const Piece whole = piece(i, 0, c);
+      if (allowed(whole) && whole.sum < best.sum) best = {whole.sum, whole.worst, static_cast<int>(i), false};
       if (!st.barrier || !scored[i].barrier_cut) continue;
-      const auto [upper, upper_worst] = piece(i, st.barrier, c);
+      const Piece upper = piece(i, st.barrier, c);
       const Tail& below = tail_at(st.barrier);
-      if (upper_worst <= config.worst_allowed && upper + below.sum < best.sum - kGain)
-        best = {upper + below.sum, std::max(upper_worst, below.worst), static_cast<int>(i), true};
+      if (allowed(upper) && upper.sum + below.sum < best.sum - kGain)
+        best = {upper.sum + below.sum, std::max(upper.worst, below.worst), static_cast<int>(i), true};
     }
     tails[e] = best;
   }

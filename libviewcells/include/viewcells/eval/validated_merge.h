@@ -16,7 +16,8 @@
 ///     Where a candidate's cut is AV-S's own (at its barrier), the histories below are
 ///     interchangeable, so the choice is made per range of counts: the lowest sum of the mean
 ///     log ratios over all counts (a dynamic program over the barriers), each piece within
-///     the allowance at every count on both B and C.
+///     the allowance at every count on both B and C, and losing at its worst count no more
+///     than it gains on average (else it is a tie, and ties keep AV-S's order).
 /// The history written has the chosen merges with PVSs from the construction samples, A, B
 /// and C together (what extraction and compression then store).
 #include <cstdint>
@@ -43,7 +44,8 @@ struct ValidatedMergeConfig {
   /// Counts scored, log-spaced from min(4, leaves) to the leaves, factor 1.25 (4, 6, 8, 11, 14,
   /// 18, ...): a small map is cut to a few cells.
   uint32_t score_from = 4;
-  /// A start is taken only when its worst count is at most this (a log ratio) above AV-S's.
+  /// A start (or a piece of one) is taken only when its worst count is at most this (a log
+  /// ratio) above AV-S's, and at most its mean gain (merge_piece_allowed).
   double worst_allowed = 0.01;
   /// Random samples held out as well (drawn as the construction samples are, with their own
   /// seed): the evaluator's kind of PVS. Each count's log ratio is then the mean of the two
@@ -98,6 +100,13 @@ struct LeafMerge {
 /// The chosen history in words, piece by piece ("greedy merging from the subdivision's own
 /// cut at 5000 cells, within its cut at 78 cells until there; from 78 cells: ...").
 std::string describe_chain(const MergeSummary& summary);
+
+/// Whether merge_validated takes a piece of a candidate history (counts scored in it, the sum
+/// of their held-out log(cost / AV-S's cost) and the largest): its worst count is at most
+/// `worst_allowed` above AV-S's, and at most its mean gain over the piece's counts. A piece
+/// that gains less on average than it loses at one count is a tie within the held-out
+/// samples' noise, and a tie keeps AV-S's own order (merging must not make a cut worse).
+bool merge_piece_allowed(double sum, double worst, size_t counts, double worst_allowed);
 
 /// `base`: the construction samples' leaf PVSs, per node of `s` (bsp/subdivision.h leaf_pvs);
 /// `s` needs its cells (neighbours). Deterministic for any thread count.
