@@ -1,0 +1,1 @@
+scripts/maps-shipped-leaf.sh 1 45 --play-space all
