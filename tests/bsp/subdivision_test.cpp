@@ -606,6 +606,9 @@ TEST(Subdivision, GeometryAlignedBoundsKeepTheBestPlane) {
     }
     EXPECT_GT(best_ga, best_axis) << "seed " << seed << ": a geometry-aligned plane should decide this split";
     EXPECT_NEAR(s.splits[0].reduction, std::max(best_ga, best_axis), 1e-9 * s.initial_cost) << "seed " << seed;
+    // Most planes are bounded out, not evaluated on all parts.
+    EXPECT_GT(s.stats.geometry_full_passes, 0u);
+    EXPECT_LT(s.stats.geometry_full_passes, s.stats.geometry_candidates) << "seed " << seed;
   }
 }
 

@@ -514,7 +514,7 @@ struct Candidate {
 
 struct Evaluation {
   Candidate best;
-  uint64_t axis = 0, geometry = 0;
+  uint64_t axis = 0, geometry = 0, geometry_full = 0;
 };
 
 class Builder {
@@ -712,6 +712,7 @@ class Builder {
     out_.stats.slivers_refused = slivers_refused_;
     out_.stats.splits_undone = splits_undone_;
     out_.stats.geometry_candidates = geometry_evaluated_;
+    out_.stats.geometry_full_passes = geometry_full_;
     out_.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
@@ -989,6 +990,7 @@ class Builder {
     axis_evaluated_ += e.axis;
     parts_evaluated_ += refs_[node].size();
     geometry_evaluated_ += e.geometry;
+    geometry_full_ += e.geometry_full;
   }
 
   Evaluation evaluate(int32_t node) {
@@ -1006,18 +1008,20 @@ class Builder {
     const double* r = candidate_costs(node, storage);
     Candidate results[4];
     const std::array<std::vector<double>, 3> positions = axis_positions(node, out_.cells[node].bounds());
-    auto task = [&](int t) {
-      if (t < 3) {
-        results[t] = best_axis_candidate(node, t, positions[t], *ext, ev, r);
-      } else if (ga_) {
-        results[3] = best_geometry_candidate(node, ev, r);
-      }
-    };
+    auto task = [&](int t) { results[t] = best_axis_candidate(node, t, positions[t], *ext, ev, r); };
     // Small nodes in this thread (their sibling is evaluated beside them); the same results.
-    if (refs.size() < kParallelParts && !ga_) {
+    if (refs.size() < kParallelParts) {
       for (int t = 0; t < 3; ++t) task(t);
     } else {
-      tbb::parallel_for(0, 4, task);
+      tbb::parallel_for(0, 3, task);
+    }
+    // Geometry-aligned planes after the axes: one wins only by beating the best axis-aligned
+    // candidate, so planes whose bound is below it need no exact evaluation.
+    if (ga_) {
+      double to_beat = -INFINITY;
+      for (int t = 0; t < 3; ++t)
+        if (results[t].valid) to_beat = std::max(to_beat, results[t].reduction);
+      results[3] = best_geometry_candidate(node, ev, r, to_beat);
     }
     for (const Candidate& c : results)  // in a fixed order: ties keep the earlier kind/axis
       if (c.valid && (!ev.best.valid || c.reduction > ev.best.reduction)) ev.best = c;
@@ -1318,8 +1322,11 @@ class Builder {
     return {true, Plane::axis_aligned(axis, positions[best_j]), best_reduction};
   }
 
-  /// Planes of non-axis-aligned triangles hit inside the node, a random subset; each costs O(n).
-  Candidate best_geometry_candidate(int32_t node, Evaluation& ev, const double* r) {
+  /// The best of the planes of non-axis-aligned triangles hit inside the node (a random subset;
+  /// each costs O(n)), or none. In a large cell, only the planes whose bound may beat `to_beat`
+  /// (the best axis-aligned reduction: ties keep the axis) are evaluated on all parts, so a
+  /// plane left out could not have been chosen.
+  Candidate best_geometry_candidate(int32_t node, Evaluation& ev, const double* r, double to_beat) {
     const RawVector<SegRef>& refs = refs_[node];
     // Triangles hit at segment ends inside this node lie (at least partly) inside it.
     // (Distinct ones first, by marks; then sorted: far fewer than the parts.) The same pass
@@ -1461,7 +1468,7 @@ class Builder {
       });
       const double margin = 1e-9 * std::abs(own) + 1e-300;
       std::vector<char> exact(results.size(), 0);
-      double best_exact = -INFINITY;
+      double best_exact = to_beat;
       for (size_t next = 0; next < order.size();) {
         if (results[order[next]].reduction < best_exact - margin) break;  // no later plane can win
         // A batch of planes with the highest bounds, evaluated on all parts in parallel.
@@ -1477,6 +1484,13 @@ class Builder {
       }
       for (size_t j = 0; j < results.size(); ++j)
         if (!exact[j]) results[j].valid = false;  // bounded below the best: cannot be chosen
+      __atomic_add_fetch(&ev.geometry_full, static_cast<uint64_t>(std::count(exact.begin(), exact.end(), 1)),
+                         __ATOMIC_RELAXED);
+    } else {
+      __atomic_add_fetch(&ev.geometry_full,
+                         static_cast<uint64_t>(std::count_if(results.begin(), results.end(),
+                                                             [](const Candidate& c) { return c.valid; })),
+                         __ATOMIC_RELAXED);
     }
     Candidate best;
     for (const Candidate& c : results)
@@ -1507,7 +1521,7 @@ class Builder {
   uint64_t slivers_refused_ = 0;
   uint64_t splits_undone_ = 0;
   std::vector<Candidate> best_;
-  std::atomic<uint64_t> axis_evaluated_{0}, geometry_evaluated_{0}, parts_evaluated_{0};
+  std::atomic<uint64_t> axis_evaluated_{0}, geometry_evaluated_{0}, geometry_full_{0}, parts_evaluated_{0};
   tbb::enumerable_thread_specific<Marks> marks_;
   tbb::enumerable_thread_specific<ExtentSlots> extent_slots_;
   tbb::enumerable_thread_specific<std::array<ExtentSlots, 2>> split_slots_;  ///< apply_split: both sides

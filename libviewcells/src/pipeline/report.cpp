@@ -258,6 +258,7 @@ std::string report_json(const BuildResult& r) {
                            {"cost_at_power_of_two_cells", cost_curve(sub)},
                            {"axis_candidates_evaluated", sub.stats.axis_candidates},
                            {"geometry_candidates_evaluated", sub.stats.geometry_candidates},
+                           {"geometry_candidates_on_all_parts", sub.stats.geometry_full_passes},
                            {"segment_parts_evaluated", sub.stats.parts_evaluated},
                            {"sliver_splits_refused", sub.stats.slivers_refused},
                            {"splits_undone", sub.stats.splits_undone},

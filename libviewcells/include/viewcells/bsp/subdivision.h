@@ -125,6 +125,9 @@ struct SplitRecord {
 struct SubdivisionStats {
   uint64_t axis_candidates = 0;      ///< candidate planes evaluated, by kind
   uint64_t geometry_candidates = 0;
+  /// Geometry-aligned candidates evaluated on all of their cell's parts (the others were
+  /// bounded from their objects' extreme part ends below a candidate that beats them).
+  uint64_t geometry_full_passes = 0;
   /// Segment parts read by candidate evaluation, summed over the cells evaluated (a segment
   /// lies in every cell it crosses, so this grows faster than the segments).
   uint64_t parts_evaluated = 0;
