@@ -1335,6 +1335,7 @@ def shipped_leaf(out, path, err, secs, play=None, *check):
             w.writerow(r.values())
     before = sum(t["goal_leaf"] == "True" for t in table) + len(rescued)
     met = sum(r["met"] for r in rows)
+    done = [r for r in rows if r["cells"] != ""]  # the maps whose bake made a cut
     flag = " with --play-space" if play else ""
     if every:
         intro = (f"Every map of the main table ({len(rows)}), baked with one setting in one run: the most cells whose "
@@ -1376,7 +1377,6 @@ def shipped_leaf(out, path, err, secs, play=None, *check):
                      f"{r['bytes_at_count']:,} | {got} | {'yes' if r['met'] else 'no'} |")
     lines.append("")
     if every:
-        done = [r for r in rows if r["cells"] != ""]
         lines.append(f"**{met} of {len(rows)} maps meet all three within q3map2's rows and leaf surface lists with this "
                      f"one bake setting** (cost at most half of q3map2's per frame, median camera at most 1 wrong pixel, "
                      f"lists within the bytes; goal: {-(-9 * len(rows) // 10)}). Ours / q3map2: median "
@@ -1393,9 +1393,9 @@ def shipped_leaf(out, path, err, secs, play=None, *check):
         lines.append(f"**{met} of these {len(rows)} maps meet all three within q3map2's rows and leaf surface lists "
                      f"with --play-space** ({before} met them without it). Ours / q3map2 with it against the "
                      f"cluster-count bake without it (more cells and the play space together): median "
-                     f"{statistics.median(r['ratio'] / r['ratio_at_count'] for r in rows if r['cells'] != ''):.3f}. "
+                     f"{statistics.median(r['ratio'] / r['ratio_at_count'] for r in done):.3f}. "
                      "Mean wrong pixels per 1024x1024 frame, median over these maps: "
-                     f"{statistics.median(r['err'] for r in rows if r['cells'] != ''):.2f} with it, "
+                     f"{statistics.median(r['err'] for r in done):.2f} with it, "
                      f"{statistics.median(r['err_at_count'] for r in rows):.2f} at the cluster count without it.\n")
     else:
         lines.append(f"**{met} of these {len(rows)} maps meet all three within q3map2's rows and leaf surface lists{flag}: "
