@@ -26,7 +26,7 @@ int run_build(const BuildArgs& a, const Common& c) {
   ThreadLimit threads(c.threads);
   pipeline::BuildConfig config;
   config.model = a.cells.model();  // before the sampling, not after
-  config.subdivision = a.cells.subdivision(c, a.sampling.seed);
+  config.subdivision = a.cells.subdivision(c, a.sampling);
   config.scene = a.sampling.source();
   config.sampling = a.sampling.sampler(c);
   config.merge = !a.no_merge;

@@ -203,7 +203,7 @@ CostModel CellOptions::model() const {
   return m;
 }
 
-SubdivisionConfig CellOptions::subdivision(const Common& c, uint64_t seed) const {
+SubdivisionConfig CellOptions::subdivision(const Common& c, const SamplingOptions& s) const {
   SubdivisionConfig config;
   config.max_cells = max_cells;
   config.geometry_aligned = no_ga ? GeometryAlignedMode::kOff : (ga ? GeometryAlignedMode::kOn : GeometryAlignedMode::kAuto);
@@ -212,8 +212,9 @@ SubdivisionConfig CellOptions::subdivision(const Common& c, uint64_t seed) const
   config.exact_candidates = exact_candidates;
   config.min_reduction = min_reduction;
   config.density = parse_density_band(density_band);
-  config.play_space = play_space;
-  config.seed = seed;
+  config.play_space = play_space || (play_space_by_default && !no_play_space && density_band.empty() &&
+                                      s.view_box.empty() && pipeline::is_q3_map(s.scene));
+  config.seed = s.seed;
   config.show_progress = !c.quiet;
   return config;
 }
@@ -285,10 +286,17 @@ void add_cell_options(CLI::App* cmd, CellOptions& a, const std::string& max_cell
       ->capture_default_str();
   cmd->add_option("--density-band", a.density_band,
                   "Viewpoint density zlo,zhi[,outside]: weight 1 between the heights, outside (default 0.1) elsewhere");
-  cmd->add_flag("--play-space", a.play_space,
-                "Quake 3 maps: weigh cells by their volume where a player's eye can be (non-solid leaves reachable "
-                "from the spawn points, at most 112 units above a walkable floor) instead of all non-solid space, so "
-                "merging spends the cells where players are");
+  auto* play = cmd->add_flag(
+      "--play-space", a.play_space,
+      std::string("Quake 3 maps: weigh cells by their volume where a player's eye can be (non-solid leaves reachable "
+                  "from the spawn points, at most 112 units above a walkable floor) instead of all non-solid space, so "
+                  "merging spends the cells where players are") +
+          (a.play_space_by_default ? " (the default on a Quake 3 map unless --density-band or --view-box is given)"
+                                   : ""));
+  if (a.play_space_by_default)
+    cmd->add_flag("--no-play-space", a.no_play_space,
+                  "Quake 3 maps: weigh cells by their volume in all of the map's non-solid space, not the play space")
+        ->excludes(play);
 }
 
 pipeline::CutRule CutOptions::rule() const {

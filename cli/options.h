@@ -98,10 +98,14 @@ struct CellOptions {
   std::string screen = "1024x768";
   double fov = 90;
   std::string density_band;
-  bool play_space = false;
+  bool play_space = false, no_play_space = false;
+  /// bake: the play space is on for a Quake 3 map unless --no-play-space, --density-band or
+  /// --view-box says otherwise (a map's frames are seen from where players are).
+  bool play_space_by_default = false;
 
   CostModel model() const;
-  SubdivisionConfig subdivision(const Common& c, uint64_t seed) const;
+  /// Seed and scene (for the play space's default) from the sampling options.
+  SubdivisionConfig subdivision(const Common& c, const SamplingOptions& s) const;
 };
 /// `max_cells_help` empty: no --max-cells option.
 void add_cell_options(CLI::App* cmd, CellOptions& a, const std::string& max_cells_help);

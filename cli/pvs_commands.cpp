@@ -199,7 +199,7 @@ int run_bake(BakeArgs a, const Common& c) {
   ThreadLimit threads(c.threads);
   pipeline::BakeConfig config;
   config.model = a.cells.model();
-  config.subdivision = a.cells.subdivision(c, a.sampling.seed);
+  config.subdivision = a.cells.subdivision(c, a.sampling);
   config.scene = a.sampling.source();
   config.sampling = a.sampling.sampler(c);
   config.merge_agvs = a.merge.agvs(c, a.sampling.seed, config.sampling.samples);
@@ -224,6 +224,7 @@ int run_bake(BakeArgs a, const Common& c) {
 void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
   auto a = std::make_shared<BakeArgs>();
   a->cells.max_cells = 0;
+  a->cells.play_space_by_default = true;
   a->sampling.samples = 1'000'000;
   auto* bk = app.add_subcommand(
       "bake",

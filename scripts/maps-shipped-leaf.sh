@@ -13,7 +13,9 @@
 # see what it does to them), to docs/results/q3-shipped-play-check.md and .csv and the section
 # "q3shippedplaycheck". With --play-space all: every map of the table, in one run, to
 # docs/results/q3-shipped-play-all.md and .csv and the section "q3shippedplayall" (one bake
-# setting on every map: what BENCHMARKS.md leads with).
+# setting on every map: what BENCHMARKS.md leads with; --play-space is bake's default on a map
+# now, and is passed anyway). Without --play-space, the bakes pass --no-play-space (all of the
+# map's non-solid space, as the table it extends).
 # Usage: scripts/maps-shipped-leaf.sh [PIXEL_ERROR] [SECONDS] [--play-space [all | MAP_NAME...]]   (defaults 1, 45: the table's)
 set -euo pipefail
 err="${1:-1}"
@@ -32,7 +34,7 @@ elif [ "$play" = --play-space ]; then
   kind=play out=out/shipped-play bake=fit-play flags=(--play-space)
   mapfile -t names < <(python3 scripts/vctables.py shipped-misses "$table" docs/results/q3-shipped-leaf.csv)
 elif [ -z "$play" ]; then
-  kind=leaf out=out/shipped-leaf bake=fit-leaf flags=()
+  kind=leaf out=out/shipped-leaf bake=fit-leaf flags=(--no-play-space)
   mapfile -t names < <(python3 scripts/vctables.py shipped-misses "$table")
 else
   echo "maps-shipped-leaf.sh: the third argument is --play-space or nothing (got $play)" >&2

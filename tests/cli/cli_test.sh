@@ -397,9 +397,18 @@ assert 'non-solid' in s['view_space'], s['view_space']
   expect_ok "$VC" bake "$MAPS/oa_dm2.bsp" --cells 40 --samples 50000 --max-cells 100 --merge-pvs samples \
     --agvs-samples 100000 -o dm2.pvs --report dm2bake.json -q
   [ "$(json_get dm2bake.json "['effects']['restricted_view_space']['enabled']")" = "True" ] && ok || bad "bake on a map: AGVS not in the view space"
+  # On a map, bake weighs cells and draws AGVS's points in the play space unless told not to.
+  [ "$(json_get dm2bake.json "['settings']['play_space']")" = "True" ] && ok || bad "bake on a map: the play space is not the default"
+  json_get dm2bake.json "['effects']['restricted_view_space']['reason']" | grep -q "play space" && ok ||
+    bad "bake on a map: the report does not say AGVS drew in the play space"
+  expect_error "excludes" "$VC" bake "$MAPS/oa_dm2.bsp" --cells 40 --play-space --no-play-space -o dm2bad.pvs
+  expect_error "not expected" "$VC" build "$MAPS/oa_dm2.bsp" --no-play-space -o dm2bad.vcells
   # bake --measured-error: stops when the play cameras measure it, and measure agrees with its report.
   expect_ok "$VC" bake "$MAPS/oa_dm2.bsp" --cells 40 --samples 50000 --max-cells 100 --merge-pvs samples \
-    --measured-error 300 --measure-cameras 300 -o dm2m.pvs --report dm2mbake.json -q
+    --measured-error 300 --measure-cameras 300 --no-play-space -o dm2m.pvs --report dm2mbake.json -q
+  [ "$(json_get dm2mbake.json "['settings']['play_space']")" = "False" ] &&
+    json_get dm2mbake.json "['effects']['restricted_view_space']['reason']" | grep -q "non-solid space" && ok ||
+    bad "bake --no-play-space on a map: still the play space"
   expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" dm2m.pvs --count 300 --report dm2mm.json -q
   python3 -c "
 import json
