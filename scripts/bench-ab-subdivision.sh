@@ -9,7 +9,9 @@
 # subdivision table's map row: SEGMENTS construction samples, default 300,000, to CELLS cells,
 # default 1,500, the default stagnation stop, geometry-aligned candidates as auto decides).
 # Each side writes its cells; the last line says whether the two builds' .vcells are
-# byte-identical (the same tree).
+# byte-identical (the same tree). Commits before f2ea46e (such as 6f655e9, the build the
+# subdivision issue's 149 s came from) need libopenmesh-dev to build, which install-deps.sh no
+# longer installs: `apt-get install libopenmesh-dev` first.
 # Usage: scripts/bench-ab-subdivision.sh OLD_COMMIT [RUNS] [CITY_SIZE | map:NAME] [SEGMENTS] [CELLS]
 set -euo pipefail
 cd "$(dirname "$0")/.."
