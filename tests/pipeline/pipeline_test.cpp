@@ -89,12 +89,16 @@ TEST(Pipeline, PlaySpaceWeighsCellsWherePlayersAreAndAgvsDrawsThere) {
   c.subdivision.max_cells = 150;
   c.subdivision.show_progress = false;
   c.subdivision.play_space = true;
-  const pipeline::BuildResult r = pipeline::build(c, quiet);
+  pipeline::BuildResult r = pipeline::build(c, quiet);
   const auto j = nlohmann::json::parse(pipeline::report_json(r));
   EXPECT_TRUE(j["effects"]["viewpoint_density"]["enabled"]) << j["effects"].dump();
   // Each cell weighs its volume in the play space's leaves: in all, the play space's volume.
-  const pipeline::LoadedScene& loaded = r.sampling.loaded;
+  pipeline::LoadedScene& loaded = r.sampling.loaded;
   const PlaySpace play = q3_play_space(*loaded.map, *loaded.scene, *loaded.caster, PlaySpaceConfig{});
+  // The build kept the play space it found, for AGVS to share (a bake finds it once).
+  ASSERT_TRUE(loaded.play);
+  EXPECT_EQ(loaded.play->leaves, play.leaves);
+  const PlaySpace* found = loaded.play.get();
   const Subdivision& s = r.file.subdivision;
   double total = 0;
   for (int32_t l : s.leaves()) total += s.nodes[l].weight;
@@ -105,6 +109,7 @@ TEST(Pipeline, PlaySpaceWeighsCellsWherePlayersAreAndAgvsDrawsThere) {
   AgvsConfig a;
   pipeline::use_play_view_space(loaded, a);
   ASSERT_TRUE(a.view_point_map && a.view_space);
+  EXPECT_EQ(loaded.play.get(), found) << "the play space was found again";
   const Q3Map& map = *loaded.map;
   const Subdivision q3 = q3_subdivision(map, q3_view_box(map));
   const size_t inner = map.nodes.size();

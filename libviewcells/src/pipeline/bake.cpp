@@ -88,7 +88,7 @@ SubdivisionFile hierarchy(const BakeConfig& c, LoadedScene& loaded, uint32_t max
 /// The AGVS PVSs of the view cells `pf` (located by `cells`), continued from the work
 /// directory's state when it belongs to them, and saved there. With `cams` and a measured
 /// error, the cameras' measurements stop it (BakeConfig::measured_error).
-std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, const LoadedScene& loaded, const PvsFile& pf,
+std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, LoadedScene& loaded, const PvsFile& pf,
                                               const CellLocator& cells, const std::optional<CameraSet>& cams,
                                               BakeResult& out, const Log& log) {
   AgvsConfig agvs = c.agvs;

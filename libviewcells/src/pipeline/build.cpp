@@ -79,7 +79,8 @@ Subdivision subdivide_sampled(const SamplingRun& s, const CostModel& model, Subd
     // The play space's leaves weigh the cells: points uniform in them are the division's
     // viewpoint density, and their volume in each cell its weight afterwards.
     const Q3Map& map = *s.loaded.map;
-    const PlaySpace play = q3_play_space(map, *s.loaded.scene, *s.loaded.caster, PlaySpaceConfig{});
+    VC_CHECK(s.loaded.play);  // found by build() (pipeline::play_space), shared with AGVS in a bake
+    const PlaySpace& play = *s.loaded.play;
     play_q3 = q3_subdivision(map, s.result.segments.view_box);
     keep_leaf_weights(*play_q3, map, play.leaves);
     config.viewpoints = std::make_shared<const std::vector<Vec3>>(
@@ -169,6 +170,7 @@ BuildResult build(const BuildConfig& config, LoadedScene loaded, const Log& log)
     throw Error("--slice-z " + fmt(config.views.slice_z) + " lies outside the view space (z from " + fmt(box.lo.z) +
                 " to " + fmt(box.hi.z) + ")");
   out.subdivision_config = config.subdivision;
+  if (config.subdivision.play_space) play_space(out.sampling.loaded);
   Subdivision sub = subdivide_sampled(s, config.model, out.subdivision_config, out.play_space, log);
 
   merge_leaves(config, s, sub, out, log);

@@ -53,10 +53,16 @@ void use_map_view_space(const std::shared_ptr<const Q3Map>& map, AgvsConfig& con
   config.view_space = [map](const Vec3& p) { return q3_in_view_space(*map, p); };
 }
 
-void use_play_view_space(const LoadedScene& s, AgvsConfig& config) {
+const PlaySpace& play_space(LoadedScene& s) {
   if (!s.map) throw Error("the play space needs a Quake 3 map");
+  if (!s.play) s.play = std::make_shared<const PlaySpace>(q3_play_space(*s.map, *s.scene, *s.caster, PlaySpaceConfig{}));
+  return *s.play;
+}
+
+void use_play_view_space(LoadedScene& s, AgvsConfig& config) {
+  const std::vector<bool>& leaves_of_play = play_space(s).leaves;  // s.play holds it from here on
+  const std::shared_ptr<const std::vector<bool>> play(s.play, &leaves_of_play);  // shares its ownership
   std::shared_ptr<const Q3Map> map = s.map;
-  auto play = std::make_shared<const std::vector<bool>>(q3_play_space(*map, *s.scene, *s.caster, PlaySpaceConfig{}).leaves);
   // The play leaves' bounds, drawn by volume: a point of leaf l's bounds counts when it lies in
   // l (and outside its detail brushes), so the points are uniform over the play leaves however
   // their bounds overlap.

@@ -15,6 +15,10 @@
 #include "viewcells/sampling/sampler.h"
 #include "viewcells/scene/scene.h"
 
+namespace viewcells {
+struct PlaySpace;
+}
+
 namespace viewcells::pipeline {
 
 using Log = std::function<void(const std::string&)>;
@@ -36,6 +40,9 @@ struct LoadedScene {
   std::unique_ptr<const Scene> scene;
   std::unique_ptr<RayCaster> caster;
   std::shared_ptr<const Q3Map> map;  ///< the Quake 3 map, when the scene is one
+  /// The map's play space (q3_play_space with its defaults), once play_space() has found it:
+  /// the division, merging and AGVS of one bake share it.
+  std::shared_ptr<const PlaySpace> play;
   double load_seconds = 0, bvh_seconds = 0;
   std::string view_space = "the whole view box";  ///< where sample origins are drawn, in words
 };
@@ -49,9 +56,13 @@ void use_map_view_space(LoadedScene& loaded, SamplerConfig& config);
 
 /// On a Quake 3 map (`map` not null), AGVS draws its points in the map's non-solid space too.
 void use_map_view_space(const std::shared_ptr<const Q3Map>& map, AgvsConfig& config);
-/// On a Quake 3 map, AGVS draws its points in the play space's leaves (q3_play_space), so that
+/// The play space of a Quake 3 map (q3_play_space with its defaults), found the first time
+/// and kept in `loaded.play`. Error for other scenes.
+const PlaySpace& play_space(LoadedScene& loaded);
+
+/// On a Quake 3 map, AGVS draws its points in the play space's leaves (play_space()), so that
 /// its pixel error estimate is that of cameras where players are (with --play-space).
-void use_play_view_space(const LoadedScene& loaded, AgvsConfig& config);
+void use_play_view_space(LoadedScene& loaded, AgvsConfig& config);
 
 /// Loading and sampling, with what a report needs.
 struct SamplingRun {
