@@ -188,7 +188,8 @@ json build_effects(const BuildResult& r) {
   e["geometry_aligned_candidates"] = effect(sub.stats.geometry_aligned, sub.stats.geometry_aligned_reason);
   e["pixel_cost_term"] = effect(model.pixel_term(), model.describe_pixel_term());
   e["viewpoint_density"] =
-      !r.play_space.empty() ? effect(true, "the play space (--play-space, bake's default on a Quake 3 map): p(i) is the share of " + r.play_space + " in the cell")
+      !r.play_space.empty() ? effect(true, "the play space (--play-space, bake's default on a Quake 3 map): p(i) is the "
+                                           "share of " + r.play_space + " in the cell")
       : config.density.enabled
           ? effect(true, "--density-band: weight 1 for " + fmt(config.density.lo, 2) + " <= z <= " +
                              fmt(config.density.hi, 2) + ", " + fmt(config.density.outside, 3) + " elsewhere")
@@ -384,10 +385,9 @@ json agvs_curve(const AgvsStats& st, size_t references) {
 }
 
 json agvs_view_space(bool restricted, bool play = false) {
-  return effect(restricted, play         ? "the play space (--play-space, bake's default on a Quake 3 map): AGVS's points are "
-                                           "drawn in its leaves (those "
-                                           "reachable from the spawn points with a point at most 112 units above a "
-                                           "walkable floor)"
+  return effect(restricted, play         ? "the play space (--play-space, bake's default on a Quake 3 map): AGVS's "
+                                           "points are drawn in its leaves (those reachable from the spawn points with "
+                                           "a point at most 112 units above a walkable floor)"
                             : restricted ? "a Quake 3 map: AGVS's points are drawn in its non-solid space"
                                          : "AGVS's points are drawn in the whole view box");
 }

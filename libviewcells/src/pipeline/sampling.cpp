@@ -55,7 +55,8 @@ void use_map_view_space(const std::shared_ptr<const Q3Map>& map, AgvsConfig& con
 
 const PlaySpace& play_space(LoadedScene& s) {
   if (!s.map) throw Error("the play space needs a Quake 3 map");
-  if (!s.play) s.play = std::make_shared<const PlaySpace>(q3_play_space(*s.map, *s.scene, *s.caster, PlaySpaceConfig{}));
+  if (!s.play)
+    s.play = std::make_shared<const PlaySpace>(q3_play_space(*s.map, *s.scene, *s.caster, PlaySpaceConfig{}));
   return *s.play;
 }
 
