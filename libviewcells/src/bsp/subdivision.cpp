@@ -1484,14 +1484,12 @@ class Builder {
       }
       for (size_t j = 0; j < results.size(); ++j)
         if (!exact[j]) results[j].valid = false;  // bounded below the best: cannot be chosen
-      __atomic_add_fetch(&ev.geometry_full, static_cast<uint64_t>(std::count(exact.begin(), exact.end(), 1)),
-                         __ATOMIC_RELAXED);
-    } else {
-      __atomic_add_fetch(&ev.geometry_full,
-                         static_cast<uint64_t>(std::count_if(results.begin(), results.end(),
-                                                             [](const Candidate& c) { return c.valid; })),
-                         __ATOMIC_RELAXED);
     }
+    // The planes still valid are those evaluated on all parts.
+    __atomic_add_fetch(&ev.geometry_full,
+                       static_cast<uint64_t>(std::count_if(results.begin(), results.end(),
+                                                           [](const Candidate& c) { return c.valid; })),
+                       __ATOMIC_RELAXED);
     Candidate best;
     for (const Candidate& c : results)
       if (c.valid && (!best.valid || c.reduction > best.reduction)) best = c;

@@ -67,7 +67,7 @@ std::vector<Vec3> uniform_points(const Subdivision& q3, const Q3Map& map, uint32
 
 /// Subdivides the sampled view space (AV-S), weighting cells by a map's view space (with
 /// --play-space, its play space; `play_rule` says what that was).
-Subdivision subdivide_sampled(const SamplingRun& s, const CostModel& model, SubdivisionConfig& config,
+Subdivision subdivide_sampled(SamplingRun& s, const CostModel& model, SubdivisionConfig& config,
                               std::string& play_rule, const Log& log) {
   std::string ga_reason;
   use_geometry_aligned(*s.loaded.scene, config, ga_reason);
@@ -79,8 +79,7 @@ Subdivision subdivide_sampled(const SamplingRun& s, const CostModel& model, Subd
     // The play space's leaves weigh the cells: points uniform in them are the division's
     // viewpoint density, and their volume in each cell its weight afterwards.
     const Q3Map& map = *s.loaded.map;
-    VC_CHECK(s.loaded.play);  // found by build() (pipeline::play_space), shared with AGVS in a bake
-    const PlaySpace& play = *s.loaded.play;
+    const PlaySpace& play = play_space(s.loaded);  // kept there: a bake's AGVS shares it
     play_q3 = q3_subdivision(map, s.result.segments.view_box);
     keep_leaf_weights(*play_q3, map, play.leaves);
     config.viewpoints = std::make_shared<const std::vector<Vec3>>(
@@ -170,8 +169,7 @@ BuildResult build(const BuildConfig& config, LoadedScene loaded, const Log& log)
     throw Error("--slice-z " + fmt(config.views.slice_z) + " lies outside the view space (z from " + fmt(box.lo.z) +
                 " to " + fmt(box.hi.z) + ")");
   out.subdivision_config = config.subdivision;
-  if (config.subdivision.play_space) play_space(out.sampling.loaded);
-  Subdivision sub = subdivide_sampled(s, config.model, out.subdivision_config, out.play_space, log);
+  Subdivision sub = subdivide_sampled(out.sampling, config.model, out.subdivision_config, out.play_space, log);
 
   merge_leaves(config, s, sub, out, log);
   SubdivisionFile& file = out.file;
