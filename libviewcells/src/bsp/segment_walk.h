@@ -2,6 +2,7 @@
 // Walking a segment down a BSP: the one rule by which a segment is divided among the leaves,
 // for the subdivision's own trees and for the compact copies that locate segments fast.
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <tuple>
 #include <vector>
@@ -10,6 +11,19 @@
 #include "viewcells/core/vec3.h"
 
 namespace viewcells::bsp_detail {
+
+/// Where a plane cuts the part a + t (b - a), t in [t0, t1], whose ends are at signed
+/// distances d0 and d1 on opposite sides: t on the grid of multiples of 2^-31 (exact in
+/// double, 0 and 1 included), the point nearest the plane's rounded crossing, kept within
+/// [t0, t1]. The subdivision stores its parts' t in 31-bit fixed point (half the memory of
+/// doubles); every walk down a tree cuts on the same grid, so that a segment is divided among
+/// the leaves exactly as the subdivision divided it. The grid moves a cut by at most
+/// |b - a| / 2^32 along the segment.
+inline double cut_parameter(double t0, double t1, double d0, double d1) {
+  const double t = t0 + (t1 - t0) * (d0 / (d0 - d1));
+  const double on_grid = t > 0 ? std::nearbyint(std::min(t, 1.0) * 0x1p31) * 0x1p-31 : 0.0;
+  return std::clamp(on_grid, t0, t1);
+}
 
 /// Walks the segment a-b down `tree`: stop(n, t0, t1) is asked at every node the segment has
 /// length in (the part a + t (b - a), t in [t0, t1]), and the walk goes below n only when it
@@ -47,7 +61,7 @@ void walk_segment(const Tree& tree, const Vec3& a, const Vec3& b,
       d1 = plane.distance(p1);
     }
     if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) {  // as the subdivision's own splits
-      const double t = std::clamp(t0 + (t1 - t0) * (d0 / (d0 - d1)), t0, t1);
+      const double t = cut_parameter(t0, t1, d0, d1);
       stack.emplace_back(tree.child(n, s0 < 0 ? 0 : 1), t0, t);
       stack.emplace_back(tree.child(n, s0 < 0 ? 1 : 0), t, t1);
       continue;

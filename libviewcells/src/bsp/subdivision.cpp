@@ -192,11 +192,19 @@ namespace {
 /// Smallest part of a cell a split may cut off, relative to the cell's volume.
 constexpr double kMinPart = 1e-9;
 
-/// The part of segment `id` in a node: a + t (b - a), t in [t0, t1].
+/// The part of segment `id` in a node: a + t (b - a), t in [t0, t1], with t in 31-bit fixed
+/// point (q / 2^31, on the grid bsp_detail::cut_parameter cuts on). Twelve bytes instead of 24
+/// with doubles: the leaves of the city at 50k cells hold 47.5M parts, and every split writes
+/// its cell's parts into its children, so their size is memory traffic and page faults (the
+/// city's subdivision to 50k cells: peak memory 1.16 GB against 1.73 GB).
 struct SegRef {
+  static constexpr uint32_t kOne = 1u << 31;
   uint32_t id;
-  double t0, t1;
+  uint32_t q0, q1;
+  double t0() const { return static_cast<double>(q0) * 0x1p-31; }
+  double t1() const { return static_cast<double>(q1) * 0x1p-31; }
 };
+static_assert(sizeof(SegRef) == 12);
 
 /// One segment's end points and objects in one cache line: the subdivision reads a segment by
 /// id once per node it lies in (tens of millions of parts at 50k cells), and the segment
@@ -558,7 +566,7 @@ class Builder {
                         for (uint32_t i = range.begin(); i < range.end(); ++i) {
                           ends_[i] = {segs_.a(i), segs_.b(i), segs_.object_a[i], segs_.object_b[i],
                                       triangle_of(segs_.triangle_a, i), triangle_of(segs_.triangle_b, i)};
-                          refs[i] = {i, 0.0, 1.0};
+                          refs[i] = {i, 0, SegRef::kOne};
                         }
                       });
     if (config_.strategy == SplitStrategy::kPolygonBsp) {
@@ -827,7 +835,7 @@ class Builder {
     RawVector<uint8_t> code(n);
     // Per chunk, where its crossing parts are cut, in order (a few percent of the parts: an
     // array over all parts cost page faults on hundreds of megabytes over a run).
-    std::vector<std::vector<double>> cuts(chunks);
+    std::vector<std::vector<uint32_t>> cuts(chunks);
     std::vector<std::array<size_t, 2>> at(chunks + 1, {0, 0});  // per chunk: its first index in each child
     std::array<std::vector<NodeExtents>, 2> chunk_ext;  // per side, per chunk
     if (extents)
@@ -845,15 +853,16 @@ class Builder {
         prefetch_ends(refs, i);
         const SegRef& s = refs[i];
         const SegEnds& e = ends_[s.id];
-        const Vec3 p0 = e.at(s.t0), p1 = e.at(s.t1);
+        const double t0 = s.t0(), t1 = s.t1();
+        const Vec3 p0 = e.at(t0), p1 = e.at(t1);
         const int s0 = plane.side(p0), s1 = plane.side(p1);
         int to = classify(s0, s1);
         if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) {
           // Crosses: each side gets its part (the cut point is rounded; sides stay exact).
           to |= s0 < 0 ? 4 : 8;
           const double d0 = plane.distance(p0), d1 = plane.distance(p1);
-          const double cut = std::clamp(s.t0 + (s.t1 - s.t0) * (d0 / (d0 - d1)), s.t0, s.t1);
-          cuts[c].push_back(cut);
+          const double cut = bsp_detail::cut_parameter(t0, t1, d0, d1);
+          cuts[c].push_back(static_cast<uint32_t>(cut * 0x1p31));  // exact: cut is on the grid
           if (extents) {
             const Vec3 mid = e.at(cut);
             const int first = s0 < 0 ? 0 : 1;
@@ -882,14 +891,14 @@ class Builder {
     side[1].resize(at[chunks][1]);
     for_chunks([&](size_t c) {
       size_t next[2] = {at[c][0], at[c][1]};
-      const double* cut = cuts[c].data();
+      const uint32_t* cut = cuts[c].data();
       for (size_t i = c * grain; i < std::min(n, (c + 1) * grain); ++i) {
         const SegRef& s = refs[i];
         if (code[i] & 12) {
-          const double t = *cut++;
+          const uint32_t q = *cut++;
           const int first = (code[i] & 4) ? 0 : 1;
-          side[first][next[first]++] = {s.id, s.t0, t};
-          side[1 - first][next[1 - first]++] = {s.id, t, s.t1};
+          side[first][next[first]++] = {s.id, s.q0, q};
+          side[1 - first][next[1 - first]++] = {s.id, q, s.q1};
           continue;
         }
         if (code[i] & 1) side[0][next[0]++] = s;
@@ -1128,7 +1137,7 @@ class Builder {
       __builtin_prefetch(&ends_[refs[(first + read + kAhead) % n].id]);
       const SegRef& part = refs[(first + read) % n];
       const SegEnds& e = ends_[part.id];
-      const Vec3 p0 = e.at(part.t0), p1 = e.at(part.t1);
+      const Vec3 p0 = e.at(part.t0()), p1 = e.at(part.t1());
       bool wanted = false;
       for (int axis = 0; axis < 3; ++axis) {
         std::vector<double>& at = positions[axis];
@@ -1154,7 +1163,7 @@ class Builder {
     for (size_t i = 0; i < refs.size(); ++i) {
       prefetch_ends(refs, i);
       const SegEnds& e = ends_[refs[i].id];
-      for (double c : {e.at(refs[i].t0)[axis], e.at(refs[i].t1)[axis]})
+      for (double c : {e.at(refs[i].t0())[axis], e.at(refs[i].t1())[axis]})
         if (c > lo_b && c < hi_b) positions.push_back(c);
     }
     std::sort(positions.begin(), positions.end());
@@ -1249,7 +1258,7 @@ class Builder {
         prefetch_ends(refs, i);
         const SegRef& s = refs[i];
         const SegEnds& e = ends_[s.id];
-        slots.add_part(e.at(s.t0), e.at(s.t1), e.object_a, e.object_b, into);
+        slots.add_part(e.at(s.t0()), e.at(s.t1()), e.object_a, e.object_b, into);
       }
       slots.finish(into);
     };
@@ -1344,9 +1353,9 @@ class Builder {
       prefetch_ends(refs, i);
       const SegRef& s = refs[i];
       const SegEnds& e = ends_[s.id];
-      if (s.t0 == 0.0 && seen.first(e.triangle_a)) tris.push_back(e.triangle_a);
-      if (s.t1 == 1.0 && seen.first(e.triangle_b)) tris.push_back(e.triangle_b);
-      parts[i] = {e.at(s.t0), e.at(s.t1), e.object_a, e.object_b};
+      if (s.q0 == 0 && seen.first(e.triangle_a)) tris.push_back(e.triangle_a);
+      if (s.q1 == SegRef::kOne && seen.first(e.triangle_b)) tris.push_back(e.triangle_b);
+      parts[i] = {e.at(s.t0()), e.at(s.t1()), e.object_a, e.object_b};
       points.extend(parts[i].p0);
       points.extend(parts[i].p1);
     }
