@@ -140,6 +140,18 @@ TEST(Subdivision, InvariantsOnTheCity) {
   EXPECT_GT(horizontal, 5);
 }
 
+/// The numerical hard cases the subdivision is tested on: rotated walls (geometry-aligned
+/// planes) and an office moved to coordinates around 1e5.
+std::array<const Scene*, 2> hard_scenes() {
+  static const Scene rotated = generate_scene({GeneratorKind::kRotatedOffice, 2, 2});
+  static const Scene far = [] {
+    Scene s = generate_scene({GeneratorKind::kOffice, 2, 2});
+    translate(s, {1e5, 1e5, 1e5});
+    return s;
+  }();
+  return {&rotated, &far};
+}
+
 TEST(Subdivision, CutsLieOnTheGridWithinThePart) {
   // The parts store t in 31-bit fixed point: every cut is a multiple of 2^-31 within [t0, t1],
   // nearest the crossing, and a NaN crossing (ends at equal distances) gives t0.
@@ -164,10 +176,7 @@ TEST(Subdivision, CutsLieOnTheGridWithinThePart) {
 TEST(Subdivision, PiecesTileEachSegment) {
   // A segment's pieces over the leaves (the same grid as the builder's parts) cover [0, 1]
   // without gaps or overlaps, at 1e5 offsets and on rotated walls too.
-  Scene rotated = generate_scene({GeneratorKind::kRotatedOffice, 2, 2});
-  Scene far = generate_scene({GeneratorKind::kOffice, 2, 2});
-  translate(far, {1e5, 1e5, 1e5});
-  for (const Scene* scene : {&rotated, &far}) {
+  for (const Scene* scene : hard_scenes()) {
     const SegmentSet segs = sample(*scene, 5000);
     const Subdivision s = build(*scene, segs, 80);
     std::vector<std::tuple<int32_t, double, double>> pieces, stack;
@@ -190,10 +199,7 @@ TEST(Subdivision, PiecesTileEachSegment) {
 
 TEST(Subdivision, HardCases) {
   // Rotated walls with geometry-aligned planes; coordinates at 1e5.
-  Scene rotated = generate_scene({GeneratorKind::kRotatedOffice, 2, 2});
-  Scene far = generate_scene({GeneratorKind::kOffice, 2, 2});
-  translate(far, {1e5, 1e5, 1e5});
-  for (const Scene* scene : {&rotated, &far}) {
+  for (const Scene* scene : hard_scenes()) {
     const SegmentSet segs = sample(*scene, 20000);
     const Subdivision s = build(*scene, segs, 120);
     EXPECT_EQ(s.leaf_count(), 120u) << scene->source;
