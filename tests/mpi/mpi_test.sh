@@ -11,7 +11,7 @@ VC="$1"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_btl_vader_single_copy_mechanism=none  # containers without ptrace permission
 # One node's transports only: probing for others (UCX) took 0.2 s of each launch's 0.7 s, and
-# this test launches mpirun 35 times.
+# this test launches mpirun 21 times.
 export OMPI_MCA_pml=ob1 OMPI_MCA_btl=self,vader
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
