@@ -379,7 +379,7 @@ expect_error "q3-clusters needs a Quake 3 map" "$VC" compare office.obj --sample
 if [ -n "$MAPS" ] && [ -f "$MAPS/oa_dm2.bsp" ]; then
   expect_ok "$VC" info "$MAPS/oa_dm2.bsp"
   grep -q "1041 clusters" out.txt && ok || bad "info lacks the map's clusters"
-  expect_ok "$VC" compare "$MAPS/oa_dm2.bsp" --samples 200000 --methods av-m,q3-clusters -o q3cmp -q
+  expect_ok "$VC" compare "$MAPS/oa_dm2.bsp" --samples 100000 --methods av-m,q3-clusters -o q3cmp -q
   python3 -c "
 import json, math
 s = json.load(open('q3cmp/summary.json'))

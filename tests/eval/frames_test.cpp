@@ -152,7 +152,9 @@ TEST(Q3PlaySpace, HoldsEveryPlayCameraAndIsTheSameForAnyThreadCount) {
   size_t count = 0;
   for (size_t l = 0; l < map.leaves.size(); ++l) {
     count += play.leaves[l];
-    if (play.leaves[l]) ASSERT_TRUE(reachable[l]) << "leaf " << l;
+    if (play.leaves[l]) {
+      ASSERT_TRUE(reachable[l]) << "leaf " << l;
+    }
   }
   EXPECT_EQ(count, play.play_leaves);
   EXPECT_GT(play.play_leaves, 0u);

@@ -89,7 +89,7 @@ done
 # every rank's).
 lanes="--mutation-lanes 5"
 # shellcheck disable=SC2086
-ranks 2 -q pvs office.vcells --scene office.obj --cells 12 --samples 1000000 --batch 5000 $lanes --save state.vagvs \
+ranks 3 -q pvs office.vcells --scene office.obj --cells 12 --samples 1000000 --batch 5000 $lanes --save state.vagvs \
   --save-every 0.2 -o killed.pvs >/dev/null 2>killed.err &
 run=$!
 for _ in $(seq 600); do [ -s state.vagvs ] && break; sleep 0.1; done
@@ -108,13 +108,14 @@ saved=$("$VC" pvs office.vcells --scene office.obj --cells 12 --samples 1 --batc
 [ "${saved:-0}" -gt 0 ] && [ "${saved:-0}" -lt 1000000 ] && ok || bad "the checkpoint holds ${saved:-?} samples"
 echo "mpi_test: killed a rank; the checkpoint held $saved of 1,000,000 samples"
 cp state.vagvs state-copy.vagvs
+# Resumed on 2 ranks: 3 oversubscribed ranks take 6 s of CPU for this run, 2 take 3.6 s.
 # shellcheck disable=SC2086
-ranks 3 -q pvs office.vcells --scene office.obj --cells 12 --samples 1000000 --batch 5000 $lanes \
-  --resume state-copy.vagvs -o resumed.pvs || bad "resume on 3 ranks"
+ranks 2 -q pvs office.vcells --scene office.obj --cells 12 --samples 1000000 --batch 5000 $lanes \
+  --resume state-copy.vagvs -o resumed.pvs || bad "resume on 2 ranks"
 # shellcheck disable=SC2086
 "$VC" -q pvs office.vcells --scene office.obj --cells 12 --samples 1000000 --batch 5000 $lanes -o full.pvs ||
   bad "full run"
-same_files "resumed on 3 ranks after a kill" full.pvs resumed.pvs
+same_files "resumed on 2 ranks after a kill on 3" full.pvs resumed.pvs
 
 echo "mpi_test: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

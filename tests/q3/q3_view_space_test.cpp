@@ -4,6 +4,8 @@
 // VIEWCELLS_REQUIRE_MAPS=1 to make its absence a failure rather than a skip).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 
@@ -51,6 +53,51 @@ TEST(Q3ViewSpace, SubdivisionLocatesLikeTheMap) {
     EXPECT_EQ(q3_leaf_of_node(map, node), map.leaf_at(p)) << p.x << " " << p.y << " " << p.z;
     EXPECT_EQ(q3_in_view_space(map, p), p.x <= 0);
   }
+}
+
+/// Columns of points `base + (0, 0, h)` for ascending h, some repeated, some on a plane.
+void expect_columns_find_the_leaves_of_their_points(const Q3Map& map, const Box3& box, int columns) {
+  Rng rng(11, 0);
+  const Vec3 e = box.extent();
+  std::vector<double> heights;
+  std::vector<int32_t> leaves;
+  for (int i = 0; i < columns; ++i) {
+    const Vec3 base{box.lo.x + e.x * rng.uniform(), box.lo.y + e.y * rng.uniform(), 0};
+    heights.clear();
+    double h = box.lo.z + e.z * 0.2 * rng.uniform();
+    for (uint32_t k = 0, n = rng.below(100); k < n; ++k) {  // over 64 at times
+      heights.push_back(h);
+      if (rng.below(8)) h += e.z * 0.02 * rng.uniform();
+    }
+    // A point exactly on a horizontal plane, where the side test decides by its sign alone.
+    const Q3Plane& pl = map.planes[rng.below(static_cast<uint32_t>(map.planes.size()))];
+    if (pl.normal.x == 0 && pl.normal.y == 0 && std::abs(pl.normal.z) == 1) {
+      heights.push_back(pl.dist * pl.normal.z);
+      std::sort(heights.begin(), heights.end());
+    }
+    map.column_leaves(base, heights, leaves);
+    ASSERT_EQ(leaves.size(), heights.size());
+    for (size_t k = 0; k < heights.size(); ++k)
+      ASSERT_EQ(leaves[k], map.leaf_at(base + Vec3{0, 0, 1} * heights[k]))
+          << "column " << i << " at (" << base.x << ", " << base.y << "), height " << heights[k];
+  }
+}
+
+TEST(Q3ViewSpace, ColumnsFindTheLeavesOfTheirPoints) {
+  Q3Map map = small_map();
+  expect_columns_find_the_leaves_of_their_points(map, kBox, 5000);
+  // A sloped plane splits a column in the middle, and a horizontal one at a point on it.
+  map.planes = {{{0, 0, 1}, 2.5}, {{0.6, 0, 0.8}, 1}};
+  expect_columns_find_the_leaves_of_their_points(map, kBox, 5000);
+  std::vector<int32_t> leaves;
+  map.column_leaves({0, 0, 0}, std::vector<double>{-5, 2.5, 2.5, 7}, leaves);
+  EXPECT_EQ(leaves, (std::vector<int32_t>{0, 1, 1, 1}));  // on the plane is in front
+  map.column_leaves({0, 0, 0}, std::vector<double>{}, leaves);
+  EXPECT_TRUE(leaves.empty());
+  // A node tree with a cycle is an error, as for a single point.
+  map.nodes = {{0, {1, -1}}, {1, {0, -3}}};
+  EXPECT_THROW(map.column_leaves({0, 0, 0}, std::vector<double>{-5, 5}, leaves), Error);
+  EXPECT_THROW(map.leaf_at({0, 0, 5}), Error);
 }
 
 TEST(Q3ViewSpace, LeafVolumesAndWeightsAreExact) {
@@ -131,6 +178,7 @@ TEST(Q3OaDm2, ClustersCoverTheNonSolidLeaves) {
     const Vec3 p{box.lo.x + e.x * rng.uniform(), box.lo.y + e.y * rng.uniform(), box.lo.z + e.z * rng.uniform()};
     ASSERT_EQ(q3_leaf_of_node(map, s.locate(p)), map.leaf_at(p));
   }
+  expect_columns_find_the_leaves_of_their_points(map, box, 20000);
   // The sky closes the map but costs nothing.
   size_t sky = 0;
   for (const ObjectInfo& o : scene.objects) sky += !o.rendered;

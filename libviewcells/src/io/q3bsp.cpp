@@ -4,6 +4,7 @@
 #include "viewcells/io/q3bsp.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -90,6 +91,50 @@ int32_t Q3Map::leaf_at(const Vec3& p) const {
     n = node.children[dot(pl.normal, p) - pl.dist >= 0 ? 0 : 1];
   }
   return -(n + 1);
+}
+
+void Q3Map::column_leaves(const Vec3& base, std::span<const double> heights, std::vector<int32_t>& out) const {
+  // At a node, the side test of the column's points is monotone along the column: only z
+  // varies, and rounding keeps n.z * z, and a sum with the same other terms, monotone. So the
+  // points on either side form a run, found by bisection with leaf_at's own test.
+  struct Run {
+    int32_t node;
+    uint32_t lo, hi;  ///< the points [lo, hi) that reach the node
+    size_t depth;
+  };
+  out.assign(heights.size(), -1);
+  if (heights.empty()) return;
+  const Vec3 up{0, 0, 1};
+  // Pending runs hold disjoint points: at most one per point.
+  std::array<Run, 64> small;
+  std::vector<Run> large(heights.size() > small.size() ? heights.size() : 0);
+  Run* const stack = large.empty() ? small.data() : large.data();
+  size_t pending = 0;
+  stack[pending++] = Run{0, 0, static_cast<uint32_t>(heights.size()), 0};
+  while (pending > 0) {
+    const Run run = stack[--pending];
+    if (run.node < 0) {
+      std::fill(out.begin() + run.lo, out.begin() + run.hi, -(run.node + 1));
+      continue;
+    }
+    if (run.depth > nodes.size()) throw Error(path, 0, "Quake 3 BSP: the node tree has a cycle");
+    const Q3Node& node = nodes[run.node];
+    const Q3Plane& pl = planes[node.plane];
+    const auto front = [&](uint32_t k) { return dot(pl.normal, base + up * heights[k]) - pl.dist >= 0; };
+    const bool first = front(run.lo), last = front(run.hi - 1);
+    if (first == last) {
+      stack[pending++] = Run{node.children[first ? 0 : 1], run.lo, run.hi, run.depth + 1};
+      continue;
+    }
+    // b: the first point on the last point's side; [lo, b) are on the first point's side.
+    uint32_t a = run.lo, b = run.hi - 1;
+    while (b - a > 1) {
+      const uint32_t mid = a + (b - a) / 2;
+      (front(mid) == first ? a : b) = mid;
+    }
+    stack[pending++] = Run{node.children[first ? 0 : 1], run.lo, b, run.depth + 1};
+    stack[pending++] = Run{node.children[last ? 0 : 1], b, run.hi, run.depth + 1};
+  }
 }
 
 bool Q3Map::in_brush(const Q3Brush& b, const Vec3& p, double slack) const {

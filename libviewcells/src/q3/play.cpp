@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <numbers>
+#include <span>
 
 #include "viewcells/bsp/adjacency.h"
 #include "viewcells/core/error.h"
@@ -103,17 +104,21 @@ PlaySpace q3_play_space(const Q3Map& map, const Scene& scene, const RayCaster& c
   std::vector<std::atomic<uint8_t>> marked(map.leaves.size());
   const Vec3 up{0, 0, 1};
   constexpr double kLift = 0.25;  // off the floor, so the floor itself is not what the ray meets
+  // A column's points, every `step` units from kLift up to `reach`.
+  std::vector<double> heights;
+  for (double h = kLift; h < config.reach; h += config.step) heights.push_back(h);
   tbb::parallel_for(tbb::blocked_range<uint32_t>(0, config.columns, 1024), [&](const tbb::blocked_range<uint32_t>& r) {
+    std::vector<int32_t> leaves;
     for (uint32_t i = r.begin(); i < r.end(); ++i) {
       Rng rng(config.seed, (uint64_t{92} << 40) | i);
       const double pick = rng.uniform(), u = rng.uniform(), v = rng.uniform();
       const Vec3 f = floors.point(scene, pick, u, v);
       const Hit hit = caster.intersect(Ray{f + up * kLift, up, 0, config.reach - kLift});
       const double top = hit.hit() ? kLift + hit.t : config.reach;
-      for (double h = kLift; h < top; h += config.step) {
-        const int32_t l = map.leaf_at(f + up * h);
+      const auto end = std::lower_bound(heights.begin(), heights.end(), top);
+      map.column_leaves(f, std::span<const double>(heights.data(), end - heights.begin()), leaves);
+      for (const int32_t l : leaves)
         if (reachable[l] && !marked[l].load(std::memory_order_relaxed)) marked[l].store(1, std::memory_order_relaxed);
-      }
     }
   });
   out.leaves.assign(map.leaves.size(), false);
