@@ -508,16 +508,16 @@ expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --agvs-samples 200000
 [ "$(json_get bake3.json "['effects']['agvs_resumed']['enabled']")" = "True" ] && ok || bad "bake did not continue the saved AGVS state"
 # A bake cut off during AGVS (kill -9) continues from its last checkpoint when run again, and
 # writes what an uninterrupted bake writes.
-expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --agvs-samples 1500000 -o direct.pvs -q
-"$VC" bake office.obj --cells 12 --samples 20000 --agvs-samples 1500000 -o killed.pvs --work killwork \
-  --checkpoint 0.3 2>kill.txt &
+expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --agvs-samples 1000000 -o direct.pvs -q
+"$VC" bake office.obj --cells 12 --samples 20000 --agvs-samples 1000000 -o killed.pvs --work killwork \
+  --checkpoint 0.1 2>kill.txt &
 pid=$!
 for _ in $(seq 100); do grep -q "checkpoint after" kill.txt 2>/dev/null && break; sleep 0.1; done
 kill -9 "$pid" 2>/dev/null
 wait "$pid" 2>/dev/null
 [ ! -e killed.pvs ] && ok || bad "a bake killed mid-way wrote its output"
-expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --agvs-samples 1500000 -o killed.pvs --work killwork \
-  --checkpoint 0.3 --report killed.json -q
+expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --agvs-samples 1000000 -o killed.pvs --work killwork \
+  --checkpoint 0.1 --report killed.json -q
 [ "$(json_get killed.json "['effects']['agvs_resumed']['enabled']")" = "True" ] && ok || bad "the killed bake did not continue from its checkpoint"
 cmp -s direct.pvs killed.pvs && ok || bad "a bake resumed after kill -9 differs from an uninterrupted one"
 for budget in 3000 6K 20000; do

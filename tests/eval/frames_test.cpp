@@ -145,6 +145,9 @@ TEST(Q3PlaySpace, HoldsEveryPlayCameraAndIsTheSameForAnyThreadCount) {
   const Scene& scene = d->scene;
   const RayCaster* caster = d->caster.get();
   PlaySpaceConfig config;
+  for (const auto& bad : {PlaySpaceConfig{0}, PlaySpaceConfig{1000, 1, 112, 0}, PlaySpaceConfig{1000, 1, 112, 1e-5},
+                          PlaySpaceConfig{1000, 1, INFINITY}, PlaySpaceConfig{1000, 1, 112, 8, 1.5}})
+    EXPECT_THROW(q3_play_space(map, scene, *caster, bad), Error);
   config.columns = 200000;
   const PlaySpace play = q3_play_space(map, scene, *caster, config);
   const std::vector<bool> reachable = q3_reachable_leaves(map);

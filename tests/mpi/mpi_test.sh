@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # viewcells on several MPI ranks (a VIEWCELLS_MPI build): `sample`, `pvs`, `bake` and `compare`
-# under mpirun with 1, 2 and 3 ranks (oversubscribed) write the same files, byte for byte, as one
-# process without mpirun, and the same report numbers (timings and the ranks' traffic aside).
+# under mpirun with 2 and 3 ranks (oversubscribed; `sample` also on 1) write the same files, byte
+# for byte, as one process without mpirun, and the same report numbers (timings and the ranks'
+# traffic aside).
 # Then a rank of a checkpointing `pvs` run is killed: the run ends with an error (no hang, no
 # output), and resuming from its last checkpoint on another number of ranks finishes with the
 # file an uninterrupted run writes.
@@ -11,7 +12,7 @@ VC="$1"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_btl_vader_single_copy_mechanism=none  # containers without ptrace permission
 # One node's transports only: probing for others (UCX) took 0.2 s of each launch's 0.7 s, and
-# this test launches mpirun 21 times.
+# this test launches mpirun 17 times.
 export OMPI_MCA_pml=ob1 OMPI_MCA_btl=self,vader
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -47,6 +48,9 @@ for n in 1 2 3; do
   ranks "$n" -q sample office.obj --samples 40000 -o "s$n.vseg" --report "s$n.json" || bad "sample on $n ranks"
   same_files "sample, $n ranks" s0.vseg "s$n.vseg"
   same_numbers "sample, $n ranks" s0.json "s$n.json"
+  # On one rank every collective returns at once: the sample above covers starting and stopping
+  # under mpirun, and the commands below run as in one process.
+  [ "$n" -gt 1 ] || continue
   ranks "$n" -q pvs office.vcells --scene office.obj --cells 12 --samples 50000 --batch 5000 -o "p$n.pvs" \
     --report "p$n.json" || bad "pvs on $n ranks"
   same_files "pvs, $n ranks" p0.pvs "p$n.pvs"
@@ -61,7 +65,8 @@ done
 # REF and SGVS, the visibility filter's densities (partitioned with the cells, then combined),
 # AGVS's mutation lanes (each drawn and fed by its own rank, combined at the end), and stopping
 # on a measured error (every rank measures the same table and stops at the same batch).
-for extra in "--method ref" "--method sgvs" "--filter" "--mutation-lanes 5" \
+# (Lanes also run on the city below, and in the killed and resumed run.)
+for extra in "--method ref" "--method sgvs" "--filter --mutation-lanes 5" \
   "--measure-cameras 64 --measure-size 64 --measured-error 1 --mutation-lanes 9"; do
   # shellcheck disable=SC2086
   "$VC" -q pvs office.vcells --scene office.obj --cells 12 --samples 30000 --batch 5000 $extra -o x0.pvs || bad "pvs $extra"

@@ -95,6 +95,7 @@ std::vector<bool> q3_reachable_leaves(const Q3Map& map, size_t* spawn_points) {
 PlaySpace q3_play_space(const Q3Map& map, const Scene& scene, const RayCaster& caster, const PlaySpaceConfig& config) {
   if (config.columns == 0 || !(config.reach > 0) || !(config.step > 0) || !(config.walk_normal > 0 && config.walk_normal <= 1))
     throw Error("play space: columns, reach, step and walkable normal must be positive (the normal at most 1)");
+  if (!(config.reach / config.step <= 1e6)) throw Error("play space: reach / step exceeds a million points a column");
   PlaySpace out;
   const std::vector<bool> reachable = q3_reachable_leaves(map);
   const WalkableFloors floors(scene, config.walk_normal);
