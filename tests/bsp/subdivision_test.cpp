@@ -391,9 +391,11 @@ TEST(Subdivision, ViewpointPointsWeighCellsByTheirShare) {
     west += c.hi.x <= mid_x + 1e-9;
     east += c.lo.x >= mid_x - 1e-9;
   }
-  for (const BspNode& n : s.nodes)
-    if (n.plane >= 0)
+  for (const BspNode& n : s.nodes) {
+    if (n.plane >= 0) {
       EXPECT_NEAR(s.nodes[n.child[0]].weight + s.nodes[n.child[1]].weight, n.weight, 1e-9 * box.volume());
+    }
+  }
   EXPECT_GT(west, 4 * std::max(east, 1)) << "cells gather where the viewpoints are";
   EXPECT_GT(empty, 0);
   // The same tree for one and for two threads.
@@ -600,6 +602,9 @@ double brute_force_reduction(const SegmentSet& segs, const std::vector<double>& 
 /// and evaluates on all parts only those whose bound could beat the best so far (the root has
 /// far more than the 2,048 parts from which it bounds). Its reduction must be the best that a
 /// brute-force pass over every segment gives for every one of those planes, exactly classified.
+/// The second sample weighs the cells by viewpoints (a map's play space does), in the western
+/// half of the box only, where a plane's weight below is the share of them on its side: the
+/// builder skips counting them for planes that cannot win whatever that share.
 TEST(Subdivision, GeometryAlignedBoundsKeepTheBestPlane) {
   const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 1});
   const std::vector<double> r = per_object_costs(scene, CostModel{});
@@ -613,9 +618,28 @@ TEST(Subdivision, GeometryAlignedBoundsKeepTheBestPlane) {
     config.geometry_aligned = GeometryAlignedMode::kOn;
     config.min_reduction = 0;
     config.show_progress = false;
+    const Box3 box = segs.view_box;
+    std::shared_ptr<std::vector<Vec3>> viewpoints;
+    if (seed == 2) {
+      viewpoints = std::make_shared<std::vector<Vec3>>();
+      Rng rng(9);
+      for (int i = 0; i < 4000; ++i)
+        viewpoints->push_back({rng.uniform(box.lo.x, 0.5 * (box.lo.x + box.hi.x)), rng.uniform(box.lo.y, box.hi.y),
+                               rng.uniform(box.lo.z, box.hi.z)});
+      config.viewpoints = viewpoints;
+    }
+    // The share of the weight on the negative side of a plane (or on it): of the viewpoints,
+    // or of the volume.
+    auto share_below = [&](const Plane& plane, double volume_share) {
+      if (!viewpoints) return volume_share;
+      size_t below = 0;
+      for (const Vec3& p : *viewpoints) below += plane.side(p) <= 0;
+      return static_cast<double>(below) / static_cast<double>(viewpoints->size());
+    };
     const Subdivision s = subdivide(scene, segs, CostModel{}, config);
     ASSERT_EQ(s.splits.size(), 1u);
-    const Box3 box = s.view_box;
+    ASSERT_EQ(s.view_box.lo, box.lo);
+    ASSERT_EQ(s.view_box.hi, box.hi);
     double best_axis = -INFINITY;
     for (int axis = 0; axis < 3; ++axis) {
       std::vector<double> xs;
@@ -624,7 +648,17 @@ TEST(Subdivision, GeometryAlignedBoundsKeepTheBestPlane) {
           if (p[axis] > box.lo[axis] && p[axis] < box.hi[axis]) xs.push_back(p[axis]);
       std::sort(xs.begin(), xs.end());
       xs.erase(std::unique(xs.begin(), xs.end()), xs.end());
-      for (double x : xs) best_axis = std::max(best_axis, brute_force_reduction(segs, r, s.initial_cost, box, axis, x));
+      std::vector<double> at;  // the viewpoints' coordinates along the axis, sorted
+      if (viewpoints)
+        for (const Vec3& p : *viewpoints) at.push_back(p[axis]);
+      std::sort(at.begin(), at.end());
+      for (double x : xs) {
+        const auto cost = brute_force_side_costs(segs, r, [&](size_t i) { return axis_sides(segs, i, axis, x); });
+        const double share = viewpoints ? static_cast<double>(std::upper_bound(at.begin(), at.end(), x) - at.begin()) /
+                                              static_cast<double>(at.size())
+                                        : (x - box.lo[axis]) / (box.hi[axis] - box.lo[axis]);
+        best_axis = std::max(best_axis, s.initial_cost - share * cost[0] - (1 - share) * cost[1]);
+      }
     }
     // The builder's planes: one per distinct non-axis-aligned plane of the triangles hit, keyed
     // as it keys them (the lowest triangle id per key).
@@ -657,7 +691,8 @@ TEST(Subdivision, GeometryAlignedBoundsKeepTheBestPlane) {
       if (!(vl > 1e-9 * volume && volume - vl > 1e-9 * volume)) continue;
       const auto cost = brute_force_side_costs(
           segs, r, [&](size_t i) { return std::array<int, 2>{plane.side(segs.a(i)), plane.side(segs.b(i))}; });
-      best_ga = std::max(best_ga, s.initial_cost - (vl * cost[0] + (volume - vl) * cost[1]) / volume);
+      const double share = share_below(plane, vl / volume);
+      best_ga = std::max(best_ga, s.initial_cost - share * cost[0] - (1 - share) * cost[1]);
     }
     EXPECT_GT(best_ga, best_axis) << "seed " << seed << ": a geometry-aligned plane should decide this split";
     EXPECT_NEAR(s.splits[0].reduction, std::max(best_ga, best_axis), 1e-9 * s.initial_cost) << "seed " << seed;

@@ -1388,7 +1388,24 @@ class Builder {
     // is seen from there (that end's part touches the side), so those objects are a subset of
     // what each side sees, each side's r(PVS) can only grow from theirs, and the reduction can
     // only fall.
-    auto reduction_of = [&](const Plane& plane, double vl, const std::vector<ObjectExtremes>* extremes) {
+    // The weight below a plane: the viewpoints on its negative side (each by the exact side, its
+    // filter bounded by their box), or its volume below (or in the density's band).
+    Box3 viewpoint_box;
+    if (points_)
+      for (uint32_t i : pts_[node]) viewpoint_box.extend((*config_.viewpoints)[i]);
+    auto weight_below = [&](const Plane& plane, double vl) {
+      if (points_) {
+        const FilteredSide side(plane, viewpoint_box);
+        uint64_t below = 0;
+        for (uint32_t i : pts_[node]) below += side((*config_.viewpoints)[i]) <= 0;
+        return static_cast<double>(below) * point_weight_;
+      }
+      if (config_.density.enabled) return config_.density.weight_below(cell, part, plane);
+      return vl;
+    };
+    // What each side of a plane sees, r(PVS) summed: exact from all the parts, or from below
+    // (a subset of each side's objects) from `extremes`.
+    auto side_costs = [&](const Plane& plane, const std::vector<ObjectExtremes>* extremes) {
       const FilteredSide side(plane, points);
       auto& [neg, pos] = side_pair_marks_.local();
       neg.reset(r_.size());
@@ -1414,15 +1431,10 @@ class Builder {
           if (to & 2) cr += pos.add(e.object_a, r) + pos.add(e.object_b, r);
         }
       }
-      double wl = vl;
-      if (points_) {
-        uint64_t below = 0;
-        for (uint32_t i : pts_[node]) below += plane.side((*config_.viewpoints)[i]) <= 0;
-        wl = static_cast<double>(below) * point_weight_;
-      } else if (config_.density.enabled) {
-        wl = config_.density.weight_below(cell, part, plane);
-      }
-      return own - (wl * cl + (weight - wl) * cr) / total_weight_;
+      return std::pair{cl, cr};
+    };
+    auto reduction = [&](double wl, std::pair<double, double> costs) {
+      return own - (wl * costs.first + (weight - wl) * costs.second) / total_weight_;
     };
     // In a cell of more than kBoundedParts parts, every plane is first bounded from its
     // objects' extreme ends (O(objects), where most objects are seen across much of the cell),
@@ -1452,14 +1464,24 @@ class Builder {
       for (const ObjectExtremes& x : extremes) entry[x.object] = UINT32_MAX;
     }
     // The planes in parallel, the best chosen in their order: ties keep the first.
+    const double margin = 1e-9 * std::abs(own) + 1e-300;  // for rounding
     std::vector<Candidate> results(planes.size());
-    std::vector<double> volume_below(planes.size());
+    std::vector<double> below(planes.size());  // each plane's weight below, for its exact pass
     tbb::parallel_for(size_t{0}, planes.size(), [&](size_t j) {
       const auto& tri = scene_.triangles[planes[j]];
       const Plane plane = Plane::through(scene_.vertices[tri[0]], scene_.vertices[tri[1]], scene_.vertices[tri[2]]);
-      const double vl = volume_below[j] = cell.volume_below(plane), vr = volume - vl;
+      const double vl = cell.volume_below(plane), vr = volume - vl;
       if (!(vl > kMinPart * volume && vr > kMinPart * volume)) return;
-      results[j] = {true, plane, reduction_of(plane, vl, bounded ? &extremes : nullptr)};
+      const auto costs = side_costs(plane, bounded ? &extremes : nullptr);
+      if (bounded) {
+        // Whatever the weight below (0 to the cell's), the reduction is at most this. A plane
+        // it leaves below the axis split (by more than rounding) cannot be chosen, and its
+        // weight below, a pass over the cell's viewpoints with a viewpoint density, is not needed.
+        const double any_weight = own - weight * std::min(costs.first, costs.second) / total_weight_;
+        if (any_weight < to_beat - 2 * margin) return;
+      }
+      below[j] = weight_below(plane, vl);
+      results[j] = {true, plane, reduction(below[j], costs)};
     });
     if (bounded) {
       std::vector<size_t> order;
@@ -1468,7 +1490,6 @@ class Builder {
       std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
         return results[a].reduction > results[b].reduction || (results[a].reduction == results[b].reduction && a < b);
       });
-      const double margin = 1e-9 * std::abs(own) + 1e-300;
       std::vector<char> exact(results.size(), 0);
       double best_exact = to_beat;
       for (size_t next = 0; next < order.size();) {
@@ -1477,7 +1498,7 @@ class Builder {
         const size_t batch = std::min(order.size(), next + 4);
         tbb::parallel_for(next, batch, [&](size_t i) {
           Candidate& c = results[order[i]];
-          c.reduction = reduction_of(c.plane, volume_below[order[i]], nullptr);
+          c.reduction = reduction(below[order[i]], side_costs(c.plane, nullptr));
         });
         for (; next < batch; ++next) {
           exact[order[next]] = 1;
