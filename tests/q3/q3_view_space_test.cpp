@@ -94,6 +94,7 @@ TEST(Q3ViewSpace, ColumnsFindTheLeavesOfTheirPoints) {
   EXPECT_EQ(leaves, (std::vector<int32_t>{0, 1, 1, 1}));  // on the plane is in front
   map.column_leaves({0, 0, 0}, std::vector<double>{}, leaves);
   EXPECT_TRUE(leaves.empty());
+  EXPECT_THROW(map.column_leaves({0, 0, 0}, std::vector<double>{1, 0}, leaves), Error);
   // A node tree with a cycle is an error, as for a single point.
   map.nodes = {{0, {1, -1}}, {1, {0, -3}}};
   EXPECT_THROW(map.column_leaves({0, 0, 0}, std::vector<double>{-5, 5}, leaves), Error);

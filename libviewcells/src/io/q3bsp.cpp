@@ -102,6 +102,8 @@ void Q3Map::column_leaves(const Vec3& base, std::span<const double> heights, std
     uint32_t lo, hi;  ///< the points [lo, hi) that reach the node
     size_t depth;
   };
+  if (!std::is_sorted(heights.begin(), heights.end()))
+    throw Error(path, 0, "the heights of a column's points must ascend");
   out.assign(heights.size(), -1);
   if (heights.empty()) return;
   const Vec3 up{0, 0, 1};

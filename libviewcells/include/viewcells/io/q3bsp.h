@@ -89,8 +89,8 @@ struct Q3Map {
   Q3SurfaceKind kind(const Q3Surface& s) const;
   /// The leaf containing p (walking the nodes).
   int32_t leaf_at(const Vec3& p) const;
-  /// out[k] = leaf_at(base + (0, 0, heights[k])) for each k, heights ascending: the same
-  /// leaves, found by one walk of the nodes for the whole vertical column.
+  /// out[k] = leaf_at(base + (0, 0, heights[k])) for each k: the same leaves, found by one walk
+  /// of the nodes for the whole vertical column. Error unless the heights ascend.
   void column_leaves(const Vec3& base, std::span<const double> heights, std::vector<int32_t>& out) const;
   /// Whether p lies in brush b: behind all of its sides, up to `slack` map units.
   bool in_brush(const Q3Brush& b, const Vec3& p, double slack = 1e-3) const;
