@@ -448,6 +448,11 @@ RawMesh read_isolated(const std::string& name, F&& read) {
   if (WIFSIGNALED(status))
     throw Error(name, 0, "Assimp crashed reading it (signal " + std::to_string(WTERMSIG(status)) +
                              "): the file is malformed");
+  // A child that exits without an answer and with a failing status crashed too (a sanitizer
+  // reports a crash and exits rather than dying of the signal).
+  if (answer.empty() && WIFEXITED(status) && WEXITSTATUS(status) != 0)
+    throw Error(name, 0, "Assimp crashed reading it (exit status " + std::to_string(WEXITSTATUS(status)) +
+                             "): the file is malformed");
   if (answer.empty()) throw Error(name, 0, "the Assimp reader ended without an answer");
   if (answer[0] == 'E') throw Error(answer.substr(1));  // already names the file
   return decode(answer.substr(1), name);
