@@ -1383,11 +1383,6 @@ class Builder {
     const double volume = out_.nodes[node].volume, weight = out_.nodes[node].weight;
     const ConvexPolyhedron& cell = out_.cells[node];
     const ConvexPolyhedron part = config_.density.enabled ? config_.density.band_part(cell) : ConvexPolyhedron();
-    // A plane's reduction, from all the parts (exact; each plane costs O(n)), or bounded from
-    // above by `extremes`: an object one of whose extreme part ends lies strictly on a side
-    // is seen from there (that end's part touches the side), so those objects are a subset of
-    // what each side sees, each side's r(PVS) can only grow from theirs, and the reduction can
-    // only fall.
     // The weight below a plane: the viewpoints on its negative side (each by the exact side, its
     // filter bounded by their box), or its volume below (or in the density's band).
     Box3 viewpoint_box;
@@ -1403,8 +1398,11 @@ class Builder {
       if (config_.density.enabled) return config_.density.weight_below(cell, part, plane);
       return vl;
     };
-    // What each side of a plane sees, r(PVS) summed: exact from all the parts, or from below
-    // (a subset of each side's objects) from `extremes`.
+    // What each side of a plane sees, r(PVS) summed: exact from all the parts (each plane costs
+    // O(n)), or from below by `extremes`: an object one of whose extreme part ends lies strictly
+    // on a side is seen from there (that end's part touches the side), so those objects are a
+    // subset of what each side sees, each side's r(PVS) can only grow from theirs, and the
+    // reduction can only fall.
     auto side_costs = [&](const Plane& plane, const std::vector<ObjectExtremes>* extremes) {
       const FilteredSide side(plane, points);
       auto& [neg, pos] = side_pair_marks_.local();
