@@ -222,6 +222,24 @@ TEST(Subdivision, GeometryAlignedPlanesHelpTheRotatedOffice) {
   expect_invariants(scene, segs, ga);
 }
 
+/// Cells below the root take their geometry-aligned candidates too: the builder skips them only
+/// in cells none of whose part ends lies on a non-axis-aligned triangle (which the division of
+/// the parent notes), and the rotated office's walls are hit in most cells.
+TEST(Subdivision, GeometryAlignedPlanesBelowTheRoot) {
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 2});
+  const SegmentSet segs = sample(scene, 40000);
+  const Subdivision root = build(scene, segs, 2, GeometryAlignedMode::kOn);
+  const Subdivision s = build(scene, segs, 60, GeometryAlignedMode::kOn);
+  ASSERT_EQ(s.leaf_count(), 60u);
+  size_t below_root = 0;
+  for (size_t k = 1; k < s.splits.size(); ++k)
+    below_root += !s.planes[s.nodes[s.splits[k].node].plane].is_axis_aligned();
+  EXPECT_GT(below_root, 5u) << "splits below the root along rotated walls";
+  // Far more candidates than the root's and its two children's (the build of 2 cells counts them).
+  EXPECT_GT(s.stats.geometry_candidates, 3 * root.stats.geometry_candidates);
+  expect_invariants(scene, segs, s);
+}
+
 /// The same tree: splits, planes, nodes, leaf segments and what was evaluated for them.
 void expect_same_tree(const Subdivision& a, const Subdivision& b) {
   ASSERT_EQ(a.splits.size(), b.splits.size());

@@ -545,6 +545,10 @@ class Builder {
       out_.stats.geometry_aligned_reason = std::string("not used by ") + to_string(config_.strategy);
     }
     ga_ = out_.stats.geometry_aligned;
+    if (ga_) {
+      plane_source_.assign(scene_.triangles.size(), 0);
+      for (uint32_t t = 0; t < scene_.triangles.size(); ++t) plane_source_[t] = plane_direction(t).has_value();
+    }
     if (!(total_volume_ > 0)) throw Error("the view space box has zero volume");
     const Box3& b = out_.view_box;
     for (int a = 0; a < 3; ++a) {
@@ -796,6 +800,7 @@ class Builder {
   int32_t add_node(const BspNode& node, ConvexPolyhedron cell, RawVector<SegRef> refs) {
     const int32_t parent = node.parent;
     depth_.push_back(parent < 0 ? 0 : depth_[parent] + 1);
+    plane_hits_.push_back(1);  // until add_children knows better
     out_.nodes.push_back(node);
     out_.cells.push_back(std::move(cell));
     refs_.push_back(std::move(refs));
@@ -807,6 +812,7 @@ class Builder {
   struct Partition {
     RawVector<SegRef> side[2];
     std::array<NodeExtents, 2> ext;
+    bool plane_hits[2] = {false, false};  ///< with geometry-aligned planes: see plane_hits_
   };
 
   /// AV-S evaluates cells by their extents, which splits gather; the baselines need none.
@@ -834,6 +840,7 @@ class Builder {
     std::vector<std::vector<uint32_t>> cuts(chunks);
     std::vector<std::array<size_t, 2>> at(chunks + 1, {0, 0});  // per chunk: its first index in each child
     std::array<std::vector<NodeExtents>, 2> chunk_ext;  // per side, per chunk
+    std::vector<std::array<uint8_t, 2>> chunk_hits(chunks, {0, 0});  // per chunk: plane_hits of each side
     if (extents)
       for (auto& side_ext : chunk_ext) side_ext.resize(chunks);
     auto for_chunks = [&](auto&& f) {
@@ -845,6 +852,7 @@ class Builder {
       std::array<ExtentSlots, 2>& slots = split_slots_.local();
       if (extents)
         for (ExtentSlots& sl : slots) sl.reset(r_.size());
+      uint8_t hits[2] = {0, 0};
       for (size_t i = c * grain; i < std::min(n, (c + 1) * grain); ++i) {
         prefetch_ends(refs, i);
         const SegRef& s = refs[i];
@@ -858,16 +866,25 @@ class Builder {
           to |= s0 < 0 ? 4 : 8;
           const double d0 = plane.distance(p0), d1 = plane.distance(p1);
           const double cut = bsp_detail::cut_parameter(t0, t1, d0, d1);
-          cuts[c].push_back(static_cast<uint32_t>(cut * 0x1p31));  // exact: cut is on the grid
+          const uint32_t q = static_cast<uint32_t>(cut * 0x1p31);  // exact: cut is on the grid
+          cuts[c].push_back(q);
+          if (ga_) {
+            const int first = s0 < 0 ? 0 : 1;
+            hits[first] |= hits_plane_source({s.id, s.q0, q}, e);
+            hits[1 - first] |= hits_plane_source({s.id, q, s.q1}, e);
+          }
           if (extents) {
             const Vec3 mid = e.at(cut);
             const int first = s0 < 0 ? 0 : 1;
             slots[first].add_part(p0, mid, e.object_a, e.object_b, chunk_ext[first][c]);
             slots[1 - first].add_part(mid, p1, e.object_a, e.object_b, chunk_ext[1 - first][c]);
           }
-        } else if (extents) {
-          for (int k = 0; k < 2; ++k)
-            if (to & (1 << k)) slots[k].add_part(p0, p1, e.object_a, e.object_b, chunk_ext[k][c]);
+        } else {
+          if (ga_ && hits_plane_source(s, e))
+            for (int k = 0; k < 2; ++k) hits[k] |= (to >> k) & 1;
+          if (extents)
+            for (int k = 0; k < 2; ++k)
+              if (to & (1 << k)) slots[k].add_part(p0, p1, e.object_a, e.object_b, chunk_ext[k][c]);
         }
         code[i] = static_cast<uint8_t>(to);
         count[0] += to & 1;
@@ -876,8 +893,11 @@ class Builder {
       if (extents)
         for (int k = 0; k < 2; ++k) slots[k].finish(chunk_ext[k][c]);
       at[c + 1] = {count[0], count[1]};
+      chunk_hits[c] = {hits[0], hits[1]};
     });
     Partition out;
+    for (const auto& h : chunk_hits)
+      for (int k = 0; k < 2; ++k) out.plane_hits[k] |= h[k] != 0;
     if (extents)
       for (int k = 0; k < 2; ++k) out.ext[k] = join_extents(chunk_ext[k]);
     for (size_t c = 0; c < chunks; ++c)
@@ -954,6 +974,7 @@ class Builder {
     for (int k = 0; k < 2; ++k) {
       const int32_t c = add_node(p.measured[k], std::move(k == 0 ? p.halves->first : p.halves->second),
                                  std::move(p.parts.side[k]));
+      plane_hits_[c] = p.parts.plane_hits[k];
       if (gathers_extents()) {
         pending_ext_.resize(out_.nodes.size());
         pending_ext_[c] = std::make_unique<NodeExtents>(std::move(p.parts.ext[k]));
@@ -983,6 +1004,7 @@ class Builder {
     out_.cells.resize(n);
     refs_.resize(n);
     depth_.resize(n);
+    plane_hits_.resize(n);
     best_.resize(n);
     if (pending_ext_.size() > n) pending_ext_.resize(n);
     if (tris_.size() > n) tris_.resize(n);
@@ -1327,11 +1349,31 @@ class Builder {
     return {true, Plane::axis_aligned(axis, positions[best_j]), best_reduction};
   }
 
+  /// The unit normal of triangle t if its plane is a geometry-aligned candidate (not
+  /// degenerate, not axis-aligned).
+  std::optional<Vec3> plane_direction(uint32_t t) const {
+    const Vec3 n = scene_.triangle_normal(t);
+    const double len = length(n);
+    if (!(len > 0)) return std::nullopt;
+    const Vec3 u = n / len;
+    if (std::max({std::abs(u.x), std::abs(u.y), std::abs(u.z)}) > 1.0 - 1e-9) return std::nullopt;
+    return u;
+  }
+
+  /// Whether a node part's end inside the node hit a plane source (the triangles
+  /// best_geometry_candidate takes its planes from).
+  bool hits_plane_source(const SegRef& s, const SegEnds& e) const {
+    return (s.q0 == 0 && e.triangle_a != kNoObject && plane_source_[e.triangle_a]) ||
+           (s.q1 == SegRef::kOne && e.triangle_b != kNoObject && plane_source_[e.triangle_b]);
+  }
+
   /// The best of the planes of non-axis-aligned triangles hit inside the node (a random subset;
   /// each costs O(n)), or none. In a large cell, only the planes whose bound may beat `to_beat`
   /// (the best axis-aligned reduction: ties keep the axis) are evaluated on all parts, so a
   /// plane left out could not have been chosen.
   Candidate best_geometry_candidate(int32_t node, Evaluation& ev, const double* r, double to_beat) {
+    // About half the cells of oa_shouse hold no end on a plane source: no pass over their parts.
+    if (!plane_hits_[node]) return {};
     const RawVector<SegRef>& refs = refs_[node];
     // Triangles hit at segment ends inside this node lie (at least partly) inside it.
     // (Distinct ones first, by marks; then sorted: far fewer than the parts.) The same pass
@@ -1359,11 +1401,9 @@ class Builder {
     // One candidate per distinct plane (walls are made of several triangles).
     std::map<std::array<long long, 4>, uint32_t> by_plane;
     for (uint32_t t : tris) {
-      const Vec3 n = scene_.triangle_normal(t);
-      const double len = length(n);
-      if (!(len > 0)) continue;
-      const Vec3 u = n / len;
-      if (std::max({std::abs(u.x), std::abs(u.y), std::abs(u.z)}) > 1.0 - 1e-9) continue;  // axis-aligned
+      const std::optional<Vec3> direction = plane_direction(t);
+      if (!direction) continue;
+      const Vec3& u = *direction;
       const double d = dot(u, scene_.vertices[scene_.triangles[t][0]]);
       const double q = 1e6 / std::max(1.0, out_.view_box.diagonal());
       by_plane.emplace(std::array<long long, 4>{std::llround(u.x * 1e6), std::llround(u.y * 1e6),
@@ -1530,6 +1570,10 @@ class Builder {
   std::vector<RawVector<SegRef>> refs_;
   std::vector<SegEnds> ends_;  ///< per segment, as segs_
   std::vector<uint32_t> depth_;              ///< per node
+  /// With geometry-aligned planes: per triangle, whether it is a plane source (plane_direction);
+  /// per node, whether one of its parts has an end inside it on a plane source (0: the node
+  /// has no geometry-aligned candidates; the root and nodes not made by partition: 1).
+  std::vector<uint8_t> plane_source_, plane_hits_;
   std::vector<std::vector<uint32_t>> tris_;  ///< BSP baseline: per node, the polygons in it
   /// With viewpoints (points_): per node, the viewpoints in it (those of split nodes freed),
   /// and the weight of one.
