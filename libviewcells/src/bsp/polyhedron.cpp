@@ -198,10 +198,13 @@ double ConvexPolyhedron::volume_below(const Plane& plane) const {
   // the plane, contributes nothing, so it need not be built.
   const Vec3 c0 = centroid();
   const Vec3 ref = c0 - plane.normal * plane.distance(c0);
-  std::vector<double> dist(vertices_.size());
+  // Reused buffers: the subdivision calls this for every candidate position in a cell that is
+  // not a box (hundreds of thousands of calls on a map), and two allocations each showed.
+  thread_local std::vector<double> dist;
+  thread_local std::vector<Vec3> poly;
+  dist.resize(vertices_.size());
   for (size_t i = 0; i < vertices_.size(); ++i) dist[i] = plane.distance(vertices_[i]);
   double v = 0;
-  std::vector<Vec3> poly;
   for (const PolyFace& f : faces_) {
     poly.clear();
     const size_t n = f.vertices.size();
