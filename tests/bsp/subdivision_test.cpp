@@ -284,6 +284,46 @@ TEST(Subdivision, IdenticalForOneAndTwoThreads) {
   expect_same_for_one_and_two_threads(scene, sample(scene, 15000), 80);
 }
 
+/// In a cell that is not a box (below a geometry-aligned split) the builder clips the cell for
+/// an axis position's volume below only where it can change the choice: every 16th position
+/// bounds those between, and with viewpoints only a position that would become the best is
+/// clipped. The tree must be the one that clipping at every position gives, with the volume
+/// as the weight and with viewpoints (in the western half of the box only).
+TEST(Subdivision, ClippingWhereItMattersKeepsTheTree) {
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 2, 2});
+  const SegmentSet segs = sample(scene, 30000);
+  for (bool with_viewpoints : {false, true}) {
+    SubdivisionConfig config;
+    config.max_cells = 150;
+    config.geometry_aligned = GeometryAlignedMode::kOn;
+    config.show_progress = false;
+    if (with_viewpoints) {
+      auto viewpoints = std::make_shared<std::vector<Vec3>>();
+      const Box3 box = segs.view_box;
+      Rng rng(4);
+      for (int i = 0; i < 20000; ++i)
+        viewpoints->push_back({rng.uniform(box.lo.x, 0.5 * (box.lo.x + box.hi.x)), rng.uniform(box.lo.y, box.hi.y),
+                               rng.uniform(box.lo.z, box.hi.z)});
+      config.viewpoints = viewpoints;
+    }
+    const Subdivision fast = subdivide(scene, segs, CostModel{}, config);
+    config.clip_every_position = true;
+    const Subdivision every = subdivide(scene, segs, CostModel{}, config);
+    SCOPED_TRACE(with_viewpoints ? "with viewpoints" : "volume as the weight");
+    // The test means something only where cells that are not boxes were split along an axis.
+    size_t axis_splits_of_non_boxes = 0;
+    for (const SplitRecord& split : fast.splits) {
+      const BspNode& node = fast.nodes[split.node];
+      bool box = true;
+      for (int32_t n = split.node; fast.nodes[n].parent >= 0; n = fast.nodes[n].parent)
+        box &= fast.planes[fast.nodes[fast.nodes[n].parent].plane].is_axis_aligned();
+      axis_splits_of_non_boxes += !box && fast.planes[node.plane].is_axis_aligned();
+    }
+    EXPECT_GT(axis_splits_of_non_boxes, 10u);
+    expect_same_tree(fast, every);
+  }
+}
+
 // Splits go in rounds whose children are evaluated before their order is confirmed; where a
 // child outranks a cell taken later in the round, the rest of the round is undone. The tree,
 // and what was evaluated for it, must be the serial loop's (a round of one cell) for any

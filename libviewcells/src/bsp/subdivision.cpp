@@ -523,6 +523,8 @@ class Builder {
   /// Nodes of at least this many parts evaluate their axes (and sort their positions) in
   /// parallel; smaller ones in one thread, their siblings beside them. The same results.
   static constexpr size_t kParallelParts = 1 << 13;
+  /// best_axis_candidate in a cell that is not a box: one clip of the cell every kStride positions.
+  static constexpr size_t kStride = 16;
 
   Builder(const Scene& scene, const SegmentSet& segs, const CostModel& model, const SubdivisionConfig& config,
           Subdivision& out)
@@ -1323,25 +1325,73 @@ class Builder {
       uint64_t below = 0;
       for (size_t j = 0; j < k; ++j) points_below[j] = static_cast<double>(below += first_at[j]) * point_weight_;
     }
+    auto volume_below = [&](size_t j) {
+      return box ? volume * (positions[j] - lo_b) / (hi_b - lo_b)
+                 : cell.volume_below(Plane::axis_aligned(axis, positions[j]));
+    };
+    auto reduction_at = [&](size_t j, double wl) {
+      const double wr = weight - wl;
+      return own - (wl * left[j] + wr * right[j]) / total_weight_;
+    };
+    // The first position of the highest reduction among those that leave no sliver. In a cell
+    // that is not a box each volume below is a clip of the cell (a map's cells below a
+    // geometry-aligned split: hundreds of thousands of clips), so it is computed only where
+    // it can change the choice:
+    // - with viewpoints, the reduction does not depend on it: only for a position that would
+    //   become the best, to check that it leaves no sliver;
+    // - with the volume as the weight, the reduction is linear in it and the volume below grows
+    //   with the position: the volumes at every kStride-th position (anchors) bound those
+    //   between, and a position whose bound stays below the best anchor's reduction (by more
+    //   than rounding) cannot be the best.
+    // The same choice as clipping at every position.
     bool found = false;
     size_t best_j = 0;
     double best_reduction = 0;
-    for (size_t j = 0; j < k; ++j) {
-      const double vl = box ? volume * (positions[j] - lo_b) / (hi_b - lo_b)
-                            : cell.volume_below(Plane::axis_aligned(axis, positions[j]));
-      if (!(vl > kMinPart * volume && volume - vl > kMinPart * volume)) continue;
-      // Without a density the weight below is the volume below, just computed (weight_below
-      // would clip the cell again for the same number).
-      const double wl = points_            ? points_below[j]
-                        : box              ? box_weight_below(positions[j])
-                        : density.enabled ? density.weight_below(cell, part, Plane::axis_aligned(axis, positions[j]))
-                                          : vl;
-      const double wr = weight - wl;
-      const double reduction = own - (wl * left[j] + wr * right[j]) / total_weight_;
+    auto consider = [&](size_t j, double vl, double wl) {
+      if (!(vl > kMinPart * volume && volume - vl > kMinPart * volume)) return;
+      const double reduction = reduction_at(j, wl);
       if (!found || reduction > best_reduction) {
         found = true;
         best_j = j;
         best_reduction = reduction;
+      }
+    };
+    if (!box && points_ && !config_.clip_every_position) {
+      for (size_t j = 0; j < k; ++j)
+        if (!found || reduction_at(j, points_below[j]) > best_reduction) consider(j, volume_below(j), points_below[j]);
+    } else if (!box && !density.enabled && k > 2 * kStride && !config_.clip_every_position) {
+      std::vector<double> anchor_vl;  // at positions 0, kStride, 2 kStride, ... and k - 1
+      double best_anchor = -INFINITY;
+      for (size_t j = 0;; j = std::min(j + kStride, k - 1)) {
+        const double vl = volume_below(j);
+        anchor_vl.push_back(vl);
+        if (vl > kMinPart * volume && volume - vl > kMinPart * volume)
+          best_anchor = std::max(best_anchor, reduction_at(j, vl));
+        if (j == k - 1) break;
+      }
+      const double margin = 1e-9 * std::abs(own) + 1e-300, slack = 1e-6 * volume;
+      for (size_t j = 0; j < k; ++j) {
+        const size_t a = j / kStride;
+        if (j % kStride == 0 || j == k - 1) {
+          const double vl = anchor_vl[j == k - 1 ? anchor_vl.size() - 1 : a];
+          consider(j, vl, vl);
+          continue;
+        }
+        const double lo = anchor_vl[a] - slack, hi = anchor_vl[a + 1] + slack;
+        if (std::max(reduction_at(j, lo), reduction_at(j, hi)) < best_anchor - margin) continue;
+        const double vl = volume_below(j);
+        consider(j, vl, vl);
+      }
+    } else {
+      for (size_t j = 0; j < k; ++j) {
+        const double vl = volume_below(j);
+        // Without a density the weight below is the volume below, just computed (weight_below
+        // would clip the cell again for the same number).
+        consider(j, vl,
+                 points_           ? points_below[j]
+                 : box             ? box_weight_below(positions[j])
+                 : density.enabled ? density.weight_below(cell, part, Plane::axis_aligned(axis, positions[j]))
+                                   : vl);
       }
     }
     __atomic_add_fetch(&ev.axis, k, __ATOMIC_RELAXED);

@@ -79,6 +79,10 @@ struct SubdivisionConfig {
   /// (or 2 x as many parts read), so coordinates where many segments end (walls) are likelier:
   /// O(k log k). Either way every chosen position is evaluated exactly.
   bool exact_candidates = false;
+  /// In a cell that is not a box, an axis position's volume below is a clip of the cell; the
+  /// builder clips only where the volume can change the choice. True: at every position, for
+  /// tests that check it is the same choice.
+  bool clip_every_position = false;
   GeometryAlignedMode geometry_aligned = GeometryAlignedMode::kAuto;
   uint32_t ga_candidates = 150;       ///< geometry-aligned planes per node at most (paper: 150)
   /// kAuto enables geometry-aligned candidates when at least this share of the surface area
