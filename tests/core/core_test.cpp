@@ -10,7 +10,7 @@
 namespace viewcells {
 namespace {
 
-TEST(Error, CarriesFileAndLine) {
+TEST(ErrorMessage, CarriesFileAndLine) {
   const Error e("scene.obj", 12, "bad vertex");
   EXPECT_STREQ(e.what(), "scene.obj:12: bad vertex");
   EXPECT_EQ(e.file(), "scene.obj");

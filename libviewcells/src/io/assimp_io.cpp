@@ -105,7 +105,9 @@ class Builder {
       std::string object = node_name;
       if (mode_ == AssimpObjects::kMeshes) {
         const std::string mesh_name = mesh->mName.length ? mesh->mName.C_Str() : "mesh" + std::to_string(mi);
-        object += "/" + mesh_name + (node->mNumMeshes > 1 ? "#" + std::to_string(i) : "");
+        object += '/';
+        object += mesh_name;
+        if (node->mNumMeshes > 1) object += '#' + std::to_string(i);
       } else if (see_through) {
         object += " (see-through)";  // a node's opaque and see-through meshes are two objects
       }
