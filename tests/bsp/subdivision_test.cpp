@@ -891,6 +891,12 @@ TEST(Subdivision, BadInput) {
   segs.view_box = {{0, 0, 0}, {1, 1, 1}};
   segs.push_back({0, 0, 0}, {1, 1, 1}, 99, kNoObject, 0, kNoObject);
   EXPECT_THROW(build(scene, segs, 10), Error);
+  // A triangle the scene does not have (geometry-aligned candidates read its plane).
+  SegmentSet bad_triangle;
+  bad_triangle.view_box = segs.view_box;
+  bad_triangle.push_back({0, 0, 0}, {1, 1, 1}, 0, kNoObject, static_cast<uint32_t>(scene.triangles.size()), kNoObject);
+  for (GeometryAlignedMode ga : {GeometryAlignedMode::kOff, GeometryAlignedMode::kOn})
+    EXPECT_THROW(build(scene, bad_triangle, 10, ga), Error);
   EXPECT_THROW(per_object_costs(scene, CostModel{100, -1, 0}), Error);
   EXPECT_THROW(per_object_costs(scene, CostModel{NAN, 1, 0}), Error);
   CostModel bad_screen{100, 1, 0.5};

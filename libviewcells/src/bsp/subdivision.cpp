@@ -1664,6 +1664,12 @@ Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const Cost
       if (o != kNoObject && o >= scene.objects.size())
         throw Error("segment " + std::to_string(i) + " names object " + std::to_string(o) +
                     ", but the scene has " + std::to_string(scene.objects.size()) + " (segments of another scene?)");
+  // The triangles hit (geometry-aligned candidates are their planes), where the set has them.
+  for (const auto* triangles : {&segments.triangle_a, &segments.triangle_b})
+    for (size_t i = 0; i < triangles->size(); ++i)
+      if ((*triangles)[i] != kNoObject && (*triangles)[i] >= scene.triangles.size())
+        throw Error("segment " + std::to_string(i) + " names triangle " + std::to_string((*triangles)[i]) +
+                    ", but the scene has " + std::to_string(scene.triangles.size()) + " (segments of another scene?)");
   Subdivision out;
   Builder(scene, segments, model, config, out).run();
   return out;
