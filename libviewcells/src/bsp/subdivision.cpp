@@ -870,14 +870,13 @@ class Builder {
           const double cut = bsp_detail::cut_parameter(t0, t1, d0, d1);
           const uint32_t q = static_cast<uint32_t>(cut * 0x1p31);  // exact: cut is on the grid
           cuts[c].push_back(q);
+          const int first = s0 < 0 ? 0 : 1;  // the child of the part before the cut
           if (ga_) {
-            const int first = s0 < 0 ? 0 : 1;
             hits[first] |= hits_plane_source({s.id, s.q0, q}, e);
             hits[1 - first] |= hits_plane_source({s.id, q, s.q1}, e);
           }
           if (extents) {
             const Vec3 mid = e.at(cut);
-            const int first = s0 < 0 ? 0 : 1;
             slots[first].add_part(p0, mid, e.object_a, e.object_b, chunk_ext[first][c]);
             slots[1 - first].add_part(mid, p1, e.object_a, e.object_b, chunk_ext[1 - first][c]);
           }
@@ -1659,17 +1658,18 @@ Subdivision subdivide(const Scene& scene, const SegmentSet& segments, const Cost
     throw Error("viewpoint density band needs lo < hi and a finite, non-negative outside weight");
   if (config.viewpoints && config.density.enabled)
     throw Error("the viewpoint density is either a height band or points, not both");
-  for (size_t i = 0; i < segments.size(); ++i)
+  // The objects seen and the triangles hit (geometry-aligned candidates are their planes; a set
+  // built by hand may carry no triangles), in one pass.
+  auto refuse = [&](size_t i, const char* what, uint32_t id, size_t count) {
+    throw Error("segment " + std::to_string(i) + " names " + what + " " + std::to_string(id) + ", but the scene has " +
+                std::to_string(count) + " (segments of another scene?)");
+  };
+  for (size_t i = 0; i < segments.size(); ++i) {
     for (uint32_t o : {segments.object_a[i], segments.object_b[i]})
-      if (o != kNoObject && o >= scene.objects.size())
-        throw Error("segment " + std::to_string(i) + " names object " + std::to_string(o) +
-                    ", but the scene has " + std::to_string(scene.objects.size()) + " (segments of another scene?)");
-  // The triangles hit (geometry-aligned candidates are their planes), where the set has them.
-  for (const auto* triangles : {&segments.triangle_a, &segments.triangle_b})
-    for (size_t i = 0; i < triangles->size(); ++i)
-      if ((*triangles)[i] != kNoObject && (*triangles)[i] >= scene.triangles.size())
-        throw Error("segment " + std::to_string(i) + " names triangle " + std::to_string((*triangles)[i]) +
-                    ", but the scene has " + std::to_string(scene.triangles.size()) + " (segments of another scene?)");
+      if (o != kNoObject && o >= scene.objects.size()) refuse(i, "object", o, scene.objects.size());
+    for (uint32_t t : {triangle_of(segments.triangle_a, i), triangle_of(segments.triangle_b, i)})
+      if (t != kNoObject && t >= scene.triangles.size()) refuse(i, "triangle", t, scene.triangles.size());
+  }
   Subdivision out;
   Builder(scene, segments, model, config, out).run();
   return out;
