@@ -71,6 +71,37 @@ TEST(Evaluate, ConstructionSamplesReproduceTheMergeHistorysCosts) {
   for (uint32_t cells = 1; cells <= 80; ++cells) EXPECT_NEAR(c.at(cells), h.cost_with(cells), 1e-9 * h.initial_cost) << cells;
 }
 
+TEST(Evaluate, WholeObjectCostsAreSummedExactly) {
+  // Whole costs whose total is below 2^53 sum to the same double in any order; anything else
+  // keeps the floating-point sum in order.
+  EXPECT_TRUE(whole_and_small({100, 250, 3, 0}));
+  EXPECT_FALSE(whole_and_small({100, 100.5}));
+  EXPECT_FALSE(whole_and_small({-1}));
+  EXPECT_FALSE(whole_and_small({0x1p32}));
+  EXPECT_FALSE(whole_and_small({NAN}));
+  EXPECT_FALSE(whole_and_small(std::vector<double>((size_t{1} << 21) + 1, 0x1p32 - 1))) << "total 2^53 or more";
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 1});
+  const std::vector<double> base = per_object_costs(scene, CostModel{});
+  ASSERT_TRUE(whole_and_small(base));
+  std::vector<uint32_t> all(scene.objects.size());
+  for (uint32_t o = 0; o < all.size(); ++o) all[o] = o;
+  EXPECT_EQ(whole_pvs_cost(base, all), pvs_cost(scene, base, CostModel{}, all, Box3{}));
+  // The evaluator on both paths: whole costs (the default model), and costs with halves.
+  const SegmentSet segs = sample(scene, 20000, 1);
+  const Subdivision s = build(scene, segs, "av-s", 40);
+  for (const double a : {100.0, 100.5}) {
+    CostModel model;
+    model.a = a;
+    ASSERT_EQ(whole_and_small(per_object_costs(scene, model)), a == 100.0);
+    MergeConfig mc;
+    mc.show_progress = false;
+    const MergeHistory h = merge_cells(scene, partition_from_subdivision(s, leaf_pvs(s, segs)), model, mc);
+    const CostCurve c = evaluate_merge_history(scene, s, h, evaluation_pvs(s, segs), model);
+    for (uint32_t cells = 1; cells <= 40; ++cells)
+      EXPECT_NEAR(c.at(cells), h.cost_with(cells), 1e-12 * h.initial_cost) << a << " " << cells;
+  }
+}
+
 TEST(Evaluate, CostOfAFixedPartitionConvergesWithMoreEvaluationSamples) {
   const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 2});
   const Subdivision s = build(scene, sample(scene, 20000, 1), "av-s", 16);

@@ -510,7 +510,9 @@ TEST(Merge, RefinedBlocksCostLessStayConnectedAndKeepUnitsWhole) {
     EXPECT_LT(st.passes, 50u) << "passes end when no unit moves";
     EXPECT_NEAR(st.cost_before, blocks_cost(f, block), 1e-9 * st.cost_before);
     EXPECT_NEAR(st.cost_after, blocks_cost(f, refined), 1e-9 * st.cost_after);
-    if (st.moves) EXPECT_LT(st.cost_after, st.cost_before);
+    if (st.moves) {
+      EXPECT_LT(st.cost_after, st.cost_before);
+    }
     EXPECT_TRUE(blocks_connected(f, block));
     EXPECT_TRUE(blocks_connected(f, refined));
     EXPECT_EQ(std::set<int32_t>(refined.begin(), refined.end()), std::set<int32_t>(block.begin(), block.end()))

@@ -82,6 +82,15 @@ double pvs_cost(const Scene& scene, const std::vector<double>& base, const CostM
   return c;
 }
 
+bool whole_and_small(const std::vector<double>& costs) {
+  double total = 0;
+  for (double x : costs) {
+    if (!(x >= 0) || x != std::floor(x) || x >= 0x1p32) return false;
+    total += x;
+  }
+  return total < 0x1p53;
+}
+
 namespace {
 
 template <class Id>

@@ -54,6 +54,7 @@ std::vector<double> evaluated_bsp_costs(const Scene& scene, const Subdivision& s
                                    const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
   if (leaf_pvs.size() != s.nodes.size()) throw Error("evaluation PVSs do not match the subdivision");
   const std::vector<double> base = per_object_costs(scene, model);
+  const bool whole = !model.pixel_term() && whole_and_small(base);
   const size_t n = s.nodes.size();
   std::vector<std::vector<uint32_t>> pvs(n);
   std::vector<Box3> bounds(n);
@@ -73,7 +74,7 @@ std::vector<double> evaluated_bsp_costs(const Scene& scene, const Subdivision& s
       pvs[node.child[0]] = {};
       pvs[node.child[1]] = {};
     }
-    r[i] = pvs_cost(scene, base, model, pvs[i], bounds[i]);
+    r[i] = whole ? whole_pvs_cost(base, pvs[i]) : pvs_cost(scene, base, model, pvs[i], bounds[i]);
   }
   return r;
 }
@@ -84,6 +85,7 @@ std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision&
   if (leaves.size() != h.leaf_count || leaf_pvs.size() != s.nodes.size())
     throw Error("the merge history does not match the subdivision");
   const std::vector<double> base = per_object_costs(scene, model);
+  const bool whole = !model.pixel_term() && whole_and_small(base);
   std::vector<std::vector<uint32_t>> pvs(h.nodes.size());
   std::vector<double> r(h.nodes.size(), 0.0);
   for (size_t i = 0; i < h.nodes.size(); ++i) {
@@ -95,7 +97,7 @@ std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision&
       pvs[m.child[0]] = {};
       pvs[m.child[1]] = {};
     }
-    r[i] = pvs_cost(scene, base, model, pvs[i], m.bounds);
+    r[i] = whole ? whole_pvs_cost(base, pvs[i]) : pvs_cost(scene, base, model, pvs[i], m.bounds);
   }
   return r;
 }

@@ -481,6 +481,7 @@ class Merger {
     if constexpr (kWide) {
       return viewcells::pvs_cost(scene_, r_, model_, pvs, bounds);
     } else {
+      if (whole_costs_) return whole_pvs_cost(r_, pvs);
       double c = 0;
       for (Id o : pvs) c += r_[o];
       return c;
@@ -550,15 +551,6 @@ class Merger {
     double sum = 0;
     for (uint32_t o : list) sum += m[o];
     return sum;
-  }
-
-  static bool whole_and_small(const std::vector<double>& r) {
-    double total = 0;
-    for (double x : r) {
-      if (!(x >= 0) || x != std::floor(x) || x >= 0x1p32) return false;
-      total += x;
-    }
-    return total < 0x1p53;
   }
 
   void set_marks(Marks& marks, int32_t cell, bool on) const {

@@ -62,6 +62,21 @@ double cell_object_cost(const ObjectInfo& object, double base, const std::vector
 double pvs_cost(const Scene& scene, const std::vector<double>& base, const CostModel& model,
                 const std::vector<uint32_t>& pvs, const Box3& bounds);
 
+/// True when every cost is a whole number in [0, 2^32) and all of them sum below 2^53 (the
+/// default model's max(100, triangles) on any real scene): then every sum of them is exact in
+/// a double, whatever the order of the additions.
+bool whole_and_small(const std::vector<double>& costs);
+
+/// pvs_cost without the pixel term, for whole_and_small costs: the sum in whole numbers, which
+/// is the same value as the sum in order (both are exact) without a chain of dependent
+/// floating-point adds (the validated merge sums tens of thousands of lists per candidate).
+template <class Id>
+double whole_pvs_cost(const std::vector<double>& base, const std::vector<Id>& pvs) {
+  uint64_t c = 0;
+  for (Id o : pvs) c += static_cast<uint64_t>(base[o]);
+  return static_cast<double>(c);
+}
+
 /// The union of two sorted id lists, sorted.
 std::vector<uint32_t> unite_sorted(const std::vector<uint32_t>& a, const std::vector<uint32_t>& b);
 std::vector<uint16_t> unite_sorted(const std::vector<uint16_t>& a, const std::vector<uint16_t>& b);

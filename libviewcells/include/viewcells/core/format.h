@@ -16,8 +16,13 @@ inline std::string fmt(double v, int precision = 3) {
 }
 
 inline std::string describe_box(const Box3& b) {
-  return "[" + fmt(b.lo.x) + ", " + fmt(b.lo.y) + ", " + fmt(b.lo.z) + "] - [" + fmt(b.hi.x) + ", " +
-         fmt(b.hi.y) + ", " + fmt(b.hi.z) + "]";
+  // By appends: gcc 12 warns (-Wrestrict, a false alarm) on "literal" + a temporary string.
+  std::string s = "[";
+  s += fmt(b.lo.x) + ", " + fmt(b.lo.y) + ", " + fmt(b.lo.z);
+  s += "] - [";
+  s += fmt(b.hi.x) + ", " + fmt(b.hi.y) + ", " + fmt(b.hi.z);
+  s += "]";
+  return s;
 }
 
 }  // namespace viewcells
