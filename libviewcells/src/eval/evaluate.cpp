@@ -100,12 +100,9 @@ std::vector<double> evaluated_merge_costs_by_bits(const MergeHistory& h, const s
     if (m.child[0] < 0) {
       slot[i] = static_cast<uint32_t>(i);  // the leaves' slots, in order
       uint64_t* b = &bits[i * words];
-      uint64_t c = 0;
-      for (uint32_t o : leaf_pvs[leaves[i]]) {
-        b[o >> 6] |= uint64_t{1} << (o & 63);
-        c += whole[o];
-      }
-      r[i] = static_cast<double>(c);
+      const std::vector<uint32_t>& list = leaf_pvs[leaves[i]];
+      for (uint32_t o : list) b[o >> 6] |= uint64_t{1} << (o & 63);
+      r[i] = whole_pvs_cost(base, list);
       continue;
     }
     uint64_t* x = &bits[static_cast<size_t>(slot[m.child[0]]) * words];
