@@ -413,6 +413,34 @@ TEST(Sampler, SegmentTargetIsAPrefixOfTheSampleStream) {
   }
 }
 
+/// Chunks of one stream, each drawn with its own first batch, are the whole stream: the
+/// evaluator draws millions of samples that way without holding them all.
+TEST(Sampler, ChunksOfAStreamAreTheStream) {
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 2});
+  const auto caster = make_embree_caster(scene);
+  SamplerConfig config;
+  config.show_progress = false;
+  config.samples = 20000;  // not a multiple of the batch size: the last chunk's batch is short
+  config.seed = 4;
+  const SamplingResult all = sample_segments(scene, *caster, config);
+  SegmentSet joined;
+  joined.view_box = all.segments.view_box;
+  size_t chunks = 0;
+  const SamplingStats stats = sample_in_chunks(scene, *caster, config, 3000, [&](const SegmentSet& chunk) {
+    EXPECT_EQ(chunk.view_box, joined.view_box);
+    joined.append(chunk);
+    ++chunks;
+  });
+  EXPECT_EQ(chunks, 10u) << "3000 rounds down to two batches of 1024: 20000 samples in ten chunks";
+  EXPECT_TRUE(joined == all.segments) << joined.size() << " segments against " << all.segments.size();
+  EXPECT_EQ(stats.samples, all.stats.samples);
+  EXPECT_EQ(stats.rays, all.stats.rays);
+  EXPECT_EQ(stats.valid_segments, all.stats.valid_segments);
+  EXPECT_EQ(stats.segments_per_object, all.stats.segments_per_object);
+  config.target_segments = 100;
+  EXPECT_THROW(sample_in_chunks(scene, *caster, config, 3000, [](const SegmentSet&) {}), Error);
+}
+
 TEST(Sampler, BadInput) {
   const Scene scene = test::cube_grid(2);
   EXPECT_THROW(sample(scene, 10, 1, EmptySpaceMode::kAuto, Box3{{0, 0, 0}, {1, 1, 0}}), Error);

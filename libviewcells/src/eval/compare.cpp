@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <set>
 
 #include "viewcells/cells/hierarchy_file.h"
@@ -39,24 +40,20 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
   check_methods(config.methods);  // unknown names fail before any work
   if (config.construction.seed == config.evaluation.seed)
     throw Error("evaluation samples need their own seed (it equals the construction seed)");
+  if (config.evaluation_sets < 1) throw Error("at least one evaluation set is needed");
+  for (uint32_t k = 1; k < config.evaluation_sets; ++k)
+    if (config.evaluation.seed + k == config.construction.seed)
+      throw Error("an evaluation set's seed equals the construction seed");
   Comparison out;
   SamplingResult built = sample_segments(scene, caster, config.construction);
   out.construction = built.stats;
-  if (config.evaluation_sets < 1) throw Error("at least one evaluation set is needed");
-  SamplingResult eval = sample_segments(scene, caster, config.evaluation);
-  out.evaluation = eval.stats;
-  std::vector<SegmentSet> more;  // evaluation sets 1, 2, ...
-  for (uint32_t k = 1; k < config.evaluation_sets; ++k) {
-    SamplerConfig e = config.evaluation;
-    e.seed += k;
-    if (e.seed == config.construction.seed) throw Error("an evaluation set's seed equals the construction seed");
-    SamplingResult m = sample_segments(scene, caster, e);
-    out.evaluation.seconds += m.stats.seconds;  // the sampling of every set
-    more.push_back(std::move(m.segments));
-  }
   const uint32_t hist_cells = config.histogram_cells ? config.histogram_cells : config.max_cells;
 
-  std::optional<Subdivision> av_s;  // shared by av-s and av-m
+  // Every method built first; then the evaluation samples, drawn chunk by chunk, each chunk
+  // walked down every distinct tree and dropped (only the leaves' object lists grow), so the
+  // evaluation's memory does not grow with its sample count.
+  std::vector<std::unique_ptr<Subdivision>> trees;  // distinct subdivisions (av-s, av-m share one)
+  int av_s_tree = -1;
   double av_s_seconds = 0;
   auto build = [&](const std::string& method) {
     SubdivisionConfig sc = config.subdivision;
@@ -65,81 +62,106 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
     sc.strategy = parse_split_strategy(method == "av-s-exact" ? "av-s" : method);
     sc.show_progress = config.show_progress;
     const auto t = std::chrono::steady_clock::now();
-    Subdivision s = subdivide(scene, built.segments, config.model, sc);
-    if (config.prepare) config.prepare(s);
-    return std::make_pair(std::move(s), seconds_since(t));
+    auto s = std::make_unique<Subdivision>(subdivide(scene, built.segments, config.model, sc));
+    if (config.prepare) config.prepare(*s);
+    trees.push_back(std::move(s));
+    return seconds_since(t);
   };
+  std::vector<int> tree_of;                         // per method
+  std::vector<std::optional<MergeHistory>> merged;  // per method: AV-M's history
   for (const std::string& method : config.methods) {
     MethodResult r;
     r.method = method;
-    const bool merged = method == "av-m" || method == "av-m-samples";
-    Subdivision local;
-    const Subdivision* s = nullptr;
-    if (merged || method == "av-s") {
-      if (!av_s) {
-        auto [sub, secs] = build("av-s");
-        av_s = std::move(sub);
-        av_s_seconds = secs;
+    const bool merges = method == "av-m" || method == "av-m-samples";
+    if (merges || method == "av-s") {
+      if (av_s_tree < 0) {
+        av_s_seconds = build("av-s");
+        av_s_tree = static_cast<int>(trees.size()) - 1;
       }
-      s = &*av_s;
+      tree_of.push_back(av_s_tree);
       r.build_seconds = av_s_seconds;
     } else {
-      auto [sub, secs] = build(method);
-      local = std::move(sub);
-      s = &local;
-      r.build_seconds = secs;
+      r.build_seconds = build(method);
+      tree_of.push_back(static_cast<int>(trees.size()) - 1);
     }
-    r.stop_reason = s->stats.stop_reason;
-    r.geometry_aligned = s->stats.geometry_aligned_reason;
-    r.axis_candidates = s->stats.axis_candidates;
-    r.geometry_candidates = s->stats.geometry_candidates;
-    const auto t = std::chrono::steady_clock::now();
-    const std::vector<std::vector<uint32_t>> pvs = evaluation_pvs(*s, eval.segments);
-    if (merged) {
+    const Subdivision& s = *trees[static_cast<size_t>(tree_of.back())];
+    r.stop_reason = s.stats.stop_reason;
+    r.geometry_aligned = s.stats.geometry_aligned_reason;
+    r.axis_candidates = s.stats.axis_candidates;
+    r.geometry_candidates = s.stats.geometry_candidates;
+    merged.emplace_back();
+    if (merges) {
       MergeConfig mc;
       mc.show_progress = config.show_progress;
-      LeafMerge lm = merge_leaves(scene, caster, *s, built.segments,
+      LeafMerge lm = merge_leaves(scene, caster, s, built.segments,
                                   held_out_sampling(config.construction, built.stats.samples), config.model,
                                   method == "av-m" ? config.merge_agvs : std::nullopt, mc);
-      MergeHistory h = std::move(lm.history);
       r.merge = std::move(lm.summary);
-      const double merge_seconds = r.merge.leaf_pvs_seconds + r.merge.neighbour_seconds + r.merge.merge_seconds;
-      r.build_seconds += merge_seconds;
-      out.evaluation_seconds -= merge_seconds;  // counted below with the evaluation otherwise
-      const std::vector<double> node_cost = evaluated_merge_costs(scene, *s, h, pvs, config.model);
-      r.evaluated = merge_history_curve(h, node_cost);
-      for (const SegmentSet& e : more)
-        r.evaluated_more.push_back(
-            merge_history_curve(h, evaluated_merge_costs(scene, *s, h, evaluation_pvs(*s, e), config.model)));
+      r.build_seconds += r.merge.leaf_pvs_seconds + r.merge.neighbour_seconds + r.merge.merge_seconds;
+      const MergeHistory& h = merged.back().emplace(std::move(lm.history));
       for (size_t cells = h.min_cells(); cells <= h.leaf_count; ++cells) {
         r.constructed.cells.push_back(static_cast<uint32_t>(cells));
         r.constructed.cost.push_back(h.cost_with(cells));
       }
       r.leaves = h.leaf_count;
-      if (hist_cells >= h.min_cells() && hist_cells <= h.leaf_count)
-        r.cells = merged_cells_at(h, node_cost, hist_cells);
-      if (config.keep_models && method == "av-m") out.av_m = std::move(h);
     } else {
-      const std::vector<double> node_cost = evaluated_bsp_costs(scene, *s, pvs, config.model);
-      r.evaluated = subdivision_curve(*s, node_cost);
-      for (const SegmentSet& e : more)
-        r.evaluated_more.push_back(subdivision_curve(*s, evaluated_bsp_costs(scene, *s, evaluation_pvs(*s, e), config.model)));
       r.constructed.cells.push_back(1);
-      r.constructed.cost.push_back(s->initial_cost);
-      for (size_t k = 0; k < s->splits.size(); ++k) {
+      r.constructed.cost.push_back(s.initial_cost);
+      for (size_t k = 0; k < s.splits.size(); ++k) {
         r.constructed.cells.push_back(static_cast<uint32_t>(k + 2));
-        r.constructed.cost.push_back(s->splits[k].cost_after);
+        r.constructed.cost.push_back(s.splits[k].cost_after);
       }
-      r.leaves = static_cast<uint32_t>(s->leaf_count());
-      if (hist_cells <= s->leaf_count()) r.cells = subdivision_cells_at(*s, node_cost, hist_cells);
+      r.leaves = static_cast<uint32_t>(s.leaf_count());
+    }
+    out.methods.push_back(std::move(r));
+  }
+
+  using Lists = std::vector<std::vector<uint32_t>>;
+  for (uint32_t k = 0; k < config.evaluation_sets; ++k) {
+    SamplerConfig e = config.evaluation;
+    e.seed += k;
+    e.show_progress = config.show_progress;
+    std::vector<Lists> pvs;  // per distinct tree: its leaves' evaluation PVSs so far
+    for (const auto& t : trees) pvs.emplace_back(t->nodes.size());
+    const bool keep = config.keep_models && k == 0;
+    const SamplingStats stats = sample_in_chunks(scene, caster, e, config.evaluation_chunk, [&](const SegmentSet& chunk) {
+      const auto t = std::chrono::steady_clock::now();
+      for (size_t i = 0; i < trees.size(); ++i) unite_into(pvs[i], evaluation_pvs(*trees[i], chunk));
+      if (keep) {
+        out.evaluation_segments.view_box = chunk.view_box;
+        out.evaluation_segments.append(chunk);
+      }
+      out.evaluation_seconds += seconds_since(t);
+    });
+    if (k == 0) {
+      out.evaluation = stats;
+    } else {
+      out.evaluation.seconds += stats.seconds;  // the sampling of every set
+    }
+    const auto t = std::chrono::steady_clock::now();
+    for (size_t m = 0; m < out.methods.size(); ++m) {
+      MethodResult& r = out.methods[m];
+      const Subdivision& s = *trees[static_cast<size_t>(tree_of[m])];
+      const Lists& leaf_pvs = pvs[static_cast<size_t>(tree_of[m])];
+      if (merged[m]) {
+        const MergeHistory& h = *merged[m];
+        const std::vector<double> node_cost = evaluated_merge_costs(scene, s, h, leaf_pvs, config.model);
+        (k == 0 ? r.evaluated : r.evaluated_more.emplace_back()) = merge_history_curve(h, node_cost);
+        if (k == 0 && hist_cells >= h.min_cells() && hist_cells <= h.leaf_count)
+          r.cells = merged_cells_at(h, node_cost, hist_cells);
+      } else {
+        const std::vector<double> node_cost = evaluated_bsp_costs(scene, s, leaf_pvs, config.model);
+        (k == 0 ? r.evaluated : r.evaluated_more.emplace_back()) = subdivision_curve(s, node_cost);
+        if (k == 0 && hist_cells <= s.leaf_count()) r.cells = subdivision_cells_at(s, node_cost, hist_cells);
+      }
     }
     out.evaluation_seconds += seconds_since(t);
-    out.methods.push_back(std::move(r));
   }
   if (config.keep_models) {
     out.construction_segments = std::move(built.segments);
-    out.evaluation_segments = std::move(eval.segments);
-    out.av_s = std::move(av_s);
+    if (av_s_tree >= 0) out.av_s = std::move(*trees[static_cast<size_t>(av_s_tree)]);
+    for (size_t m = 0; m < out.methods.size(); ++m)
+      if (config.methods[m] == "av-m" && merged[m]) out.av_m = std::move(*merged[m]);
   }
   return out;
 }

@@ -12,6 +12,18 @@
 
 namespace viewcells {
 
+void unite_into(std::vector<std::vector<uint32_t>>& into, const std::vector<std::vector<uint32_t>>& more) {
+  if (into.size() != more.size()) throw Error("unite_into: the lists are for different trees");
+  tbb::parallel_for(size_t{0}, into.size(), [&](size_t n) {
+    if (more[n].empty()) return;
+    if (into[n].empty()) {
+      into[n] = more[n];
+      return;
+    }
+    into[n] = unite_sorted(into[n], more[n]);
+  });
+}
+
 std::vector<std::vector<uint32_t>> evaluation_pvs(const Subdivision& s, const SegmentSet& eval) {
   if (s.nodes.empty()) throw Error("evaluation needs a subdivision");
   using Lists = std::vector<std::vector<uint32_t>>;

@@ -431,7 +431,7 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
         SegmentSet scratch;
         scratch.resize(slots);
         BatchOutput out;
-        samplers.local().run(config.seed, batch, std::min<uint64_t>(config.batch_size, limit - batch * config.batch_size),
+        samplers.local().run(config.seed, config.first_batch + batch, std::min<uint64_t>(config.batch_size, limit - batch * config.batch_size),
                              scratch, out, nullptr);
         ByteWriter w;
         w.put(out);
@@ -471,7 +471,8 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
                                                t->out = BatchOutput{};
                                                t->log.clear();
                                                if (stop.load(std::memory_order_relaxed)) return t;
-                                               samplers.local().run(config.seed, t->batch, t->count, t->segments,
+                                               samplers.local().run(config.seed, config.first_batch + t->batch,
+                                                                    t->count, t->segments,
                                                                     t->out, logs ? &t->log : nullptr);
                                                return t;
                                              }) &
@@ -498,6 +499,46 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
 
 SamplingResult sample_segments(const Scene& scene, const RayCaster& caster, const SamplerConfig& config) {
   return sample_impl(scene, caster, config, nullptr);
+}
+
+SamplingStats sample_in_chunks(const Scene& scene, const RayCaster& caster, const SamplerConfig& config,
+                               uint64_t chunk_samples, const std::function<void(const SegmentSet&)>& use) {
+  if (config.target_segments > 0) throw Error("sampling in chunks needs a sample count, not a segment target");
+  if (config.batch_size == 0) throw Error("batch size must be positive");
+  if (config.samples == 0) throw Error("nothing to sample: samples and segments are 0");
+  const uint64_t per_chunk = std::max<uint64_t>(1, chunk_samples / config.batch_size) * config.batch_size;
+  SamplingStats total;
+  Progress progress("sampling", config.samples);
+  for (uint64_t first = 0; first < config.samples; first += per_chunk) {
+    SamplerConfig c = config;
+    c.samples = std::min(per_chunk, config.samples - first);
+    c.first_batch = config.first_batch + first / config.batch_size;
+    c.show_progress = false;
+    SamplingResult r = sample_segments(scene, caster, c);
+    SamplingStats& s = r.stats;
+    if (first == 0) {
+      total = s;
+    } else {
+      total.samples += s.samples;
+      total.rays += s.rays;
+      total.recast_rays += s.recast_rays;
+      total.valid_segments += s.valid_segments;
+      total.missed_both += s.missed_both;
+      total.stuck_in_solid += s.stuck_in_solid;
+      total.outside_view_box += s.outside_view_box;
+      total.two_sided_samples += s.two_sided_samples;
+      total.rejected_origins += s.rejected_origins;
+      total.see_through_segments += s.see_through_segments;
+      total.see_through_rays += s.see_through_rays;
+      total.seconds += s.seconds;
+      for (size_t o = 0; o < total.segments_per_object.size(); ++o)
+        total.segments_per_object[o] += s.segments_per_object[o];
+    }
+    use(r.segments);
+    if (config.show_progress) progress.advance(c.samples);
+  }
+  if (config.show_progress) progress.finish();
+  return total;
 }
 
 struct SegmentCaster::Impl {

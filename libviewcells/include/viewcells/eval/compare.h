@@ -37,6 +37,10 @@ struct CompareConfig {
   /// (eval/validated_merge.h). Unset: AV-M is greedy merging of the leaves on the construction
   /// samples' PVSs alone, which av-m-samples always is.
   std::optional<AgvsConfig> merge_agvs;
+  /// Samples of an evaluation set drawn at a time: each chunk is walked down every tree and
+  /// dropped, so the evaluation's memory is about one chunk's plus the leaves' object lists,
+  /// whatever the sample count. The result does not depend on it.
+  uint64_t evaluation_chunk = 1'000'000;
   /// Keep the segments, the AV-S subdivision and the AV-M merge history in the Comparison.
   bool keep_models = false;
 };

@@ -18,6 +18,10 @@ namespace viewcells {
 /// that have length in the leaf. Parallel; the result does not depend on the thread count.
 std::vector<std::vector<uint32_t>> evaluation_pvs(const Subdivision& s, const SegmentSet& eval);
 
+/// Per node, `into[n]` becomes the union of itself and `more[n]` (sorted lists, as
+/// evaluation_pvs gives): the evaluation PVSs of two sets of segments from those of each.
+void unite_into(std::vector<std::vector<uint32_t>>& into, const std::vector<std::vector<uint32_t>>& more);
+
 /// c(S) against the number of cells.
 struct CostCurve {
   std::vector<uint32_t> cells;  ///< increasing

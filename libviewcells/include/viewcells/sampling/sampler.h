@@ -39,6 +39,10 @@ struct SamplerConfig {
   EmptySpaceMode empty_space = EmptySpaceMode::kAuto;
   int max_recasts = 8;        ///< re-casts per sample before it is dropped as stuck in solids
   uint32_t batch_size = 1024; ///< samples per random stream: fixes the output, not the threads
+  /// The stream's first batch: batch k of this config is batch first_batch + k of the stream
+  /// (each batch has its own random stream), so consecutive chunks of a stream, each sampled
+  /// with its own first_batch, give the segments the whole stream gives (sample_in_chunks).
+  uint64_t first_batch = 0;
   bool show_progress = true;  ///< progress bar on stderr (only when it is a terminal)
 };
 
@@ -81,6 +85,14 @@ struct SamplingResult {
 /// Draws config.samples samples (or until config.target_segments segments exist). Throws
 /// Error for an empty scene, a view box of zero volume, or a segment target out of reach.
 SamplingResult sample_segments(const Scene& scene, const RayCaster& caster, const SamplerConfig& config);
+
+/// Draws config.samples samples (no segment target) in consecutive chunks of about
+/// `chunk_samples` (a multiple of the batch size), and hands each chunk's segments to `use`
+/// before the next is drawn: the chunks together are the segments sample_segments(scene, caster,
+/// config) gives, in order, but at most one chunk is held at a time. Returns the statistics of
+/// the whole stream (times summed; segments_per_object and the rest as sample_segments gives).
+SamplingStats sample_in_chunks(const Scene& scene, const RayCaster& caster, const SamplerConfig& config,
+                               uint64_t chunk_samples, const std::function<void(const SegmentSet&)>& use);
 
 /// Casts samples whose origins and directions the caller chooses (AGVS's distributions) by the
 /// sampler's rule: forward and backward rays, empty view space detection, see-through
