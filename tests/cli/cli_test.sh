@@ -365,6 +365,11 @@ assert rows and all(r['cost'] == one[(r['method'], r['cells'])] for r in rows)
 assert all(float(r['cost_2']) > 0 for r in rows)
 assert any(r['cost_2'] != r['cost'] for r in rows if int(r['cells']) > 1), 'the second set is not independent'
 assert json.load(open('cmp3/summary.json'))['settings']['evaluation_sets'] == 2
+# Set 1 scored on its first half too: sampled PVSs only grow, so no cost falls with the rest.
+assert all(float(r['cost']) >= float(r['cost_half']) > 0 for r in rows)
+assert any(float(r['cost']) > float(r['cost_half']) for r in rows), 'the second half added nothing anywhere'
+rise = {m['method']: m['evaluator_second_half_rise'] for m in json.load(open('cmp3/summary.json'))['methods']}
+assert set(rise) == {'av-s', 'kd-casm'} and all(r['first_half_samples'] == 40960 and r['largest'] >= 0 for r in rise.values()), rise
 " && ok || bad "compare with two evaluation sets"
 expect_error "--eval-sets" "$VC" compare office.obj --samples 1000 --eval-sets 0 -o cmp2
 expect_error "unknown subdivision method 'kd-foo'" "$VC" compare office.obj --samples 1000 --methods av-m,kd-foo -o cmp2

@@ -426,11 +426,13 @@ TEST(Sampler, ChunksOfAStreamAreTheStream) {
   SegmentSet joined;
   joined.view_box = all.segments.view_box;
   size_t chunks = 0;
-  const SamplingStats stats = sample_in_chunks(scene, *caster, config, 3000, [&](const SegmentSet& chunk) {
-    EXPECT_EQ(chunk.view_box, joined.view_box);
-    joined.append(chunk);
-    ++chunks;
-  });
+  const SamplingStats stats =
+      sample_in_chunks(scene, *caster, config, 3000, [&](const SegmentSet& chunk, uint64_t so_far) {
+        EXPECT_EQ(chunk.view_box, joined.view_box);
+        joined.append(chunk);
+        ++chunks;
+        EXPECT_EQ(so_far, std::min<uint64_t>(20000, chunks * 2048));
+      });
   EXPECT_EQ(chunks, 10u) << "3000 rounds down to two batches of 1024: 20000 samples in ten chunks";
   EXPECT_TRUE(joined == all.segments) << joined.size() << " segments against " << all.segments.size();
   EXPECT_EQ(stats.samples, all.stats.samples);
@@ -438,7 +440,7 @@ TEST(Sampler, ChunksOfAStreamAreTheStream) {
   EXPECT_EQ(stats.valid_segments, all.stats.valid_segments);
   EXPECT_EQ(stats.segments_per_object, all.stats.segments_per_object);
   config.target_segments = 100;
-  EXPECT_THROW(sample_in_chunks(scene, *caster, config, 3000, [](const SegmentSet&) {}), Error);
+  EXPECT_THROW(sample_in_chunks(scene, *caster, config, 3000, [](const SegmentSet&, uint64_t) {}), Error);
 }
 
 TEST(Sampler, BadInput) {

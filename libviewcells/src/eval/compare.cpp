@@ -22,6 +22,19 @@ std::vector<uint32_t> report_cell_counts(uint32_t max) {
   return out;
 }
 
+HalfSampleRise half_sample_rise(const MethodResult& m, uint32_t from_cells) {
+  HalfSampleRise out;
+  const CostCurve &all = m.evaluated, &half = m.evaluated_half;
+  for (size_t i = 0, j = 0; i < all.cells.size(); ++i) {
+    const uint32_t n = all.cells[i];
+    while (j < half.cells.size() && half.cells[j] < n) ++j;
+    if (n < from_cells || j == half.cells.size() || half.cells[j] != n || !(half.cost[j] > 0)) continue;
+    const double rise = all.cost[i] / half.cost[j] - 1;
+    if (!out.cells || rise > out.rise) out = {rise, n};
+  }
+  return out;
+}
+
 namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t) {
@@ -117,43 +130,67 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
   }
 
   using Lists = std::vector<std::vector<uint32_t>>;
+  // Each method's evaluated curve from its tree's leaf PVSs (and, for set 0, its histogram).
+  auto score = [&](size_t m, const std::vector<Lists>& pvs, bool histogram) {
+    MethodResult& r = out.methods[m];
+    const Subdivision& s = *trees[static_cast<size_t>(tree_of[m])];
+    const Lists& leaf_pvs = pvs[static_cast<size_t>(tree_of[m])];
+    if (merged[m]) {
+      const MergeHistory& h = *merged[m];
+      const std::vector<double> node_cost = evaluated_merge_costs(scene, s, h, leaf_pvs, config.model);
+      if (histogram && hist_cells >= h.min_cells() && hist_cells <= h.leaf_count)
+        r.cells = merged_cells_at(h, node_cost, hist_cells);
+      return merge_history_curve(h, node_cost);
+    }
+    const std::vector<double> node_cost = evaluated_bsp_costs(scene, s, leaf_pvs, config.model);
+    if (histogram && hist_cells <= s.leaf_count()) r.cells = subdivision_cells_at(s, node_cost, hist_cells);
+    return subdivision_curve(s, node_cost);
+  };
+  // Set 0 is also scored at half its samples (rounded up to whole batches): its first half
+  // and the rest are drawn as two parts of its stream.
+  const uint64_t samples = config.evaluation.samples, batch = config.evaluation.batch_size;
+  const uint64_t half = batch ? (samples / 2 + batch - 1) / batch * batch : 0;
   for (uint32_t k = 0; k < config.evaluation_sets; ++k) {
     SamplerConfig e = config.evaluation;
     e.seed += k;
     e.show_progress = config.show_progress;
     std::vector<Lists> pvs;  // per distinct tree: its leaves' evaluation PVSs so far
     for (const auto& t : trees) pvs.emplace_back(t->nodes.size());
-    const bool keep = config.keep_models && k == 0;
-    const SamplingStats stats = sample_in_chunks(scene, caster, e, config.evaluation_chunk, [&](const SegmentSet& chunk) {
+    const bool first_set = k == 0;
+    auto use = [&](const SegmentSet& segments, uint64_t) {
       const auto t = std::chrono::steady_clock::now();
-      for (size_t i = 0; i < trees.size(); ++i) unite_into(pvs[i], evaluation_pvs(*trees[i], chunk));
-      if (keep) {
-        out.evaluation_segments.view_box = chunk.view_box;
-        out.evaluation_segments.append(chunk);
+      for (size_t i = 0; i < trees.size(); ++i) unite_into(pvs[i], evaluation_pvs(*trees[i], segments));
+      if (config.keep_models && first_set) {
+        out.evaluation_segments.view_box = segments.view_box;
+        out.evaluation_segments.append(segments);
       }
       out.evaluation_seconds += seconds_since(t);
-    });
-    if (k == 0) {
+    };
+    SamplingStats stats;
+    if (first_set && half > 0 && half < samples) {
+      SamplerConfig part = e;
+      part.samples = half;
+      stats = sample_in_chunks(scene, caster, part, config.evaluation_chunk, use);
+      const auto t = std::chrono::steady_clock::now();
+      out.evaluation_half_samples = half;
+      for (size_t m = 0; m < out.methods.size(); ++m) out.methods[m].evaluated_half = score(m, pvs, false);
+      out.evaluation_seconds += seconds_since(t);
+      part.samples = samples - half;
+      part.first_batch = e.first_batch + half / batch;
+      add_sampling_stats(stats, sample_in_chunks(scene, caster, part, config.evaluation_chunk, use));
+    } else {
+      stats = sample_in_chunks(scene, caster, e, config.evaluation_chunk, use);
+    }
+    if (first_set) {
       out.evaluation = stats;
     } else {
       out.evaluation.seconds += stats.seconds;  // the sampling of every set
     }
     const auto t = std::chrono::steady_clock::now();
     for (size_t m = 0; m < out.methods.size(); ++m) {
-      MethodResult& r = out.methods[m];
-      const Subdivision& s = *trees[static_cast<size_t>(tree_of[m])];
-      const Lists& leaf_pvs = pvs[static_cast<size_t>(tree_of[m])];
-      if (merged[m]) {
-        const MergeHistory& h = *merged[m];
-        const std::vector<double> node_cost = evaluated_merge_costs(scene, s, h, leaf_pvs, config.model);
-        (k == 0 ? r.evaluated : r.evaluated_more.emplace_back()) = merge_history_curve(h, node_cost);
-        if (k == 0 && hist_cells >= h.min_cells() && hist_cells <= h.leaf_count)
-          r.cells = merged_cells_at(h, node_cost, hist_cells);
-      } else {
-        const std::vector<double> node_cost = evaluated_bsp_costs(scene, s, leaf_pvs, config.model);
-        (k == 0 ? r.evaluated : r.evaluated_more.emplace_back()) = subdivision_curve(s, node_cost);
-        if (k == 0 && hist_cells <= s.leaf_count()) r.cells = subdivision_cells_at(s, node_cost, hist_cells);
-      }
+      CostCurve curve = score(m, pvs, first_set);
+      if (first_set) out.methods[m].evaluated = std::move(curve);
+      else out.methods[m].evaluated_more.push_back(std::move(curve));
     }
     out.evaluation_seconds += seconds_since(t);
   }

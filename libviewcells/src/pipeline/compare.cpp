@@ -60,7 +60,8 @@ CompareConfig compared_config(const CompareRunConfig& c, bool& with_q3) {
 }
 
 /// curves.csv: each method's evaluated cost at the report's counts and where any stopped; with
-/// several evaluation sets, a column cost_K for each further set K (2, 3, ...).
+/// several evaluation sets, a column cost_K for each further set K (2, 3, ...); cost_half: set
+/// 1's cost from the first half of its samples (Comparison::evaluation_half_samples).
 void write_curves(const CompareRunResult& r, const std::string& path) {
   const Comparison& cmp = r.comparison();
   const MethodResult* avm = find_avm(cmp);
@@ -68,7 +69,7 @@ void write_curves(const CompareRunResult& r, const std::string& path) {
   const uint32_t sets = r.compared.evaluation_sets;
   std::string csv = "method,cells,cost,ratio_to_av_m,constructed_cost";
   for (uint32_t k = 2; k <= sets; ++k) csv += ",cost_" + std::to_string(k);
-  csv += "\n";
+  csv += ",cost_half\n";
   char line[256];
   for (const MethodResult& m : cmp.methods) {
     std::vector<uint32_t> at = counts;
@@ -95,6 +96,12 @@ void write_curves(const CompareRunResult& r, const std::string& path) {
           csv += ",";
         }
       }
+      if (has_point(m.evaluated_half, n)) {
+        std::snprintf(line, sizeof line, ",%.6g", m.evaluated_half.at(n));
+        csv += line;
+      } else {
+        csv += ",";
+      }
       csv += "\n";
     }
   }
@@ -104,7 +111,7 @@ void write_curves(const CompareRunResult& r, const std::string& path) {
     const std::string ratio =
         avm && has_point(avm->evaluated, n) ? fmt(r.q3->clusters.cost / avm->evaluated.at(n), 6) : "";
     std::snprintf(line, sizeof line, "q3-clusters,%u,%.6g,%s,", n, r.q3->clusters.cost, ratio.c_str());
-    csv += line + std::string(sets - 1, ',') + "\n";
+    csv += line + std::string(sets, ',') + "\n";
   }
   write_text_file(path, csv);
 }
@@ -160,6 +167,20 @@ void log_methods(const CompareRunResult& r, const Log& log) {
              ? " (" + fmt(m.evaluated.at(last) / avm->evaluated.at(last), 3) + " x AV-M)"
              : ""));
   }
+  // Sampled PVSs only miss objects: a cost still rising with the evaluation samples is not yet
+  // the cost a viewer pays, and a method that rises more than another is flattered by it.
+  if (!cmp.evaluation_half_samples) return;
+  std::string rises;
+  for (const MethodResult& m : cmp.methods) {
+    const HalfSampleRise rise = half_sample_rise(m);
+    if (!rise.cells) continue;
+    rises += (rises.empty() ? "" : ", ") + m.method + " +" + fmt(100 * rise.rise, 1) + "% at " +
+             std::to_string(rise.cells) + " cells";
+  }
+  if (!rises.empty())
+    log("viewcells: evaluator: the evaluation samples after the first " + std::to_string(cmp.evaluation_half_samples) +
+        " of " + std::to_string(r.compared.evaluation.samples) + " raised the costs from 16 cells on by at most: " +
+        rises + " (0 would be converged; raise --eval-samples where a method rises more than the others)");
 }
 
 }  // namespace

@@ -480,6 +480,14 @@ json compare_methods_json(const Comparison& cmp) {
                        {"geometry_candidates_evaluated", m.geometry_candidates},
                        {"evaluated_cost_at_most_cells", m.evaluated.at(last)},
                        {"constructed_cost_at_most_cells", m.constructed.at(last)}});
+    if (cmp.evaluation_half_samples) {
+      const HalfSampleRise rise = half_sample_rise(m);
+      if (rise.cells)
+        methods.back()["evaluator_second_half_rise"] = {{"largest", rise.rise},
+                                                        {"at_cells", rise.cells},
+                                                        {"from_cells", 16},
+                                                        {"first_half_samples", cmp.evaluation_half_samples}};
+    }
     if (m.method == "av-m" || m.method == "av-m-samples") {
       const MergeSummary& v = m.merge;
       methods.back()["merge"] = {{"leaf_pvs_seconds", v.leaf_pvs_seconds},

@@ -501,8 +501,27 @@ SamplingResult sample_segments(const Scene& scene, const RayCaster& caster, cons
   return sample_impl(scene, caster, config, nullptr);
 }
 
+void add_sampling_stats(SamplingStats& total, const SamplingStats& s) {
+  total.samples += s.samples;
+  total.rays += s.rays;
+  total.recast_rays += s.recast_rays;
+  total.valid_segments += s.valid_segments;
+  total.missed_both += s.missed_both;
+  total.stuck_in_solid += s.stuck_in_solid;
+  total.outside_view_box += s.outside_view_box;
+  total.two_sided_samples += s.two_sided_samples;
+  total.rejected_origins += s.rejected_origins;
+  total.see_through_segments += s.see_through_segments;
+  total.see_through_rays += s.see_through_rays;
+  total.seconds += s.seconds;
+  if (total.segments_per_object.size() < s.segments_per_object.size())
+    total.segments_per_object.resize(s.segments_per_object.size(), 0);
+  for (size_t o = 0; o < s.segments_per_object.size(); ++o) total.segments_per_object[o] += s.segments_per_object[o];
+}
+
 SamplingStats sample_in_chunks(const Scene& scene, const RayCaster& caster, const SamplerConfig& config,
-                               uint64_t chunk_samples, const std::function<void(const SegmentSet&)>& use) {
+                               uint64_t chunk_samples,
+                               const std::function<void(const SegmentSet&, uint64_t)>& use) {
   if (config.target_segments > 0) throw Error("sampling in chunks needs a sample count, not a segment target");
   if (config.batch_size == 0) throw Error("batch size must be positive");
   if (config.samples == 0) throw Error("nothing to sample: samples and segments are 0");
@@ -515,26 +534,9 @@ SamplingStats sample_in_chunks(const Scene& scene, const RayCaster& caster, cons
     c.first_batch = config.first_batch + first / config.batch_size;
     c.show_progress = false;
     SamplingResult r = sample_segments(scene, caster, c);
-    SamplingStats& s = r.stats;
-    if (first == 0) {
-      total = s;
-    } else {
-      total.samples += s.samples;
-      total.rays += s.rays;
-      total.recast_rays += s.recast_rays;
-      total.valid_segments += s.valid_segments;
-      total.missed_both += s.missed_both;
-      total.stuck_in_solid += s.stuck_in_solid;
-      total.outside_view_box += s.outside_view_box;
-      total.two_sided_samples += s.two_sided_samples;
-      total.rejected_origins += s.rejected_origins;
-      total.see_through_segments += s.see_through_segments;
-      total.see_through_rays += s.see_through_rays;
-      total.seconds += s.seconds;
-      for (size_t o = 0; o < total.segments_per_object.size(); ++o)
-        total.segments_per_object[o] += s.segments_per_object[o];
-    }
-    use(r.segments);
+    if (first == 0) total = r.stats;
+    else add_sampling_stats(total, r.stats);
+    use(r.segments, first + c.samples);
     if (config.show_progress) progress.advance(c.samples);
   }
   if (config.show_progress) progress.finish();

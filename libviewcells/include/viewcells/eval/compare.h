@@ -49,6 +49,10 @@ struct MethodResult {
   std::string method;
   CostCurve evaluated;          ///< c(S) on the evaluation samples along the method's order
   std::vector<CostCurve> evaluated_more;  ///< the same on evaluation sets 1, 2, ... (evaluation_sets)
+  /// The same as `evaluated` from the first Comparison::evaluation_half_samples samples of its
+  /// set (about half): what the second half added is how far the evaluator is from converged
+  /// for this method (sampled PVSs only miss objects, so costs only rise with more samples).
+  CostCurve evaluated_half;
   CostCurve constructed;        ///< the method's own estimate (construction samples)
   std::vector<CellCost> cells;  ///< evaluated cells at the histogram cell count (if reached)
   uint32_t leaves = 0;          ///< cells the method produced
@@ -63,6 +67,7 @@ struct Comparison {
   std::vector<MethodResult> methods;
   SamplingStats construction, evaluation;
   double evaluation_seconds = 0;
+  uint64_t evaluation_half_samples = 0;  ///< see MethodResult::evaluated_half (0: not scored)
   // With CompareConfig::keep_models:
   SegmentSet construction_segments, evaluation_segments;
   std::optional<Subdivision> av_s;      ///< when av-s or av-m was built
@@ -74,6 +79,15 @@ void check_methods(const std::vector<std::string>& methods);
 
 /// Builds every method of config.methods and evaluates it. Throws Error for unknown methods.
 Comparison compare_methods(const Scene& scene, const RayCaster& caster, const CompareConfig& config);
+
+/// How much the second half of the first evaluation set raised a method's cost: the largest
+/// evaluated / evaluated_half - 1 over the report's counts from `from_cells` on (and where).
+/// 0 at 0 cells when the comparison scored no half.
+struct HalfSampleRise {
+  double rise = 0;
+  uint32_t cells = 0;
+};
+HalfSampleRise half_sample_rise(const MethodResult& m, uint32_t from_cells = 16);
 
 /// Cell counts to report a curve at: every count up to 16, then about 24 per decade, and the
 /// last one; all <= max.

@@ -86,13 +86,19 @@ struct SamplingResult {
 /// Error for an empty scene, a view box of zero volume, or a segment target out of reach.
 SamplingResult sample_segments(const Scene& scene, const RayCaster& caster, const SamplerConfig& config);
 
+/// Adds the counts, times and segments per object of `more` (another part of the same stream)
+/// to `total`; the rest of `total` (view box, empty space, see-through objects) stays.
+void add_sampling_stats(SamplingStats& total, const SamplingStats& more);
+
 /// Draws config.samples samples (no segment target) in consecutive chunks of about
 /// `chunk_samples` (a multiple of the batch size), and hands each chunk's segments to `use`
 /// before the next is drawn: the chunks together are the segments sample_segments(scene, caster,
-/// config) gives, in order, but at most one chunk is held at a time. Returns the statistics of
-/// the whole stream (times summed; segments_per_object and the rest as sample_segments gives).
+/// config) gives, in order, but at most one chunk is held at a time; `use` also gets the samples
+/// drawn so far, this chunk's included. Returns the statistics of the whole stream (times
+/// summed; segments_per_object and the rest as sample_segments gives).
 SamplingStats sample_in_chunks(const Scene& scene, const RayCaster& caster, const SamplerConfig& config,
-                               uint64_t chunk_samples, const std::function<void(const SegmentSet&)>& use);
+                               uint64_t chunk_samples,
+                               const std::function<void(const SegmentSet& chunk, uint64_t samples_so_far)>& use);
 
 /// Casts samples whose origins and directions the caller chooses (AGVS's distributions) by the
 /// sampler's rule: forward and backward rays, empty view space detection, see-through
