@@ -38,14 +38,16 @@ same_numbers() {  # WHAT A B
 "$VC" -q build office.obj --samples 30000 --max-cells 60 --merge-pvs samples -o office.vcells || exit 1
 
 # One process, no MPI launcher: the reference.
-"$VC" -q sample office.obj --samples 40000 -o s0.vseg --report s0.json || bad "sample"
+# 70,000 samples: 69 batches, two rounds of sharing; the second starts at batch 64, which on
+# three ranks is not rank 0's (a sampler that shared it as if it were failed there).
+"$VC" -q sample office.obj --samples 70000 -o s0.vseg --report s0.json || bad "sample"
 "$VC" -q pvs office.vcells --scene office.obj --cells 12 --samples 50000 --batch 5000 -o p0.pvs --report p0.json || bad "pvs"
 "$VC" -q bake office.obj --cells 8 --samples 20000 --max-cells 40 --merge-samples 20000 --agvs-samples 30000 \
   -o b0.pvs --report b0.json || bad "bake"
 "$VC" -q compare office.obj --methods av-s,kd-casm --max-cells 24 --samples 20000 --eval-samples 30000 -o c0 \
   || bad "compare"
 for n in 1 2 3; do
-  ranks "$n" -q sample office.obj --samples 40000 -o "s$n.vseg" --report "s$n.json" || bad "sample on $n ranks"
+  ranks "$n" -q sample office.obj --samples 70000 -o "s$n.vseg" --report "s$n.json" || bad "sample on $n ranks"
   same_files "sample, $n ranks" s0.vseg "s$n.vseg"
   same_numbers "sample, $n ranks" s0.json "s$n.json"
   # On one rank every collective returns at once: the sample above covers starting and stopping

@@ -439,7 +439,7 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
         put_segments(w, scratch);
         items[i] = w.take();
       });
-      cluster::share(items);
+      cluster::share(items, first);  // item i is batch first + i, owned by mine(first + i)
       for (uint64_t i = 0; i < n && !finished; ++i) {
         const uint64_t batch = first + i;
         ByteReader r(items[i], "a rank's sampling results");
