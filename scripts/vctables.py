@@ -509,8 +509,8 @@ def results(*args):
           "merge history backwards for AV-M).\n")
     print("Methods (section 6.3): AV-M = AV-S's cells merged (`build`'s default: merging decided on the leaves' "
           "PVSs from the construction samples and an AGVS run over the leaves, starting from the cut of AV-S's own "
-          "order that held-out samples score best (a second AGVS run and as many random samples as the construction "
-          "drew, another seed), chosen again below each barrier where its cut is AV-S's, and at low counts "
+          "order that held-out samples score best (a second AGVS run and four times as many random samples as the "
+          "construction drew, another seed), chosen again below each barrier where its cut is AV-S's, and at low counts "
           "also from refined blocks (cells moved between neighbouring blocks where the merge PVSs say it "
           "lowers the cost); see docs/accuracy-vs-time.md); AV-M (old) = greedy "
           "merging of the leaves on the construction samples' PVSs alone, the paper's AV-M and ours until now "
@@ -519,8 +519,8 @@ def results(*args):
           "5% of the whole view space's alone; KD-VT* = its depth-first version (max depth 40); BSP = splits on "
           "scene polygon planes only, chosen as cell-and-portal builders do.\n")
     print("What each was given: every method the same construction samples; AV-M also the two AGVS runs over "
-          "AV-S's leaves (as many samples each as the construction samples: the row's AGVS column) and as many "
-          "held-out random samples as the construction samples (seed 2000004), which no other method gets, and "
+          "AV-S's leaves (as many samples each as the construction samples: the row's AGVS column) and four "
+          "times as many held-out random samples as the construction samples (seed 2000004), which no other method gets, and "
           "whose time is in its build seconds. The evaluator never sees any of them.\n")
     scenes = [("office", "office (size 4, two storeys)"), ("rotated-office", "rotated office (size 4, 30 degrees)"),
               ("city", f"city (size {size}, a street grid)"), ("town", f"town (size {size}, not a grid)"),

@@ -291,7 +291,8 @@ TEST(Evaluate, MergingIsNotWorseThanTheSubdivisionsOwnCuts) {
   const MethodResult &avm = c.methods[0], &old = c.methods[1], &avs = c.methods[2];
   EXPECT_GT(avm.merge.merge_agvs_samples + avm.merge.validation_agvs_samples, 2 * agvs.max_samples - 1);
   EXPECT_FALSE(avm.merge.starts.empty());
-  EXPECT_EQ(avm.merge.held_out_samples, config.construction.samples) << "random samples held out, as many";
+  EXPECT_EQ(avm.merge.held_out_samples, kHeldOutPerConstructionSample * config.construction.samples)
+      << "random samples held out, four times as many";
 
   // The second, independent evaluation set (seed 3): the evaluator's noise. It is what
   // evaluating AV-S on samples drawn with that seed gives (all at once, where compare drew

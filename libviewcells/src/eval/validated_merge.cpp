@@ -305,7 +305,7 @@ SamplerConfig held_out_sampling(const SamplerConfig& construction, uint64_t samp
   SamplerConfig c = construction;
   c.seed = construction.seed + 2000003;
   c.target_segments = 0;
-  c.samples = std::max<uint64_t>(samples_drawn, 1);
+  c.samples = std::max<uint64_t>(kHeldOutPerConstructionSample * samples_drawn, 1);
   return c;
 }
 
