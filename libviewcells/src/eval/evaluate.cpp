@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <iterator>
 
+#include "bsp/segment_walk.h"
 #include "viewcells/core/error.h"
 
 namespace viewcells {
@@ -24,8 +25,47 @@ void unite_into(std::vector<std::vector<uint32_t>>& into, const std::vector<std:
   });
 }
 
+namespace {
+
+/// What a segment's walk reads of each node of a subdivision, in 24 bytes (the node and its
+/// plane are two cache lines apart in the Subdivision): the same walk, the same leaves, about
+/// half the memory reads. The evaluation walks every evaluation segment down every tree.
+class WalkTree {
+ public:
+  explicit WalkTree(const Subdivision& s) : s_(s), nodes_(s.nodes.size()) {
+    for (size_t n = 0; n < nodes_.size(); ++n) {
+      const BspNode& bn = s.nodes[n];
+      Node& w = nodes_[n];
+      w.plane = bn.plane;
+      if (bn.plane < 0) continue;
+      const Plane& p = s.planes[bn.plane];
+      w.axis = p.axis;
+      w.offset = p.offset;
+      w.child[0] = bn.child[0];
+      w.child[1] = bn.child[1];
+    }
+  }
+  bool leaf(int32_t n) const { return nodes_[n].plane < 0; }
+  int axis(int32_t n) const { return nodes_[n].axis; }
+  double offset(int32_t n) const { return nodes_[n].offset; }
+  const Plane& plane(int32_t n) const { return s_.planes[nodes_[n].plane]; }
+  int32_t child(int32_t n, int k) const { return nodes_[n].child[k]; }
+
+ private:
+  struct Node {
+    double offset = 0;
+    int32_t child[2] = {-1, -1};
+    int32_t axis = -1, plane = -1;
+  };
+  const Subdivision& s_;
+  std::vector<Node> nodes_;
+};
+
+}  // namespace
+
 std::vector<std::vector<uint32_t>> evaluation_pvs(const Subdivision& s, const SegmentSet& eval) {
   if (s.nodes.empty()) throw Error("evaluation needs a subdivision");
+  const WalkTree tree(s);
   using Lists = std::vector<std::vector<uint32_t>>;
   tbb::enumerable_thread_specific<Lists> per_thread([&] { return Lists(s.nodes.size()); });
   tbb::parallel_for(tbb::blocked_range<size_t>(0, eval.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
@@ -34,7 +74,11 @@ std::vector<std::vector<uint32_t>> evaluation_pvs(const Subdivision& s, const Se
     std::vector<std::tuple<int32_t, double, double>> stack;
     for (size_t i = r.begin(); i < r.end(); ++i) {
       leaves.clear();
-      s.leaves_of_segment(eval.a(i), eval.b(i), leaves, stack);
+      bsp_detail::walk_segment(tree, eval.a(i), eval.b(i), stack, [&](int32_t n, double, double) {
+        if (!tree.leaf(n)) return false;
+        leaves.push_back(n);
+        return true;
+      });
       for (int32_t l : leaves)
         for (uint32_t o : {eval.object_a[i], eval.object_b[i]})
           if (o != kNoObject) lists[l].push_back(o);
