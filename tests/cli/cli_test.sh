@@ -355,6 +355,16 @@ assert avm[40] < kd[40], (avm[40], kd[40])
 assert all(float(r['ratio_to_av_m']) == 1.0 for r in rows if r['method'] == 'av-m')
 " && ok || bad "compare outputs"
 [ -s cmp/histogram.csv ] && ok || bad "compare histogram"
+# -q on a terminal: no progress bars (each stage's bar is drawn only on a terminal, and a bar its
+# stage switched off must not draw itself when it ends). `script` gives the run a terminal.
+if command -v script >/dev/null; then
+  script -qc "'$VC' compare office.obj --samples 5000 --max-cells 16 --methods av-m,kd-casm -o cmpq -q" /dev/null \
+    >tty.txt 2>&1 </dev/null
+  if grep -aq '\[' tty.txt; then bad "compare -q drew progress bars on a terminal: $(tr '\r' '\n' <tty.txt | head -3)"; else ok; fi
+  script -qc "'$VC' compare office.obj --samples 5000 --max-cells 16 --methods av-m,kd-casm -o cmpq" /dev/null \
+    >tty.txt 2>&1 </dev/null
+  grep -aq 'evaluation set 1 of 1 \[' tty.txt && ok || bad "compare without -q drew no evaluation bar on a terminal"
+fi
 # A second evaluation set: every method scored on both; set 1 is the run above's.
 expect_ok "$VC" compare office.obj --samples 20000 --max-cells 40 --methods av-s,kd-casm --eval-sets 2 -o cmp3 -q
 python3 -c "

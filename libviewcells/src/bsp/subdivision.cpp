@@ -611,7 +611,7 @@ class Builder {
     if (best_[0].valid) queue.push({priority(0), 0});
 
     Progress progress("subdividing", config_.max_cells);
-    progress.advance(1);
+    if (config_.show_progress) progress.advance(1);
     uint32_t stagnant = 0;
     // Splits in rounds. A round takes the first cells of the queue, divides their parts and
     // evaluates their children in parallel (each child under the id, and each new face under

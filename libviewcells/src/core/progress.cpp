@@ -15,7 +15,9 @@ Progress::Progress(std::string label, uint64_t total)
       start_(std::chrono::steady_clock::now()) {}
 
 Progress::~Progress() {
-  if (!finished_) finish();
+  // A bar that was never advanced nor finished was switched off by its caller (a quiet run
+  // guards advance() and finish() by its show-progress flag): it draws nothing.
+  if (!finished_ && done_.load() > 0) finish();
 }
 
 void Progress::advance(uint64_t n) {

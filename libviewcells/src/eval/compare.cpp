@@ -3,10 +3,12 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <set>
 
 #include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/core/error.h"
+#include "viewcells/core/progress.h"
 #include "viewcells/merge/merge.h"
 
 namespace viewcells {
@@ -153,11 +155,18 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
   for (uint32_t k = 0; k < config.evaluation_sets; ++k) {
     SamplerConfig e = config.evaluation;
     e.seed += k;
-    e.show_progress = config.show_progress;
+    e.show_progress = false;  // one bar for the set, sampling and walking, over both parts
     std::vector<Lists> pvs;  // per distinct tree: its leaves' evaluation PVSs so far
     for (const auto& t : trees) pvs.emplace_back(t->nodes.size());
     const bool first_set = k == 0;
-    auto use = [&](const SegmentSet& segments, uint64_t) {
+    std::optional<Progress> progress;  // none with show_progress off (a bar draws itself at its end)
+    if (config.show_progress)
+      progress.emplace("evaluation set " + std::to_string(k + 1) + " of " + std::to_string(config.evaluation_sets),
+                       samples);
+    uint64_t part_drawn = 0;  // samples of the current part drawn so far
+    auto use = [&](const SegmentSet& segments, uint64_t so_far) {
+      const uint64_t chunk = so_far - part_drawn;
+      part_drawn = so_far;
       const auto t = std::chrono::steady_clock::now();
       for (size_t i = 0; i < trees.size(); ++i) unite_into(pvs[i], evaluation_pvs(*trees[i], segments));
       if (config.keep_models && first_set) {
@@ -165,6 +174,7 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
         out.evaluation_segments.append(segments);
       }
       out.evaluation_seconds += seconds_since(t);
+      if (progress) progress->advance(chunk);
     };
     SamplingStats stats;
     if (first_set && half > 0 && half < samples) {
@@ -177,10 +187,12 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
       out.evaluation_seconds += seconds_since(t);
       part.samples = samples - half;
       part.first_batch = e.first_batch + half / batch;
+      part_drawn = 0;
       add_sampling_stats(stats, sample_in_chunks(scene, caster, part, config.evaluation_chunk, use));
     } else {
       stats = sample_in_chunks(scene, caster, e, config.evaluation_chunk, use);
     }
+    if (progress) progress->finish();
     if (first_set) {
       out.evaluation = stats;
     } else {
