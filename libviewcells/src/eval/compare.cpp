@@ -159,10 +159,8 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
     std::vector<Lists> pvs;  // per distinct tree: its leaves' evaluation PVSs so far
     for (const auto& t : trees) pvs.emplace_back(t->nodes.size());
     const bool first_set = k == 0;
-    std::optional<Progress> progress;  // none with show_progress off (a bar draws itself at its end)
-    if (config.show_progress)
-      progress.emplace("evaluation set " + std::to_string(k + 1) + " of " + std::to_string(config.evaluation_sets),
-                       samples);
+    Progress progress("evaluation set " + std::to_string(k + 1) + " of " + std::to_string(config.evaluation_sets),
+                      samples);
     uint64_t part_drawn = 0;  // samples of the current part drawn so far
     auto use = [&](const SegmentSet& segments, uint64_t so_far) {
       const uint64_t chunk = so_far - part_drawn;
@@ -174,7 +172,7 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
         out.evaluation_segments.append(segments);
       }
       out.evaluation_seconds += seconds_since(t);
-      if (progress) progress->advance(chunk);
+      if (config.show_progress) progress.advance(chunk);
     };
     SamplingStats stats;
     if (first_set && half > 0 && half < samples) {
@@ -192,7 +190,7 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
     } else {
       stats = sample_in_chunks(scene, caster, e, config.evaluation_chunk, use);
     }
-    if (progress) progress->finish();
+    if (config.show_progress) progress.finish();
     if (first_set) {
       out.evaluation = stats;
     } else {

@@ -16,13 +16,6 @@ namespace viewcells {
 
 namespace {
 
-std::vector<std::vector<uint32_t>> unite(const std::vector<std::vector<uint32_t>>& a,
-                                         const std::vector<std::vector<uint32_t>>& b) {
-  std::vector<std::vector<uint32_t>> out(a.size());
-  for (size_t n = 0; n < a.size(); ++n) out[n] = unite_sorted(a[n], b[n]);
-  return out;
-}
-
 using Merges = std::vector<std::pair<int32_t, int32_t>>;
 
 /// Per leaf, the least leaf of its cell after the first `k` of `merges` (merges_by_least_leaf).
@@ -282,8 +275,9 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
 
   // The chosen merges, replayed with every sample's PVSs.
   t.restart();
-  out.leaf_pvs = unite(a.pvs, b.pvs);
-  if (config.held_out_samples) out.leaf_pvs = unite(out.leaf_pvs, c_pvs);
+  out.leaf_pvs = a.pvs;
+  unite_into(out.leaf_pvs, b.pvs);
+  if (config.held_out_samples) unite_into(out.leaf_pvs, c_pvs);
   partition = partition_from_subdivision(s, out.leaf_pvs);
   sum.neighbour_seconds += t.seconds();
   t.restart();

@@ -11,7 +11,6 @@
 #include <atomic>
 
 #include <cmath>
-#include <optional>
 
 #include "viewcells/core/binary_file.h"
 #include "viewcells/core/cluster.h"
@@ -528,8 +527,7 @@ SamplingStats sample_in_chunks(const Scene& scene, const RayCaster& caster, cons
   if (config.samples == 0) throw Error("nothing to sample: samples and segments are 0");
   const uint64_t per_chunk = std::max<uint64_t>(1, chunk_samples / config.batch_size) * config.batch_size;
   SamplingStats total;
-  std::optional<Progress> progress;  // none when off: a bar draws itself when it ends
-  if (config.show_progress) progress.emplace("sampling", config.samples);
+  Progress progress("sampling", config.samples);
   for (uint64_t first = 0; first < config.samples; first += per_chunk) {
     SamplerConfig c = config;
     c.samples = std::min(per_chunk, config.samples - first);
@@ -539,9 +537,9 @@ SamplingStats sample_in_chunks(const Scene& scene, const RayCaster& caster, cons
     if (first == 0) total = r.stats;
     else add_sampling_stats(total, r.stats);
     use(r.segments, first + c.samples);
-    if (progress) progress->advance(c.samples);
+    if (config.show_progress) progress.advance(c.samples);
   }
-  if (progress) progress->finish();
+  if (config.show_progress) progress.finish();
   return total;
 }
 
