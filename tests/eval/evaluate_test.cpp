@@ -3,6 +3,7 @@
 
 #include "support/test_scenes.h"
 
+#include <algorithm>
 #include <cmath>
 #include <iostream>
 
@@ -58,6 +59,30 @@ TEST(Evaluate, ConstructionSamplesReproduceTheBuildersCosts) {
   EXPECT_NEAR(c.at(1), s.initial_cost, 1e-9 * s.initial_cost);
   for (size_t k = 0; k < s.splits.size(); ++k)
     EXPECT_NEAR(c.at(static_cast<uint32_t>(k + 2)), s.splits[k].cost_after, 1e-9 * s.initial_cost) << k;
+}
+
+TEST(Evaluate, TheWalksOrderChangesNoList) {
+  // evaluation_pvs walks the segments in the Z-order of their ends (for the cache); the lists
+  // must be those of any other order: as sampled, and backwards.
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 1});
+  const SegmentSet segs = sample(scene, 20000, 1);
+  const Subdivision s = build(scene, segs, "av-s", 80);
+  const std::vector<size_t> order = coherent_order(segs, s.view_box);
+  std::vector<size_t> sorted = order, natural(segs.size());
+  std::sort(sorted.begin(), sorted.end());
+  for (size_t i = 0; i < natural.size(); ++i) natural[i] = i;
+  ASSERT_EQ(sorted, natural);  // a permutation
+  ASSERT_NE(order, natural);   // and not the sampled order, or this test shows nothing
+  const auto pvs = evaluation_pvs(s, segs);
+  EXPECT_EQ(evaluation_pvs(s, segs, natural), pvs);
+  EXPECT_EQ(evaluation_pvs(s, segs, std::vector<size_t>(natural.rbegin(), natural.rend())), pvs);
+  // An empty or flat box only spoils the order, never the permutation.
+  for (const Box3& box : {Box3{}, Box3{s.view_box.lo, s.view_box.lo}}) {
+    std::vector<size_t> o = coherent_order(segs, box);
+    std::sort(o.begin(), o.end());
+    EXPECT_EQ(o, natural);
+  }
+  EXPECT_THROW(evaluation_pvs(s, segs, std::vector<size_t>(3, 0)), Error);
 }
 
 TEST(Evaluate, ConstructionSamplesReproduceTheMergeHistorysCosts) {

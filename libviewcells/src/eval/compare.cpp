@@ -166,7 +166,8 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
       const uint64_t chunk = so_far - part_drawn;
       part_drawn = so_far;
       const auto t = std::chrono::steady_clock::now();
-      for (size_t i = 0; i < trees.size(); ++i) unite_into(pvs[i], evaluation_pvs(*trees[i], segments));
+      const std::vector<size_t> order = coherent_order(segments, segments.view_box);  // one for every tree
+      for (size_t i = 0; i < trees.size(); ++i) unite_into(pvs[i], evaluation_pvs(*trees[i], segments, order));
       if (config.keep_models && first_set) {
         out.evaluation_segments.view_box = segments.view_box;
         out.evaluation_segments.append(segments);

@@ -1,16 +1,53 @@
 #include "viewcells/sampling/segments.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #ifdef __linux__
 #include <sys/mman.h>
 #endif
 
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
 #include "viewcells/core/binary_file.h"
 #include "viewcells/core/error.h"
 
 namespace viewcells {
+
+namespace {
+
+/// The low 10 bits of v, one every sixth bit (the Z-order of two 3D points).
+uint64_t spread6(uint64_t v) {
+  uint64_t out = 0;
+  for (int bit = 0; bit < 10; ++bit) out |= ((v >> bit) & 1) << (6 * bit);
+  return out;
+}
+
+}  // namespace
+
+std::vector<size_t> coherent_order(const SegmentSet& s, const Box3& box) {
+  std::array<std::array<uint64_t, 1024>, 6> table;  // per coordinate: spread6 of its cell, placed
+  for (int k = 0; k < 6; ++k)
+    for (uint64_t v = 0; v < 1024; ++v) table[k][v] = spread6(v) << (5 - k);
+  const Vec3 lo = box.lo, size = box.hi - box.lo;
+  auto cell = [&](double v, int axis) {  // 0..1023 along `axis` of the box; outside or NaN: clamped
+    const double u = (v - lo[axis]) / size[axis] * 1024.0;
+    return u >= 1023.0 ? uint64_t{1023} : (u >= 0.0 ? static_cast<uint64_t>(u) : uint64_t{0});
+  };
+  std::vector<std::pair<uint64_t, size_t>> keyed(s.size());
+  tbb::parallel_for(size_t{0}, s.size(), [&](size_t i) {
+    const double c[6] = {s.ax[i], s.ay[i], s.az[i], s.bx[i], s.by[i], s.bz[i]};
+    uint64_t key = 0;
+    for (int k = 0; k < 6; ++k) key |= table[k][cell(c[k], k % 3)];
+    keyed[i] = {key, i};
+  });
+  tbb::parallel_sort(keyed.begin(), keyed.end());
+  std::vector<size_t> order(s.size());
+  tbb::parallel_for(size_t{0}, s.size(), [&](size_t i) { order[i] = keyed[i].second; });
+  return order;
+}
 
 void SegmentSet::reserve(size_t n) {
   for (auto* v : {&ax, &ay, &az, &bx, &by, &bz}) v->reserve(n);

@@ -17,6 +17,10 @@ namespace viewcells {
 /// Per node of `s` (filled for leaves): the sorted objects seen by the segments of `eval`
 /// that have length in the leaf. Parallel; the result does not depend on the thread count.
 std::vector<std::vector<uint32_t>> evaluation_pvs(const Subdivision& s, const SegmentSet& eval);
+/// The same, walking the segments in `order` (a permutation of their indices; the result does
+/// not depend on it, the time does: coherent_order(eval, ...), computed once for many trees).
+std::vector<std::vector<uint32_t>> evaluation_pvs(const Subdivision& s, const SegmentSet& eval,
+                                                  const std::vector<size_t>& order);
 
 /// Per node, `into[n]` becomes the union of itself and `more[n]` (sorted lists, as
 /// evaluation_pvs gives): the evaluation PVSs of two sets of segments from those of each.

@@ -44,6 +44,14 @@ struct SegmentSet {
   size_t memory_bytes() const { return size() * (6 * sizeof(double) + 4 * sizeof(uint32_t)); }
 };
 
+/// The segments' indices in an order where neighbours have both ends near each other (the
+/// Z-order of their ends, 10 bits an axis within `box`, interleaved): walked down a tree in
+/// this order, consecutive segments visit mostly the same nodes and leaves, which are then in
+/// the cache. Sampled segments come in random order, so walking them as drawn misses on almost
+/// every node of a large tree. Only an order: any result that does not depend on the order of
+/// the segments is the same.
+std::vector<size_t> coherent_order(const SegmentSet& s, const Box3& box);
+
 /// What a segment file records besides the segments.
 /// The segment arrays of `s`, as a .vseg file and a message between ranks (core/cluster.h)
 /// hold them, and back: get_segments replaces the segments of `s` (its view box stays) and
