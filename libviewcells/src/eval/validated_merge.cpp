@@ -113,9 +113,13 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   if (config.held_out_samples) {
     SamplerConfig sc = *config.held_out_samples;
     sc.show_progress = sc.show_progress && config.merge.show_progress;
-    const SamplingResult c = sample_segments(scene, caster, sc);
-    sum.held_out_samples = c.stats.samples;
-    c_pvs = evaluation_pvs(s, c.segments);  // every leaf each segment has length in
+    // Drawn and walked a million samples at a time (every leaf each segment has length in),
+    // so that the segments are never all held: the same lists as walking them at once.
+    c_pvs.resize(s.nodes.size());
+    sum.held_out_samples =
+        sample_in_chunks(scene, caster, sc, kHeldOutChunk, [&](const SegmentSet& chunk, uint64_t) {
+          unite_into(c_pvs, evaluation_pvs(s, chunk));
+        }).samples;
   }
   sum.leaf_pvs_seconds = t.seconds();
 

@@ -120,6 +120,8 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
 /// about 1.6x AV-M's build time (office at 5,000 cells 15.3 s against 9.8 s; the city's merge of
 /// 50k cells 97 s against 59 s, BENCHMARKS.md).
 constexpr uint64_t kHeldOutPerConstructionSample = 4;
+/// The held-out random samples are drawn and walked down the tree this many at a time (memory).
+constexpr uint64_t kHeldOutChunk = 1'000'000;
 
 /// The held-out random samples of a validated merge: kHeldOutPerConstructionSample times as
 /// many as the construction drew, drawn the same way, with seed construction.seed + 2000003
