@@ -85,6 +85,41 @@ TEST(Evaluate, TheWalksOrderChangesNoList) {
   EXPECT_THROW(evaluation_pvs(s, segs, std::vector<size_t>(3, 0)), Error);
 }
 
+TEST(Evaluate, ReplaysFromASharedCutGiveTheSameCosts) {
+  // The validated merge scores histories that begin with AV-S's own merges from AV-S's replay
+  // kept at their starts: exactly the costs of replaying them from the leaves, whether they
+  // begin with a kept cut, with part of one, or with none; on the list path (costs with
+  // halves) the cuts hold nothing and change nothing.
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 1});
+  const SegmentSet segs = sample(scene, 20000, 1);
+  const Subdivision s = build(scene, segs, "av-s", 200);
+  const std::vector<std::vector<uint32_t>> eval = evaluation_pvs(s, sample(scene, 20000, 2));
+  const size_t L = s.leaf_count();
+  for (const double a : {100.0, 100.5}) {
+    CostModel model;
+    model.a = a;
+    const CellPartition partition = partition_from_subdivision(s, leaf_pvs(s, segs));
+    MergeConfig mc;
+    mc.show_progress = false;
+    mc.prefix = subdivision_prefix(s, 1);
+    const MergeHistory av_s = merge_cells(scene, partition, model, mc);
+    const MergeReplayCuts cuts = replay_merge_cuts(scene, s, av_s, eval, model, {L - 100, L - 50, L - 25, 0, L + 5});
+    ASSERT_EQ(cuts.cuts.size(), a == 100.0 ? 3u : 0u);  // 0 and beyond the merges: none
+    if (a == 100.0) {
+      EXPECT_EQ(cuts.r, evaluated_merge_costs(scene, s, av_s, eval, model));
+    }
+    std::vector<MergeHistory> histories{av_s};
+    for (size_t start : {L, size_t{100}, size_t{60}, size_t{50}, size_t{10}}) {
+      mc.prefix = subdivision_prefix(s, start);
+      histories.push_back(merge_cells(scene, partition, model, mc));
+    }
+    for (size_t k = 0; k < histories.size(); ++k)
+      EXPECT_EQ(evaluated_merge_costs(scene, s, histories[k], eval, model, cuts),
+                evaluated_merge_costs(scene, s, histories[k], eval, model))
+          << a << " " << k;
+  }
+}
+
 TEST(Evaluate, ConstructionSamplesReproduceTheMergeHistorysCosts) {
   const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 1});
   const SegmentSet segs = sample(scene, 20000, 1);

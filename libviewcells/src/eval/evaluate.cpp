@@ -152,16 +152,42 @@ namespace {
 /// objects is no larger than the average leaf's PVS list: each live cell's PVS as bits (a
 /// merged cell takes over its first child's), r(x + y) = r(x) + r(y) - r(x n y), the common
 /// objects read off the words both have set. Exact, so the same values as the lists' sums.
+/// With `from` (a cut of a history that `h` begins with, and that history's r), the replay
+/// starts at that cut; with `keep`, the cuts after keep->cuts[k].merges merges are recorded.
 std::vector<double> evaluated_merge_costs_by_bits(const MergeHistory& h, const std::vector<int32_t>& leaves,
                                                   const std::vector<std::vector<uint32_t>>& leaf_pvs,
-                                                  const std::vector<double>& base) {
+                                                  const std::vector<double>& base,
+                                                  const MergeReplayCuts::Cut* from = nullptr,
+                                                  const std::vector<double>* from_r = nullptr,
+                                                  MergeReplayCuts* keep = nullptr) {
   const size_t words = (base.size() + 63) / 64;
   std::vector<uint64_t> whole(base.size());
   for (size_t o = 0; o < base.size(); ++o) whole[o] = static_cast<uint64_t>(base[o]);
-  std::vector<uint64_t> bits(static_cast<size_t>(h.leaf_count) * words, 0);  // per slot
   std::vector<uint32_t> slot(h.nodes.size());
   std::vector<double> r(h.nodes.size(), 0.0);
-  for (size_t i = 0; i < h.nodes.size(); ++i) {
+  std::vector<uint64_t> bits;  // per slot
+  size_t first = 0;            // the first node to compute
+  if (from) {
+    first = h.leaf_count + from->merges;
+    bits = from->bits;
+    for (size_t k = 0; k < from->live.size(); ++k) slot[from->live[k]] = static_cast<uint32_t>(k);
+    std::copy(from_r->begin(), from_r->begin() + static_cast<std::ptrdiff_t>(first), r.begin());
+  } else {
+    bits.assign(static_cast<size_t>(h.leaf_count) * words, 0);
+  }
+  std::vector<uint8_t> merged;  // per node, when cuts are kept
+  size_t next_cut = 0;
+  if (keep) merged.assign(h.nodes.size(), 0);
+  for (size_t i = first; i < h.nodes.size(); ++i) {
+    if (keep && next_cut < keep->cuts.size() && keep->cuts[next_cut].merges + h.leaf_count == i) {
+      MergeReplayCuts::Cut& cut = keep->cuts[next_cut++];
+      for (size_t n = 0; n < i; ++n)
+        if (!merged[n]) {
+          cut.live.push_back(static_cast<int32_t>(n));
+          const uint64_t* b = &bits[static_cast<size_t>(slot[n]) * words];
+          cut.bits.insert(cut.bits.end(), b, b + words);
+        }
+    }
     const MergeNode& m = h.nodes[i];
     if (m.child[0] < 0) {
       slot[i] = static_cast<uint32_t>(i);  // the leaves' slots, in order
@@ -180,8 +206,28 @@ std::vector<double> evaluated_merge_costs_by_bits(const MergeHistory& h, const s
     }
     slot[i] = slot[m.child[0]];
     r[i] = r[m.child[0]] + r[m.child[1]] - static_cast<double>(common);
+    if (keep) merged[m.child[0]] = merged[m.child[1]] = 1;
   }
   return r;
+}
+
+/// Whether evaluated_merge_costs works on bit sets for these leaf PVSs (and `base`, the
+/// objects' costs, then).
+bool merge_costs_by_bits(const Scene& scene, const MergeHistory& h, const std::vector<int32_t>& leaves,
+                         const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model,
+                         std::vector<double>& base) {
+  base = per_object_costs(scene, model);
+  if (model.pixel_term() || !whole_and_small(base) || h.leaf_count == 0) return false;
+  size_t entries = 0;
+  for (int32_t l : leaves) entries += leaf_pvs[l].size();
+  const size_t words = (base.size() + 63) / 64;
+  return words * sizeof(uint64_t) * h.leaf_count <= entries * sizeof(uint32_t);
+}
+
+void check_merge_evaluation(const Subdivision& s, const MergeHistory& h, const std::vector<int32_t>& leaves,
+                            const std::vector<std::vector<uint32_t>>& leaf_pvs) {
+  if (leaves.size() != h.leaf_count || leaf_pvs.size() != s.nodes.size())
+    throw Error("the merge history does not match the subdivision");
 }
 
 }  // namespace
@@ -189,17 +235,11 @@ std::vector<double> evaluated_merge_costs_by_bits(const MergeHistory& h, const s
 std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision& s, const MergeHistory& h,
                                    const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
   const std::vector<int32_t> leaves = s.leaves();
-  if (leaves.size() != h.leaf_count || leaf_pvs.size() != s.nodes.size())
-    throw Error("the merge history does not match the subdivision");
-  const std::vector<double> base = per_object_costs(scene, model);
+  check_merge_evaluation(s, h, leaves, leaf_pvs);
+  std::vector<double> base;
+  if (merge_costs_by_bits(scene, h, leaves, leaf_pvs, model, base))
+    return evaluated_merge_costs_by_bits(h, leaves, leaf_pvs, base);
   const bool whole = !model.pixel_term() && whole_and_small(base);
-  if (whole && h.leaf_count > 0) {
-    size_t entries = 0;
-    for (int32_t l : leaves) entries += leaf_pvs[l].size();
-    const size_t words = (base.size() + 63) / 64;
-    if (words * sizeof(uint64_t) * h.leaf_count <= entries * sizeof(uint32_t))
-      return evaluated_merge_costs_by_bits(h, leaves, leaf_pvs, base);
-  }
   std::vector<std::vector<uint32_t>> pvs(h.nodes.size());
   std::vector<double> r(h.nodes.size(), 0.0);
   for (size_t i = 0; i < h.nodes.size(); ++i) {
@@ -214,6 +254,49 @@ std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision&
     r[i] = whole ? whole_pvs_cost(base, pvs[i]) : pvs_cost(scene, base, model, pvs[i], m.bounds);
   }
   return r;
+}
+
+MergeReplayCuts replay_merge_cuts(const Scene& scene, const Subdivision& s, const MergeHistory& h,
+                                  const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model,
+                                  std::vector<size_t> merges) {
+  const std::vector<int32_t> leaves = s.leaves();
+  check_merge_evaluation(s, h, leaves, leaf_pvs);
+  MergeReplayCuts out;
+  out.history = &h;
+  std::vector<double> base;
+  if (!merge_costs_by_bits(scene, h, leaves, leaf_pvs, model, base)) return out;  // nothing to share
+  out.words = (base.size() + 63) / 64;
+  std::sort(merges.begin(), merges.end());
+  merges.erase(std::unique(merges.begin(), merges.end()), merges.end());
+  for (size_t m : merges)
+    if (m > 0 && m < h.merges()) out.cuts.push_back({m, {}, {}});
+  out.r = evaluated_merge_costs_by_bits(h, leaves, leaf_pvs, base, nullptr, nullptr, &out);
+  return out;
+}
+
+std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision& s, const MergeHistory& h,
+                                          const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model,
+                                          const MergeReplayCuts& from) {
+  const std::vector<int32_t> leaves = s.leaves();
+  check_merge_evaluation(s, h, leaves, leaf_pvs);
+  std::vector<double> base;
+  if (!merge_costs_by_bits(scene, h, leaves, leaf_pvs, model, base)) return evaluated_merge_costs(scene, s, h, leaf_pvs, model);
+  const MergeReplayCuts::Cut* cut = nullptr;
+  if (from.history && from.history->leaf_count == h.leaf_count && from.words == (base.size() + 63) / 64) {
+    // The latest cut whose merges h begins with: h's merge nodes compared with from's, in order.
+    const MergeHistory& g = *from.history;
+    const size_t L = h.leaf_count, common_limit = std::min(h.merges(), g.merges());
+    size_t same = 0;
+    for (const MergeReplayCuts::Cut& c : from.cuts) {
+      if (c.merges > common_limit) break;
+      while (same < c.merges && h.nodes[L + same].child[0] == g.nodes[L + same].child[0] &&
+             h.nodes[L + same].child[1] == g.nodes[L + same].child[1])
+        ++same;
+      if (same < c.merges) break;
+      cut = &c;
+    }
+  }
+  return evaluated_merge_costs_by_bits(h, leaves, leaf_pvs, base, cut, cut ? &from.r : nullptr);
 }
 
 CostCurve subdivision_curve(const Subdivision& s, const std::vector<double>& r) {

@@ -41,6 +41,7 @@ struct CountScores {
 struct HeldOut {
   std::vector<const std::vector<std::vector<uint32_t>>*> pvs;
   std::vector<CostCurve> av_s;
+  std::vector<MergeReplayCuts> replays;  ///< per set: AV-S's replay, kept at the candidates' starts
   std::vector<size_t> counts;
   size_t av_s_min_cells = 1;
 
@@ -48,7 +49,8 @@ struct HeldOut {
     CountScores out{std::vector<double>(counts.size(), 0.0), std::vector<double>(counts.size(), 0.0),
                     std::vector<uint8_t>(counts.size(), 0)};
     for (size_t k = 0; k < pvs.size(); ++k) {
-      const CostCurve curve = evaluate_merge_history(scene, s, h, *pvs[k], model);
+      // Every candidate begins with AV-S's own merges down to its start: replayed from there.
+      const CostCurve curve = merge_history_curve(h, evaluated_merge_costs(scene, s, h, *pvs[k], model, replays[k]));
       for (size_t j = 0; j < counts.size(); ++j) {
         const auto n = static_cast<uint32_t>(counts[j]);
         if (n < h.min_cells() || n < av_s_min_cells) continue;
@@ -135,7 +137,6 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   HeldOut held_out;
   held_out.pvs.push_back(&b.pvs);
   if (config.held_out_samples) held_out.pvs.push_back(&c_pvs);
-  for (const auto* pvs : held_out.pvs) held_out.av_s.push_back(evaluate_merge_history(scene, s, av_s, *pvs, model));
   held_out.av_s_min_cells = av_s.min_cells();
   std::vector<size_t>& counts = held_out.counts;
   for (size_t n = std::min<size_t>(config.score_from, L); n <= L; n = n * 5 / 4 + 1) counts.push_back(n);
@@ -163,6 +164,16 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
     for (size_t start = L; start >= 4 * kRefinedBarrier; start /= 2)
       if (start <= 64 * kRefinedBarrier)
         candidates.push_back({static_cast<uint32_t>(start), kRefinedBarrier, 0.0, 0.0, true});
+  // AV-S's replay on each held-out set, kept at every candidate's start (its first L - start
+  // merges are AV-S's own), and AV-S's curves.
+  std::vector<size_t> starts;
+  for (const MergeStart& st : candidates) starts.push_back(L - st.cells);
+  for (const auto* pvs : held_out.pvs) {
+    held_out.replays.push_back(replay_merge_cuts(scene, s, av_s, *pvs, model, starts));
+    const MergeReplayCuts& replay = held_out.replays.back();
+    held_out.av_s.push_back(replay.r.empty() ? evaluate_merge_history(scene, s, av_s, *pvs, model)
+                                             : merge_history_curve(av_s, replay.r));
+  }
   auto config_for = [&](const MergeStart& st) {
     MergeConfig c = mc;
     c.prefix = subdivision_prefix(s, st.cells);

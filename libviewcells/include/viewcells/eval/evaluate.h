@@ -42,6 +42,33 @@ std::vector<double> evaluated_bsp_costs(const Scene& scene, const Subdivision& s
 std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision& s, const MergeHistory& h,
                                           const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model);
 
+/// A merge history's evaluation replay kept at some of its cuts, so that the evaluation of
+/// another history over the same leaves and leaf PVSs that begins with the same merges starts
+/// at the latest such cut instead of at the leaves (the validated merge scores dozens of
+/// candidate histories, most beginning with many of AV-S's own merges). Only where
+/// evaluated_merge_costs works on bit sets (whole object costs, no pixel term, bit sets no
+/// larger than the lists); elsewhere it holds nothing and changes nothing.
+struct MergeReplayCuts {
+  struct Cut {
+    size_t merges = 0;            ///< merges done at this cut
+    std::vector<int32_t> live;    ///< its cells (history nodes)
+    std::vector<uint64_t> bits;   ///< their PVSs as bit sets over the objects, live.size() x words
+  };
+  const MergeHistory* history = nullptr;  ///< the history replayed (must outlive this)
+  std::vector<double> r;                  ///< r(PVS) of every node of `history`
+  size_t words = 0;
+  std::vector<Cut> cuts;  ///< increasing merges
+};
+/// Replays `h` (as evaluated_merge_costs does) and keeps its cuts after each of `merges`.
+MergeReplayCuts replay_merge_cuts(const Scene& scene, const Subdivision& s, const MergeHistory& h,
+                                  const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model,
+                                  std::vector<size_t> merges);
+/// evaluated_merge_costs of `h`, starting from the latest cut of `from` whose merges `h` begins
+/// with (compared node by node): the same values, exactly, as without `from`.
+std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision& s, const MergeHistory& h,
+                                          const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model,
+                                          const MergeReplayCuts& from);
+
 /// c(S) after every split of `s`, 1 .. leaf_count cells, from evaluated_bsp_costs.
 CostCurve subdivision_curve(const Subdivision& s, const std::vector<double>& node_cost);
 /// c(S) along the merge history, min_cells .. leaf_count cells, from evaluated_merge_costs.
