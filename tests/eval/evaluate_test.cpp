@@ -113,10 +113,16 @@ TEST(Evaluate, ReplaysFromASharedCutGiveTheSameCosts) {
       mc.prefix = subdivision_prefix(s, start);
       histories.push_back(merge_cells(scene, partition, model, mc));
     }
-    for (size_t k = 0; k < histories.size(); ++k)
+    const std::vector<std::vector<uint32_t>> other = evaluation_pvs(s, sample(scene, 20000, 3));
+    for (size_t k = 0; k < histories.size(); ++k) {
       EXPECT_EQ(evaluated_merge_costs(scene, s, histories[k], eval, model, cuts),
                 evaluated_merge_costs(scene, s, histories[k], eval, model))
           << a << " " << k;
+      // Other leaf PVSs: the cuts, replayed on `eval`, must not be taken.
+      EXPECT_EQ(evaluated_merge_costs(scene, s, histories[k], other, model, cuts),
+                evaluated_merge_costs(scene, s, histories[k], other, model))
+          << a << " " << k;
+    }
   }
 }
 

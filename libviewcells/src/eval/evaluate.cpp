@@ -263,6 +263,7 @@ MergeReplayCuts replay_merge_cuts(const Scene& scene, const Subdivision& s, cons
   check_merge_evaluation(s, h, leaves, leaf_pvs);
   MergeReplayCuts out;
   out.history = &h;
+  out.leaf_pvs = &leaf_pvs;
   std::vector<double> base;
   if (!merge_costs_by_bits(scene, h, leaves, leaf_pvs, model, base)) return out;  // nothing to share
   out.words = (base.size() + 63) / 64;
@@ -282,7 +283,7 @@ std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision&
   std::vector<double> base;
   if (!merge_costs_by_bits(scene, h, leaves, leaf_pvs, model, base)) return evaluated_merge_costs(scene, s, h, leaf_pvs, model);
   const MergeReplayCuts::Cut* cut = nullptr;
-  if (from.history && from.history->leaf_count == h.leaf_count && from.words == (base.size() + 63) / 64) {
+  if (from.history && from.leaf_pvs == &leaf_pvs && from.history->leaf_count == h.leaf_count && from.words == (base.size() + 63) / 64) {
     // The latest cut whose merges h begins with: h's merge nodes compared with from's, in order.
     const MergeHistory& g = *from.history;
     const size_t L = h.leaf_count, common_limit = std::min(h.merges(), g.merges());

@@ -55,6 +55,7 @@ struct MergeReplayCuts {
     std::vector<uint64_t> bits;   ///< their PVSs as bit sets over the objects, live.size() x words
   };
   const MergeHistory* history = nullptr;  ///< the history replayed (must outlive this)
+  const std::vector<std::vector<uint32_t>>* leaf_pvs = nullptr;  ///< on these (must outlive this)
   std::vector<double> r;                  ///< r(PVS) of every node of `history`
   size_t words = 0;
   std::vector<Cut> cuts;  ///< increasing merges
@@ -64,7 +65,8 @@ MergeReplayCuts replay_merge_cuts(const Scene& scene, const Subdivision& s, cons
                                   const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model,
                                   std::vector<size_t> merges);
 /// evaluated_merge_costs of `h`, starting from the latest cut of `from` whose merges `h` begins
-/// with (compared node by node): the same values, exactly, as without `from`.
+/// with (compared node by node; none unless `leaf_pvs` is the very object `from` replayed):
+/// the same values, exactly, as without `from`.
 std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision& s, const MergeHistory& h,
                                           const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model,
                                           const MergeReplayCuts& from);
