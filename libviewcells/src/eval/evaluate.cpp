@@ -234,26 +234,7 @@ void check_merge_evaluation(const Subdivision& s, const MergeHistory& h, const s
 
 std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision& s, const MergeHistory& h,
                                    const std::vector<std::vector<uint32_t>>& leaf_pvs, const CostModel& model) {
-  const std::vector<int32_t> leaves = s.leaves();
-  check_merge_evaluation(s, h, leaves, leaf_pvs);
-  std::vector<double> base;
-  if (merge_costs_by_bits(scene, h, leaves, leaf_pvs, model, base))
-    return evaluated_merge_costs_by_bits(h, leaves, leaf_pvs, base);
-  const bool whole = !model.pixel_term() && whole_and_small(base);
-  std::vector<std::vector<uint32_t>> pvs(h.nodes.size());
-  std::vector<double> r(h.nodes.size(), 0.0);
-  for (size_t i = 0; i < h.nodes.size(); ++i) {
-    const MergeNode& m = h.nodes[i];
-    if (m.child[0] < 0) {
-      pvs[i] = leaf_pvs[leaves[i]];
-    } else {
-      pvs[i] = unite_sorted(pvs[m.child[0]], pvs[m.child[1]]);
-      pvs[m.child[0]] = {};
-      pvs[m.child[1]] = {};
-    }
-    r[i] = whole ? whole_pvs_cost(base, pvs[i]) : pvs_cost(scene, base, model, pvs[i], m.bounds);
-  }
-  return r;
+  return evaluated_merge_costs(scene, s, h, leaf_pvs, model, MergeReplayCuts{});
 }
 
 MergeReplayCuts replay_merge_cuts(const Scene& scene, const Subdivision& s, const MergeHistory& h,
@@ -281,7 +262,24 @@ std::vector<double> evaluated_merge_costs(const Scene& scene, const Subdivision&
   const std::vector<int32_t> leaves = s.leaves();
   check_merge_evaluation(s, h, leaves, leaf_pvs);
   std::vector<double> base;
-  if (!merge_costs_by_bits(scene, h, leaves, leaf_pvs, model, base)) return evaluated_merge_costs(scene, s, h, leaf_pvs, model);
+  if (!merge_costs_by_bits(scene, h, leaves, leaf_pvs, model, base)) {
+    // Lists: each node's PVS the union of its children's (no cuts to start from here).
+    const bool whole = !model.pixel_term() && whole_and_small(base);
+    std::vector<std::vector<uint32_t>> pvs(h.nodes.size());
+    std::vector<double> r(h.nodes.size(), 0.0);
+    for (size_t i = 0; i < h.nodes.size(); ++i) {
+      const MergeNode& m = h.nodes[i];
+      if (m.child[0] < 0) {
+        pvs[i] = leaf_pvs[leaves[i]];
+      } else {
+        pvs[i] = unite_sorted(pvs[m.child[0]], pvs[m.child[1]]);
+        pvs[m.child[0]] = {};
+        pvs[m.child[1]] = {};
+      }
+      r[i] = whole ? whole_pvs_cost(base, pvs[i]) : pvs_cost(scene, base, model, pvs[i], m.bounds);
+    }
+    return r;
+  }
   const MergeReplayCuts::Cut* cut = nullptr;
   if (from.history && from.leaf_pvs == &leaf_pvs && from.history->leaf_count == h.leaf_count && from.words == (base.size() + 63) / 64) {
     // The latest cut whose merges h begins with: h's merge nodes compared with from's, in order.
