@@ -564,6 +564,72 @@ TEST(Merge, RefinedBlocksCostLessStayConnectedAndKeepUnitsWhole) {
   EXPECT_THROW(refine_blocks(f.scene, f.partition, pixels, unit, block), Error);
 }
 
+/// Whether two histories are the same, node for node and cost for cost (bitwise).
+void expect_same_history(const MergeHistory& a, const MergeHistory& b, const std::string& what) {
+  ASSERT_EQ(a.nodes.size(), b.nodes.size()) << what;
+  for (size_t k = 0; k < a.nodes.size(); ++k) {
+    EXPECT_EQ(a.nodes[k].child[0], b.nodes[k].child[0]) << what << ", node " << k;
+    EXPECT_EQ(a.nodes[k].child[1], b.nodes[k].child[1]) << what << ", node " << k;
+    EXPECT_EQ(a.nodes[k].parent, b.nodes[k].parent) << what << ", node " << k;
+    EXPECT_EQ(a.nodes[k].pvs_cost, b.nodes[k].pvs_cost) << what << ", node " << k;
+    EXPECT_EQ(a.nodes[k].weight, b.nodes[k].weight) << what << ", node " << k;
+  }
+  EXPECT_EQ(a.cost_after, b.cost_after) << what;
+  EXPECT_EQ(a.initial_cost, b.initial_cost) << what;
+  EXPECT_EQ(a.stats.evaluations, b.stats.evaluations) << what;
+  EXPECT_EQ(a.stats.stale, b.stats.stale) << what;
+}
+
+TEST(Merge, SharedPrefixGivesEachConfigItsOwnHistory) {
+  const Fixture f = office(90);
+  for (const bool pixel : {false, true}) {  // narrow and wide ids
+    const CostModel model = pixel ? CostModel{100, 1, 0.01} : CostModel{};
+    std::vector<MergeConfig> configs;
+    auto add = [&](size_t start, uint32_t barrier, uint32_t min_cells) {
+      MergeConfig c;
+      c.show_progress = false;
+      c.prefix = subdivision_prefix(f.sub, start);
+      c.barrier_cells = barrier;
+      if (barrier) c.block = subdivision_blocks(f.sub, barrier);
+      c.min_cells = min_cells;
+      configs.push_back(std::move(c));
+    };
+    add(30, 0, 1);
+    add(90, 0, 1);   // no prefix
+    add(30, 8, 1);   // the same prefix, a barrier below it
+    add(60, 15, 1);
+    add(12, 0, 20);  // stops inside its prefix, at 20 cells
+    add(6, 0, 1);
+    add(1, 0, 1);    // the whole prefix: nothing left to choose
+    add(60, 0, 3);
+    std::vector<MergeHistory> shared(configs.size());
+    std::vector<int> calls(configs.size(), 0);
+    merge_cells_sharing_prefix(f.scene, f.partition, model, configs, [&](size_t i, MergeHistory h) {
+      ++calls[i];  // each config's own slot: no two calls write the same one
+      shared[i] = std::move(h);
+    });
+    for (size_t i = 0; i < configs.size(); ++i) {
+      const std::string what = std::string(pixel ? "pixel term, " : "") + "config " + std::to_string(i);
+      EXPECT_EQ(calls[i], 1) << what;
+      expect_same_history(shared[i], merge_cells(f.scene, f.partition, model, configs[i]), what);
+    }
+    EXPECT_EQ(shared[4].min_cells(), 20u);
+    EXPECT_EQ(shared[6].stats.evaluations, 0u);
+  }
+  // Prefixes that are not the first merges of the longest are refused; so is a bad config.
+  MergeConfig a, b;
+  a.show_progress = b.show_progress = false;
+  a.prefix = subdivision_prefix(f.sub, 30);
+  b.prefix = {{1, 2}};
+  auto ignore = [](size_t, MergeHistory) {};
+  EXPECT_THROW(merge_cells_sharing_prefix(f.scene, f.partition, CostModel{}, {a, b}, ignore), Error);
+  b.prefix = subdivision_prefix(f.sub, 40);
+  b.block = {0, 1};
+  b.barrier_cells = 2;
+  EXPECT_THROW(merge_cells_sharing_prefix(f.scene, f.partition, CostModel{}, {a, b}, ignore), Error);
+  merge_cells_sharing_prefix(f.scene, f.partition, CostModel{}, {}, ignore);  // nothing to do
+}
+
 TEST(Merge, PrefixAndBlocksAreChecked) {
   const Fixture f = office(20);
   MergeConfig config;

@@ -9,6 +9,7 @@
 #include <tbb/parallel_for.h>
 
 #include "viewcells/core/error.h"
+#include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/eval/evaluate.h"
 
@@ -182,9 +183,9 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
     if (st.refined) c.block = refine_blocks(scene, partition, model, subdivision_blocks(s, st.cells), c.block);
     return c;
   };
-  auto history_for = [&](const MergeStart& st) {
-    MergeHistory h = merge_cells(scene, partition, model, config_for(st));
-    if (!st.refined) return h;
+  // A refined candidate's history, from its first merging (config_for) on: at every halving
+  // below its barrier, the cells of the count above moved between the blocks merging reached.
+  auto refined_on = [&](const MergeStart& st, MergeHistory h) {
     for (size_t up = st.barrier, k = up / 2; k >= 4 && h.min_cells() <= k; up = k, k /= 2) {
       const Merges m = merges_by_least_leaf(h);
       const std::vector<int32_t> blocks = cut_labels(m, L, L - k);
@@ -205,9 +206,13 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   std::atomic<uint64_t> evaluations{0}, stale{0};  // the candidates' pair costs, for the report
   const Merges av_s_merges = merges_by_least_leaf(av_s);
   std::vector<Scored> scored(candidates.size());
-  tbb::parallel_for(size_t{0}, candidates.size(), [&](size_t i) {
+  // Every candidate begins with AV-S's own merges down to its start: they are merged once, and
+  // each candidate merges on from a copy of that state (the same history as merging alone).
+  std::vector<MergeConfig> configs(candidates.size());
+  tbb::parallel_for(size_t{0}, candidates.size(), [&](size_t i) { configs[i] = config_for(candidates[i]); });
+  merge_cells_sharing_prefix(scene, partition, model, configs, [&](size_t i, MergeHistory first) {
     MergeStart& st = candidates[i];
-    const MergeHistory h = history_for(st);
+    const MergeHistory h = st.refined ? refined_on(st, std::move(first)) : std::move(first);
     evaluations += h.stats.evaluations;
     stale += h.stats.stale;
     Scored& sc = scored[i];
@@ -219,6 +224,11 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
     if (config.merge.show_progress) progress.advance(1);
   });
   if (config.merge.show_progress) progress.finish();
+  configs.clear();
+  configs.shrink_to_fit();
+  // The candidates' merges freed much in both threads' arenas: returned before the chosen
+  // history is merged again with every sample's PVSs, whose peak is the build's.
+  release_free_memory();
   sum.starts.insert(sum.starts.end(), candidates.begin(), candidates.end());
 
   // The choice, per range of counts. tails[c]: the best history below AV-S's cut at c cells,

@@ -9,6 +9,7 @@
 /// It works on any partition of the view space into cells with PVSs and a neighbour relation:
 /// the leaves of our AV-S subdivision, or a kD-tree's cells.
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -96,6 +97,16 @@ struct MergeConfig {
 /// Deterministic: ties go to the pair with the smaller node ids.
 MergeHistory merge_cells(const Scene& scene, const CellPartition& partition, const CostModel& model,
                          const MergeConfig& config = {});
+
+/// merge_cells for each of `configs`, in parallel, with the same histories as merge_cells gives
+/// each: configs whose prefixes are the first merges of one longest prefix (subdivision_prefix
+/// at several counts, say) share its merges, which are done once; at each config's end of it,
+/// a copy of that state merges on greedily as the config says. `done(i, history)` receives
+/// configs[i]'s history as soon as it is ready, on any thread. Throws if a prefix is not the
+/// first merges of the longest.
+void merge_cells_sharing_prefix(const Scene& scene, const CellPartition& partition, const CostModel& model,
+                                const std::vector<MergeConfig>& configs,
+                                const std::function<void(size_t, MergeHistory)>& done);
 
 /// The subdivision's splits undone, the last first, down to `cells` cells, as merges of the
 /// partition_from_subdivision(s, ...) cells (MergeConfig::prefix): its cuts are then exactly
