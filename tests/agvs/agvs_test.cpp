@@ -134,8 +134,11 @@ TEST(Agvs, CellsOfASegmentAreThoseOfTheLeavesItPierces) {
     c[plane.axis] = plane.offset;
     segments.push_back({point(), c});
   }
+  // And one cell for everything: the walk stops at the root.
+  std::vector<int32_t> one(s.nodes.size(), -1);
+  for (int32_t l : leaves) one[l] = 0;
   size_t several_leaves_a_cell = 0;
-  for (const std::vector<int32_t>* cells_of : {&by_subtree, &dealt}) {
+  for (const std::vector<int32_t>* cells_of : {&by_subtree, &dealt, &one}) {
     const std::vector<int32_t>& leaf_cell = *cells_of;
     const uint32_t count = 1 + static_cast<uint32_t>(*std::max_element(leaf_cell.begin(), leaf_cell.end()));
     const CellLocator cells(s, leaf_cell, count);

@@ -85,6 +85,27 @@ TEST(Evaluate, TheWalksOrderChangesNoList) {
   EXPECT_THROW(evaluation_pvs(s, segs, std::vector<size_t>(3, 0)), Error);
 }
 
+TEST(Evaluate, WalksGiveTheSubdivisionsOwnLeafLists) {
+  // The evaluator walks a compact copy of the tree (inner nodes depth first, leaves named by
+  // ordinal): per leaf, exactly the objects the subdivision's own walk gives (leaf_pvs), with
+  // planes that are not axis-aligned (the rotated office), and for a tree that is one leaf,
+  // whose list gathers every segment's objects, far more than 4,096 before duplicates go.
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 1});
+  const SegmentSet segs = sample(scene, 20000, 1);
+  for (const uint32_t cells : {80u, 1u}) {
+    const Subdivision s = build(scene, segs, "av-s", cells);
+    ASSERT_EQ(s.leaf_count(), cells);
+    const auto pvs = evaluation_pvs(s, segs);
+    EXPECT_EQ(pvs, leaf_pvs(s, segs)) << cells << " cells";
+    size_t entries = 0;
+    for (const auto& l : pvs) entries += l.size();
+    EXPECT_GT(entries, 0u);
+  }
+  bool rotated = false;
+  for (const Plane& p : build(scene, segs, "av-s", 80).planes) rotated |= p.axis < 0;
+  EXPECT_TRUE(rotated) << "no plane that is not axis-aligned: the test would not walk one";
+}
+
 TEST(Evaluate, ReplaysFromASharedCutGiveTheSameCosts) {
   // The validated merge scores histories that begin with AV-S's own merges from AV-S's replay
   // kept at their starts: exactly the costs of replaying them from the leaves, whether they

@@ -31,12 +31,12 @@ inline double cut_parameter(double t0, double t1, double d0, double d1) {
 /// leaf (a part not in a plane has an end off it), so a walk that stops early at a node
 /// reports what the walk below it would reach. `tree` gives, per inner node n, axis(n) (the
 /// axis of an axis-aligned plane, else -1), offset(n) (an axis-aligned plane's coordinate),
-/// plane(n) (the plane, for the others) and child(n, k).
+/// plane(n) (the plane, for the others) and child(n, k); the walk starts at node `root`.
 template <class Tree, class Stop>
 void walk_segment(const Tree& tree, const Vec3& a, const Vec3& b,
-                  std::vector<std::tuple<int32_t, double, double>>& stack, Stop&& stop) {
+                  std::vector<std::tuple<int32_t, double, double>>& stack, Stop&& stop, int32_t root = 0) {
   stack.clear();
-  stack.emplace_back(0, 0.0, 1.0);
+  stack.emplace_back(root, 0.0, 1.0);
   while (!stack.empty()) {
     const auto [n, t0, t1] = stack.back();
     stack.pop_back();

@@ -28,32 +28,51 @@ CellLocator::CellLocator(Subdivision bsp, std::vector<int32_t> leaf_cell, uint32
   });
   for (uint32_t c = 0; c < cell_count_; ++c)
     if (!(volume_[c] > 0)) throw Error("view cell " + std::to_string(c) + " has no volume");
-  // The tree as segments walk it, compactly: per node its plane's axis and offset (or the
-  // plane itself, for the few that are not axis-aligned), its children, and its cell when its
-  // whole subtree lies in one (-1 otherwise, found children first), where a walk stops.
-  walk_.assign(bsp_.nodes.size(), WalkNode{});
+  // The tree as segments walk it, compactly: the cell of each node's whole subtree, or -1
+  // (children first), then the nodes with -1 in depth-first order, per node its plane's axis
+  // and offset (or the plane itself, for the few that are not axis-aligned) and its children.
+  std::vector<int32_t> cell(bsp_.nodes.size(), -1);
   std::vector<std::pair<int32_t, bool>> stack{{0, false}};
   while (!stack.empty()) {
     const auto [n, children_done] = stack.back();
     stack.pop_back();
     const BspNode& node = bsp_.nodes[n];
-    WalkNode& w = walk_[n];
     if (node.plane < 0) {
-      w.cell = leaf_cell_[n];
+      cell[n] = leaf_cell_[n];
     } else if (children_done) {
-      const Plane& plane = bsp_.planes[node.plane];
-      w.axis = plane.axis;
-      w.offset = plane.offset;
-      w.plane = node.plane;
-      w.child[0] = node.child[0];
-      w.child[1] = node.child[1];
-      const int32_t c0 = walk_[node.child[0]].cell, c1 = walk_[node.child[1]].cell;
-      w.cell = c0 >= 0 && c0 == c1 ? c0 : -1;
+      const int32_t c0 = cell[node.child[0]], c1 = cell[node.child[1]];
+      cell[n] = c0 >= 0 && c0 == c1 ? c0 : -1;
     } else {
       stack.push_back({n, true});
       stack.push_back({node.child[0], false});
       stack.push_back({node.child[1], false});
     }
+  }
+  std::vector<int32_t> id(bsp_.nodes.size()), order;
+  std::vector<int32_t> todo{0};
+  while (!todo.empty()) {
+    const int32_t n = todo.back();
+    todo.pop_back();
+    if (cell[n] >= 0) {
+      id[n] = ~cell[n];
+      continue;
+    }
+    id[n] = static_cast<int32_t>(order.size());
+    order.push_back(n);
+    todo.push_back(bsp_.nodes[n].child[1]);
+    todo.push_back(bsp_.nodes[n].child[0]);
+  }
+  walk_root_ = id[0];
+  walk_.assign(order.size(), WalkNode{});
+  for (size_t i = 0; i < order.size(); ++i) {
+    const BspNode& node = bsp_.nodes[order[i]];
+    const Plane& plane = bsp_.planes[node.plane];
+    WalkNode& w = walk_[i];
+    w.axis = plane.axis;
+    w.offset = plane.offset;
+    w.plane = node.plane;
+    w.child[0] = id[node.child[0]];
+    w.child[1] = id[node.child[1]];
   }
 }
 
@@ -70,11 +89,14 @@ void CellLocator::cells_of_segment(const Vec3& a, const Vec3& b, std::vector<int
     const Plane& plane(int32_t n) const { return planes[walk[n].plane]; }
     int32_t child(int32_t n, int k) const { return walk[n].child[k]; }
   };
-  bsp_detail::walk_segment(Tree{walk_, bsp_.planes}, a, b, stack, [&](int32_t n, double, double) {
-    if (walk_[n].cell < 0) return false;
-    out.push_back(walk_[n].cell);
-    return true;
-  });
+  bsp_detail::walk_segment(
+      Tree{walk_, bsp_.planes}, a, b, stack,
+      [&](int32_t n, double, double) {
+        if (n >= 0) return false;
+        out.push_back(~n);
+        return true;
+      },
+      walk_root_);
   std::sort(out.begin(), out.end());
   out.erase(std::unique(out.begin(), out.end()), out.end());
 }

@@ -33,20 +33,47 @@ namespace {
 /// half the memory reads. The evaluation walks every evaluation segment down every tree.
 class WalkTree {
  public:
-  explicit WalkTree(const Subdivision& s) : s_(s), nodes_(s.nodes.size()) {
-    for (size_t n = 0; n < nodes_.size(); ++n) {
+  /// The inner nodes in depth-first order (a node's first child right after it); a child that
+  /// is a leaf is named by ~(its leaf ordinal), so that reaching a leaf reads no node: the walk
+  /// reads only the inner nodes, half as many bytes as the whole tree (on the city's 50k
+  /// cells, 1.2 MB against 2.4 MB, about what the core's own cache holds).
+  explicit WalkTree(const Subdivision& s) : s_(s) {
+    std::vector<int32_t> id(s.nodes.size(), -1), order;
+    std::vector<int32_t> stack{0};
+    while (!stack.empty()) {
+      const int32_t n = stack.back();
+      stack.pop_back();
       const BspNode& bn = s.nodes[n];
-      Node& w = nodes_[n];
-      w.plane = bn.plane;
-      if (bn.plane < 0) continue;
+      if (bn.plane < 0) {
+        id[n] = ~static_cast<int32_t>(leaf_nodes_.size());
+        leaf_nodes_.push_back(n);
+        continue;
+      }
+      id[n] = static_cast<int32_t>(order.size());
+      order.push_back(n);
+      stack.push_back(bn.child[1]);
+      stack.push_back(bn.child[0]);
+    }
+    root_ = id[0];
+    nodes_.resize(order.size());
+    for (size_t i = 0; i < order.size(); ++i) {
+      const BspNode& bn = s.nodes[order[i]];
+      Node& w = nodes_[i];
       const Plane& p = s.planes[bn.plane];
+      w.plane = bn.plane;
       w.axis = p.axis;
       w.offset = p.offset;
-      w.child[0] = bn.child[0];
-      w.child[1] = bn.child[1];
+      w.child[0] = id[bn.child[0]];
+      w.child[1] = id[bn.child[1]];
     }
   }
-  bool leaf(int32_t n) const { return nodes_[n].plane < 0; }
+  int32_t root() const { return root_; }
+  /// Whether walk node n is a leaf, and which leaf (0 .. leaves() - 1).
+  static bool leaf(int32_t n) { return n < 0; }
+  static uint32_t leaf_ordinal(int32_t n) { return static_cast<uint32_t>(~n); }
+  size_t leaves() const { return leaf_nodes_.size(); }
+  /// The BSP node of leaf ordinal k.
+  int32_t leaf_node(size_t k) const { return leaf_nodes_[k]; }
   int axis(int32_t n) const { return nodes_[n].axis; }
   double offset(int32_t n) const { return nodes_[n].offset; }
   const Plane& plane(int32_t n) const { return s_.planes[nodes_[n].plane]; }
@@ -60,6 +87,33 @@ class WalkTree {
   };
   const Subdivision& s_;
   std::vector<Node> nodes_;
+  std::vector<int32_t> leaf_nodes_;
+  int32_t root_ = 0;
+};
+
+/// One thread's objects per leaf (by ordinal), as the walks meet them: duplicates are the rule
+/// (segments in Z-order meet the same leaves with the same objects), so a leaf skips the pair of
+/// objects it got last, and an object equal to its list's last; a list is sorted and made
+/// unique in place whenever it doubles past 4,096 entries.
+struct LeafLists {
+  explicit LeafLists(size_t leaves) : lists(leaves), last(leaves, ~uint64_t{0}), limit(leaves, kFirstLimit) {}
+  void add(uint32_t leaf, uint32_t a, uint32_t b) {
+    const uint64_t key = (uint64_t{a} << 32) | b;
+    if (last[leaf] == key) return;
+    last[leaf] = key;
+    std::vector<uint32_t>& l = lists[leaf];
+    for (uint32_t o : {a, b})
+      if (o != kNoObject && (l.empty() || l.back() != o)) l.push_back(o);
+    if (l.size() >= limit[leaf]) {
+      std::sort(l.begin(), l.end());
+      l.erase(std::unique(l.begin(), l.end()), l.end());
+      limit[leaf] = std::max<uint32_t>(kFirstLimit, 2 * static_cast<uint32_t>(l.size()));
+    }
+  }
+  static constexpr uint32_t kFirstLimit = 4096;
+  std::vector<std::vector<uint32_t>> lists;
+  std::vector<uint64_t> last;    ///< the objects of the segment a leaf got last
+  std::vector<uint32_t> limit;   ///< the size at which a list is next made unique
 };
 
 }  // namespace
@@ -75,37 +129,39 @@ std::vector<std::vector<uint32_t>> evaluation_pvs(const Subdivision& s, const Se
   if (s.nodes.empty()) throw Error("evaluation needs a subdivision");
   if (order.size() != eval.size()) throw Error("evaluation_pvs: the order is not one of the segments");
   const WalkTree tree(s);
-  using Lists = std::vector<std::vector<uint32_t>>;
-  tbb::enumerable_thread_specific<Lists> per_thread([&] { return Lists(s.nodes.size()); });
+  tbb::enumerable_thread_specific<LeafLists> per_thread([&] { return LeafLists(tree.leaves()); });
   tbb::parallel_for(tbb::blocked_range<size_t>(0, eval.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-    Lists& lists = per_thread.local();
-    std::vector<int32_t> leaves;
+    LeafLists& lists = per_thread.local();
     std::vector<std::tuple<int32_t, double, double>> stack;
     for (size_t k = r.begin(); k < r.end(); ++k) {
       const size_t i = order[k];
-      leaves.clear();
-      bsp_detail::walk_segment(tree, eval.a(i), eval.b(i), stack, [&](int32_t n, double, double) {
-        if (!tree.leaf(n)) return false;
-        leaves.push_back(n);
-        return true;
-      });
-      for (int32_t l : leaves)
-        for (uint32_t o : {eval.object_a[i], eval.object_b[i]})
-          if (o != kNoObject && (lists[l].empty() || lists[l].back() != o)) lists[l].push_back(o);
+      const uint32_t a = eval.object_a[i], b = eval.object_b[i];
+      bsp_detail::walk_segment(
+          tree, eval.a(i), eval.b(i), stack,
+          [&](int32_t n, double, double) {
+            if (!WalkTree::leaf(n)) return false;
+            lists.add(WalkTree::leaf_ordinal(n), a, b);
+            return true;
+          },
+          tree.root());
     }
-    // Keep the lists short: duplicates are the rule (many segments see the same objects).
-    for (auto& l : lists)
-      if (l.size() > 4096) {
-        std::sort(l.begin(), l.end());
-        l.erase(std::unique(l.begin(), l.end()), l.end());
-      }
   });
-  Lists out(s.nodes.size());
-  for (Lists& lists : per_thread)
-    for (size_t n = 0; n < lists.size(); ++n) out[n].insert(out[n].end(), lists[n].begin(), lists[n].end());
-  tbb::parallel_for(size_t{0}, out.size(), [&](size_t n) {
-    std::sort(out[n].begin(), out[n].end());
-    out[n].erase(std::unique(out[n].begin(), out[n].end()), out[n].end());
+  std::vector<LeafLists*> threads;
+  for (LeafLists& lists : per_thread) threads.push_back(&lists);
+  std::vector<std::vector<uint32_t>> out(s.nodes.size());
+  tbb::parallel_for(size_t{0}, tree.leaves(), [&](size_t k) {
+    std::vector<uint32_t>& l = out[tree.leaf_node(k)];
+    for (LeafLists* t : threads) {
+      std::vector<uint32_t>& from = t->lists[k];
+      if (l.empty()) {
+        l.swap(from);
+      } else {
+        l.insert(l.end(), from.begin(), from.end());
+      }
+      from = {};
+    }
+    std::sort(l.begin(), l.end());
+    l.erase(std::unique(l.begin(), l.end()), l.end());
   });
   return out;
 }

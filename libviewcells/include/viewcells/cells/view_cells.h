@@ -37,14 +37,16 @@ class CellLocator {
  private:
   Subdivision bsp_;
   std::vector<int32_t> leaf_cell_;
-  /// Per BSP node, what a segment's walk reads (see the constructor): 32 bytes.
+  /// The nodes a segment's walk descends (those whose subtree holds more than one cell), depth
+  /// first, a node's first child right after it: 24 bytes each. A child whose subtree lies in
+  /// one cell c is named ~c, where the walk stops without reading a node.
   struct WalkNode {
     double offset = 0;
     int32_t child[2] = {-1, -1};
     int32_t axis = -1, plane = -1;
-    int32_t cell = -1;  ///< the cell of the node's whole subtree, or -1
   };
   std::vector<WalkNode> walk_;
+  int32_t walk_root_ = 0;  ///< the root as the walk names it (~c if it is all cell c)
   uint32_t cell_count_ = 0;
   std::vector<Box3> bounds_;
   std::vector<double> volume_;
