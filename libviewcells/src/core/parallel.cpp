@@ -3,10 +3,6 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
-#if defined(__GLIBC__)
-#include <malloc.h>
-#endif
-
 namespace viewcells {
 
 struct ThreadLimit::Impl {
@@ -25,12 +21,6 @@ int hardware_threads() { return tbb::info::default_concurrency(); }
 
 int worker_threads() {
   return static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-}
-
-void release_free_memory() {
-#if defined(__GLIBC__)
-  malloc_trim(0);
-#endif
 }
 
 }  // namespace viewcells

@@ -8,8 +8,8 @@
 
 #include <tbb/parallel_for.h>
 
+#include "viewcells/bsp/cost_model.h"
 #include "viewcells/core/error.h"
-#include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/eval/evaluate.h"
 
@@ -105,7 +105,7 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   MergeSummary& sum = out.summary;
   sum.validated = true;
   Stopwatch t;
-  const LeafPvsRun a = leaf_pvs_by_agvs(scene, caster, s, config.agvs, base);
+  LeafPvsRun a = leaf_pvs_by_agvs(scene, caster, s, config.agvs, base);
   base.clear();
   AgvsConfig vc = config.agvs;
   vc.seed += 1;
@@ -127,7 +127,7 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   sum.leaf_pvs_seconds = t.seconds();
 
   t.restart();
-  CellPartition partition = partition_from_subdivision(s, a.pvs);
+  CellPartition partition = partition_from_subdivision(s, std::move(a.pvs));
   sum.neighbour_seconds = t.seconds();
 
   t.restart();
@@ -226,9 +226,6 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   if (config.merge.show_progress) progress.finish();
   configs.clear();
   configs.shrink_to_fit();
-  // The candidates' merges freed much in both threads' arenas: returned before the chosen
-  // history is merged again with every sample's PVSs, whose peak is the build's.
-  release_free_memory();
   sum.starts.insert(sum.starts.end(), candidates.begin(), candidates.end());
 
   // The choice, per range of counts. tails[c]: the best history below AV-S's cut at c cells,
@@ -298,12 +295,15 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   sum.chosen = sum.chain.front().start;
   sum.merge_seconds = t.seconds();
 
-  // The chosen merges, replayed with every sample's PVSs.
+  // The chosen merges, replayed with every sample's PVSs: the same partition (cells and
+  // neighbours), each leaf's list united in place with both held-out sets'.
   t.restart();
-  out.leaf_pvs = a.pvs;
-  unite_into(out.leaf_pvs, b.pvs);
-  if (config.held_out_samples) unite_into(out.leaf_pvs, c_pvs);
-  partition = partition_from_subdivision(s, out.leaf_pvs);
+  const std::vector<int32_t> leaves = s.leaves();
+  tbb::parallel_for(size_t{0}, leaves.size(), [&](size_t i) {
+    std::vector<uint32_t>& l = partition.pvs[i];
+    l = unite_sorted(l, b.pvs[leaves[i]]);
+    if (config.held_out_samples) l = unite_sorted(l, c_pvs[leaves[i]]);
+  });
   sum.neighbour_seconds += t.seconds();
   t.restart();
   mc.prefix = least_leaf_merges_as_prefix(chosen, L);
@@ -312,6 +312,9 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   mc.show_progress = config.merge.show_progress;
   out.history = merge_cells(scene, partition, model, mc);
   sum.merge_seconds += t.seconds();
+  // The leaves' lists, per node, moved out of the partition.
+  out.leaf_pvs.assign(s.nodes.size(), {});
+  for (size_t i = 0; i < leaves.size(); ++i) out.leaf_pvs[leaves[i]] = std::move(partition.pvs[i]);
   // The whole chosen history's held-out score, as the candidates were scored.
   held_out.summarise(held_out.score(scene, s, out.history, model), out.history.min_cells(), sum.chosen);
   out.history.stats.seconds = sum.merge_seconds;

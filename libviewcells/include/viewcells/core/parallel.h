@@ -27,10 +27,4 @@ int hardware_threads();
 /// Threads parallel stages use now (the innermost ThreadLimit's, else all hardware threads).
 int worker_threads();
 
-/// Gives the heap's free pages back to the system (glibc's malloc_trim; nothing elsewhere).
-/// Worker threads allocate from arenas of their own, which keep what a stage freed; a stage
-/// that follows one with many short-lived allocations on several threads then adds its own
-/// peak on top of theirs.
-void release_free_memory();
-
 }  // namespace viewcells
