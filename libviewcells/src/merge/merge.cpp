@@ -393,12 +393,12 @@ class Merger {
     cost_ = h.initial_cost;
   }
 
-  /// Prefix merges [from, to) of `prefix`, while more than `target` cells remain.
-  void prefix(const std::vector<std::pair<int32_t, int32_t>>& prefix, size_t from, size_t to, size_t target,
+  /// Prefix merges [from, to) of `merges`, while more than `target` cells remain.
+  void prefix(const std::vector<std::pair<int32_t, int32_t>>& merges, size_t from, size_t to, size_t target,
               Progress* progress) {
     std::vector<int32_t> around;
     for (size_t j = from; j < to && alive_ > target; ++j) {
-      const auto [x, y] = prefix[j];
+      const auto [x, y] = merges[j];
       check_prefix_pair(x, y);
       merge(x, y, around, std::numeric_limits<double>::quiet_NaN());
       if (progress) progress->advance(1);
