@@ -451,8 +451,6 @@ class Merger {
     return std::move(h_);
   }
 
-  size_t alive() const { return alive_; }
-
  private:
   bool allowed(int32_t x, int32_t y) const { return !constrained_ || block_[x] == block_[y]; }
 
