@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <optional>
 
 #include <tbb/parallel_for.h>
 
@@ -31,13 +32,6 @@ std::vector<int32_t> cut_labels(const Merges& merges, size_t leaves, size_t k) {
   return up;
 }
 
-/// A history's held-out scores at the counts scored (0 where it or AV-S does not reach): the
-/// mean over the held-out sets of log(cost / AV-S's cost), and the largest of them.
-struct CountScores {
-  std::vector<double> log_ratio, worst;
-  std::vector<uint8_t> scored;  ///< 1 where the history and AV-S both reach the count
-};
-
 /// The held-out leaf PVS sets (B, and C when drawn), AV-S's costs on each, and the counts scored.
 struct HeldOut {
   std::vector<const std::vector<std::vector<uint32_t>>*> pvs;
@@ -46,9 +40,9 @@ struct HeldOut {
   std::vector<size_t> counts;
   size_t av_s_min_cells = 1;
 
-  CountScores score(const Scene& scene, const Subdivision& s, const MergeHistory& h, const CostModel& model) const {
-    CountScores out{std::vector<double>(counts.size(), 0.0), std::vector<double>(counts.size(), 0.0),
-                    std::vector<uint8_t>(counts.size(), 0)};
+  CandidateScores score(const Scene& scene, const Subdivision& s, const MergeHistory& h, const CostModel& model) const {
+    CandidateScores out{std::vector<double>(counts.size(), 0.0), std::vector<double>(counts.size(), 0.0),
+                        std::vector<uint8_t>(counts.size(), 0)};
     for (size_t k = 0; k < pvs.size(); ++k) {
       // Every candidate begins with AV-S's own merges down to its start: replayed from there.
       const CostCurve curve = merge_history_curve(h, evaluated_merge_costs(scene, s, h, *pvs[k], model, replays[k]));
@@ -64,7 +58,7 @@ struct HeldOut {
     return out;
   }
   /// The mean over the counts scored, and the worst count, as MergeStart reports them.
-  void summarise(const CountScores& c, size_t min_cells, MergeStart& st) const {
+  void summarise(const CandidateScores& c, size_t min_cells, MergeStart& st) const {
     st.score = 0;
     st.worst = 0;
     size_t terms = 0;
@@ -80,9 +74,8 @@ struct HeldOut {
 
 /// A candidate's scores and merges.
 struct Scored {
-  CountScores at;
-  Merges merges;              ///< by least leaf
-  bool barrier_cut = false;  ///< its cut at its barrier is AV-S's (the barrier held)
+  CandidateScores at;
+  Merges merges;  ///< by least leaf
 };
 
 /// The lowest sum of log ratios for the counts at most `c`, from AV-S's cut at `c` down.
@@ -96,6 +89,73 @@ struct Tail {
 
 bool merge_piece_allowed(double sum, double worst, size_t counts, double worst_allowed) {
   return worst <= worst_allowed && (counts == 0 || worst <= -sum / static_cast<double>(counts));
+}
+
+std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& candidates,
+                                             const std::vector<CandidateScores>& scores,
+                                             const std::vector<size_t>& counts, uint32_t leaves,
+                                             double worst_allowed) {
+  VC_CHECK(scores.size() == candidates.size());
+  for (const CandidateScores& sc : scores)
+    VC_CHECK(sc.log_ratio.size() == counts.size() && sc.worst.size() == counts.size() && sc.scored.size() == counts.size());
+  // tails[c]: the best history below AV-S's cut at c cells, scored on the counts at most c; c
+  // runs over the barriers, upwards, and the leaves.
+  std::vector<uint32_t> ends{leaves};
+  for (const MergeStart& st : candidates)
+    if (st.barrier) ends.push_back(st.barrier);
+  std::sort(ends.begin(), ends.end());
+  ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+  std::vector<Tail> tails(ends.size());
+  auto tail_at = [&](uint32_t c) -> const Tail& {
+    return tails[static_cast<size_t>(std::lower_bound(ends.begin(), ends.end(), c) - ends.begin())];
+  };
+  struct Piece {
+    double sum = 0, worst = 0;
+    size_t counts = 0;
+  };
+  auto piece = [&](size_t i, uint32_t below, uint32_t upto) {  // sum and worst on counts in (below, upto]
+    Piece p;
+    for (size_t j = 0; j < counts.size(); ++j)
+      if (counts[j] > below && counts[j] <= upto) {
+        p.sum += scores[i].log_ratio[j];
+        p.worst = std::max(p.worst, scores[i].worst[j]);
+        p.counts += scores[i].scored[j];
+      }
+    return p;
+  };
+  constexpr double kGain = 1e-9;  // rounding, in a sum of log ratios
+  auto allowed = [&](const Piece& p) { return merge_piece_allowed(p.sum, p.worst, p.counts, worst_allowed); };
+  for (size_t e = 0; e < ends.size(); ++e) {
+    const uint32_t c = ends[e];
+    Tail best;  // AV-S's own order: 0
+    for (size_t i = 0; i < candidates.size(); ++i) {
+      const MergeStart& st = candidates[i];
+      if (st.cells > c) continue;
+      // This candidate's option: whole, or down to its barrier and the best tail there when
+      // that does at least as well.
+      const Piece whole = piece(i, 0, c);
+      std::optional<Tail> option;
+      if (allowed(whole)) option = Tail{whole.sum, whole.worst, static_cast<int>(i), false};
+      if (st.barrier && scores[i].barrier_cut) {
+        const Piece upper = piece(i, st.barrier, c);
+        const Tail& below = tail_at(st.barrier);
+        const double split = upper.sum + below.sum;
+        if (allowed(upper) && (!option || split <= option->sum + kGain))
+          option = Tail{split, std::max(upper.worst, below.worst), static_cast<int>(i), true};
+      }
+      if (option && option->sum < best.sum - kGain) best = *option;
+    }
+    tails[e] = best;
+  }
+  std::vector<ChosenPiece> out;  // from the leaves down
+  for (uint32_t c = leaves;;) {
+    const Tail& tail = tail_at(c);
+    const uint32_t to = tail.split ? candidates[static_cast<size_t>(tail.candidate)].barrier : 0;
+    out.push_back({tail.candidate, c, to});
+    if (!tail.split) break;
+    c = to;
+  }
+  return out;
 }
 
 LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Subdivision& s,
@@ -219,7 +279,7 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
     sc.at = held_out.score(scene, s, h, model);
     held_out.summarise(sc.at, h.min_cells(), st);
     sc.merges = merges_by_least_leaf(h);
-    sc.barrier_cut = st.barrier && h.min_cells() <= st.barrier &&
+    sc.at.barrier_cut = st.barrier && h.min_cells() <= st.barrier &&
                      cut_labels(sc.merges, L, L - st.barrier) == cut_labels(av_s_merges, L, L - st.barrier);
     if (config.merge.show_progress) progress.advance(1);
   });
@@ -228,69 +288,21 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   configs.shrink_to_fit();
   sum.starts.insert(sum.starts.end(), candidates.begin(), candidates.end());
 
-  // The choice, per range of counts. tails[c]: the best history below AV-S's cut at c cells,
-  // scored on the counts at most c; c runs over the barriers, upwards, and the leaves. Each
-  // candidate is taken whole (its own merges to the end) or down to its barrier, where its
-  // cut is AV-S's and the best tail there goes on. Every piece keeps each of its counts
-  // within the allowance. Ties keep the earlier option (AV-S's own order first, whole
-  // before split), and a split must gain more than rounding, so a single candidate is
-  // chosen as before unless pieces do better.
-  std::vector<uint32_t> ends{static_cast<uint32_t>(L)};
-  for (const MergeStart& st : candidates)
-    if (st.barrier) ends.push_back(st.barrier);
-  std::sort(ends.begin(), ends.end());
-  ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
-  std::vector<Tail> tails(ends.size());
-  auto tail_at = [&](uint32_t c) -> const Tail& {
-    return tails[static_cast<size_t>(std::lower_bound(ends.begin(), ends.end(), c) - ends.begin())];
-  };
-  struct Piece {
-    double sum = 0, worst = 0;
-    size_t counts = 0;
-  };
-  auto piece = [&](size_t i, uint32_t below, uint32_t upto) {  // sum and worst on counts in (below, upto]
-    Piece p;
-    for (size_t j = 0; j < counts.size(); ++j)
-      if (counts[j] > below && counts[j] <= upto) {
-        p.sum += scored[i].at.log_ratio[j];
-        p.worst = std::max(p.worst, scored[i].at.worst[j]);
-        p.counts += scored[i].at.scored[j];
-      }
-    return p;
-  };
-  constexpr double kGain = 1e-9;  // a split must beat the whole by more than rounding
-  auto allowed = [&](const Piece& p) { return merge_piece_allowed(p.sum, p.worst, p.counts, config.worst_allowed); };
-  for (size_t e = 0; e < ends.size(); ++e) {
-    const uint32_t c = ends[e];
-    Tail best;  // AV-S's own order: 0
-    for (size_t i = 0; i < candidates.size(); ++i) {
-      const MergeStart& st = candidates[i];
-      if (st.cells > c) continue;
-      const Piece whole = piece(i, 0, c);
-      if (allowed(whole) && whole.sum < best.sum) best = {whole.sum, whole.worst, static_cast<int>(i), false};
-      if (!st.barrier || !scored[i].barrier_cut) continue;
-      const Piece upper = piece(i, st.barrier, c);
-      const Tail& below = tail_at(st.barrier);
-      if (allowed(upper) && upper.sum + below.sum < best.sum - kGain)
-        best = {upper.sum + below.sum, std::max(upper.worst, below.worst), static_cast<int>(i), true};
-    }
-    tails[e] = best;
-  }
+  std::vector<CandidateScores> scores;
+  for (Scored& sc : scored) scores.push_back(std::move(sc.at));
+  const std::vector<ChosenPiece> pieces =
+      choose_merge_pieces(candidates, scores, counts, static_cast<uint32_t>(L), config.worst_allowed);
 
   // The chosen history's merges, piece by piece, named by least leaf.
   Merges chosen;
-  for (uint32_t c = static_cast<uint32_t>(L);;) {
-    const Tail& tail = tail_at(c);
-    const Merges& m = tail.candidate < 0 ? av_s_merges : scored[static_cast<size_t>(tail.candidate)].merges;
+  for (const ChosenPiece& p : pieces) {
+    const Merges& m = p.candidate < 0 ? av_s_merges : scored[static_cast<size_t>(p.candidate)].merges;
     const MergeStart st =
-        tail.candidate < 0 ? MergeStart{1, 0, 0.0, 0.0} : candidates[static_cast<size_t>(tail.candidate)];
-    const uint32_t to = tail.split ? st.barrier : 0;
-    const size_t first = L - c, last = tail.split ? L - to : m.size();
+        p.candidate < 0 ? MergeStart{1, 0, 0.0, 0.0} : candidates[static_cast<size_t>(p.candidate)];
+    const size_t first = L - p.from, last = p.to ? L - p.to : m.size();
     chosen.insert(chosen.end(), m.begin() + static_cast<std::ptrdiff_t>(std::min(first, m.size())),
                   m.begin() + static_cast<std::ptrdiff_t>(std::min(last, m.size())));
-    sum.chain.push_back({st, c, to});
-    if (!tail.split) break;
-    c = to;
+    sum.chain.push_back({st, p.from, p.to});
   }
   sum.chosen = sum.chain.front().start;
   sum.merge_seconds = t.seconds();
