@@ -107,6 +107,45 @@ TEST(Evaluate, WalksGiveTheSubdivisionsOwnLeafLists) {
   EXPECT_TRUE(rotated) << "no plane that is not axis-aligned: the test would not walk one";
 }
 
+TEST(Evaluate, BitsAndListsGatherTheSameLeafListsSetAfterSet) {
+  // Both ways of gathering a leaf's objects (a row of bits per leaf, or lists made unique)
+  // give the subdivision's own lists, walked at once or a set at a time (as the validated merge
+  // and compare add the sets they draw), and read out between sets as well.
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 1});
+  const SegmentSet segs = sample(scene, 20000, 1);
+  const Subdivision s = build(scene, segs, "av-s", 80);
+  const std::vector<SegmentSet> sets{sample(scene, 5000, 2), sample(scene, 7000, 3), sample(scene, 3000, 4)};
+  SegmentSet all = sets[0], first_two = sets[0];
+  all.append(sets[1]);
+  all.append(sets[2]);
+  first_two.append(sets[1]);
+  // leaf_pvs reads the segments the subdivision kept: the construction set's lists.
+  auto at_once = [&](const SegmentSet& set, LeafGather gather) {
+    return evaluation_pvs(s, set, coherent_order(set, s.view_box), gather);
+  };
+  const auto all_lists = at_once(all, LeafGather::kLists), first_two_lists = at_once(first_two, LeafGather::kLists);
+  size_t entries = 0;
+  for (const auto& l : all_lists) entries += l.size();
+  EXPECT_GT(entries, 80u);
+  for (const LeafGather gather : {LeafGather::kLists, LeafGather::kBits}) {
+    EXPECT_EQ(at_once(segs, gather), leaf_pvs(s, segs));
+    EXPECT_EQ(at_once(all, gather), all_lists);
+    EvaluationPvs gathered(s, scene.objects.size(), gather);
+    EXPECT_EQ(gathered.bits(), gather == LeafGather::kBits);
+    gathered.add(sets[0]);
+    gathered.add(sets[1]);
+    EXPECT_EQ(gathered.lists(), first_two_lists) << "read out between sets";
+    gathered.add(sets[2], coherent_order(sets[2], s.view_box));
+    EXPECT_EQ(gathered.lists(), all_lists);
+    // An object the scene does not have is an error, not a write beyond the rows.
+    EvaluationPvs too_few(s, 1, gather);
+    EXPECT_THROW(too_few.add(sets[0]), Error);
+  }
+  // Automatic: lists for the office's 100 objects, bits where a row fills a cache line.
+  EXPECT_FALSE(EvaluationPvs(s, scene.objects.size()).bits());
+  EXPECT_TRUE(EvaluationPvs(s, 512).bits());
+}
+
 TEST(Evaluate, ReplaysFromASharedCutGiveTheSameCosts) {
   // The validated merge scores histories that begin with AV-S's own merges from AV-S's replay
   // kept at their starts: exactly the costs of replaying them from the leaves, whether they

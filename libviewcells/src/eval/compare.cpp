@@ -156,8 +156,8 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
     SamplerConfig e = config.evaluation;
     e.seed += k;
     e.show_progress = false;  // one bar for the set, sampling and walking, over both parts
-    std::vector<Lists> pvs;  // per distinct tree: its leaves' evaluation PVSs so far
-    for (const auto& t : trees) pvs.emplace_back(t->nodes.size());
+    std::vector<EvaluationPvs> gathered;  // per distinct tree: its leaves' evaluation PVSs so far
+    for (const auto& t : trees) gathered.emplace_back(*t, scene.objects.size());
     const bool first_set = k == 0;
     Progress progress("evaluation set " + std::to_string(k + 1) + " of " + std::to_string(config.evaluation_sets),
                       samples);
@@ -167,7 +167,7 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
       part_drawn = so_far;
       const auto t = std::chrono::steady_clock::now();
       const std::vector<size_t> order = coherent_order(segments, segments.view_box);  // one for every tree
-      for (size_t i = 0; i < trees.size(); ++i) unite_into(pvs[i], evaluation_pvs(*trees[i], segments, order));
+      for (EvaluationPvs& g : gathered) g.add(segments, order);
       if (config.keep_models && first_set) {
         out.evaluation_segments.view_box = segments.view_box;
         out.evaluation_segments.append(segments);
@@ -182,7 +182,9 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
       stats = sample_in_chunks(scene, caster, part, config.evaluation_chunk, use);
       const auto t = std::chrono::steady_clock::now();
       out.evaluation_half_samples = half;
-      for (size_t m = 0; m < out.methods.size(); ++m) out.methods[m].evaluated_half = score(m, pvs, false);
+      std::vector<Lists> half_lists;  // read out; the gathering goes on
+      for (const EvaluationPvs& g : gathered) half_lists.push_back(g.lists());
+      for (size_t m = 0; m < out.methods.size(); ++m) out.methods[m].evaluated_half = score(m, half_lists, false);
       out.evaluation_seconds += seconds_since(t);
       part.samples = samples - half;
       part.first_batch = e.first_batch + half / batch;
@@ -198,8 +200,11 @@ Comparison compare_methods(const Scene& scene, const RayCaster& caster, const Co
       out.evaluation.seconds += stats.seconds;  // the sampling of every set
     }
     const auto t = std::chrono::steady_clock::now();
+    std::vector<Lists> lists;
+    for (EvaluationPvs& g : gathered) lists.push_back(g.take());
+    gathered.clear();
     for (size_t m = 0; m < out.methods.size(); ++m) {
-      CostCurve curve = score(m, pvs, first_set);
+      CostCurve curve = score(m, lists, first_set);
       if (first_set) out.methods[m].evaluated = std::move(curve);
       else out.methods[m].evaluated_more.push_back(std::move(curve));
     }

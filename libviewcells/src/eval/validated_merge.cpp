@@ -178,11 +178,12 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
     sc.show_progress = sc.show_progress && config.merge.show_progress;
     // Drawn and walked a million samples at a time (every leaf each segment has length in),
     // so that the segments are never all held: the same lists as walking them at once.
-    c_pvs.resize(s.nodes.size());
+    EvaluationPvs gathered(s, scene.objects.size());
     sum.held_out_samples =
         sample_in_chunks(scene, caster, sc, kHeldOutChunk, [&](const SegmentSet& chunk, uint64_t) {
-          unite_into(c_pvs, evaluation_pvs(s, chunk));
+          gathered.add(chunk);
         }).samples;
+    c_pvs = gathered.take();
   }
   sum.leaf_pvs_seconds = t.seconds();
 

@@ -4,6 +4,7 @@
 /// method's own refinement order: the split order of a BSP or kd-tree (AV-S and the
 /// baselines), the merge history backwards (AV-M). Construction never sees these samples.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "viewcells/bsp/cost_model.h"
@@ -17,14 +18,47 @@ namespace viewcells {
 /// Per node of `s` (filled for leaves): the sorted objects seen by the segments of `eval`
 /// that have length in the leaf. Parallel; the result does not depend on the thread count.
 std::vector<std::vector<uint32_t>> evaluation_pvs(const Subdivision& s, const SegmentSet& eval);
+/// How evaluation_pvs gathers each leaf's objects; the lists are the same either way.
+/// kLists: per thread, lists that grow as segments meet the leaf, then sorted, made unique and
+/// joined. kBits: one row of bits over the objects per leaf, shared by the threads (a bit is
+/// set atomically where it is not set yet), read out in order at the end: no lists to grow,
+/// sort or join. kAutomatic: bits where the scene has at least 512 objects (a row fills a cache
+/// line) and the rows take at most 512 MB (and, for one call of
+/// evaluation_pvs, at most 64 bytes per segment walked, so that a few segments do not clear and
+/// read rows for every leaf), else lists.
+enum class LeafGather { kAutomatic, kLists, kBits };
+
 /// The same, walking the segments in `order` (a permutation of their indices; the result does
 /// not depend on it, the time does: coherent_order(eval, ...), computed once for many trees).
 std::vector<std::vector<uint32_t>> evaluation_pvs(const Subdivision& s, const SegmentSet& eval,
-                                                  const std::vector<size_t>& order);
+                                                  const std::vector<size_t>& order,
+                                                  LeafGather gather = LeafGather::kAutomatic);
 
-/// Per node, `into[n]` becomes the union of itself and `more[n]` (sorted lists, as
-/// evaluation_pvs gives): the evaluation PVSs of two sets of segments from those of each.
-void unite_into(std::vector<std::vector<uint32_t>>& into, const std::vector<std::vector<uint32_t>>& more);
+/// The evaluation PVSs of a subdivision's leaves from segments added a set at a time (as they
+/// are drawn, so that they are never all held): the same lists as evaluation_pvs on all of them
+/// at once. With bits (LeafGather) each set only
+/// sets bits, and the lists are read out once; else each set's lists are united with the ones
+/// before.
+class EvaluationPvs {
+ public:
+  /// `objects`: more than any object id the segments see (Scene::objects.size()).
+  EvaluationPvs(const Subdivision& s, size_t objects, LeafGather gather = LeafGather::kAutomatic);
+  ~EvaluationPvs();
+  EvaluationPvs(EvaluationPvs&&) noexcept;
+  /// Walks `eval` in `order` (a permutation of its indices), or in coherent_order.
+  void add(const SegmentSet& eval, const std::vector<size_t>& order);
+  void add(const SegmentSet& eval);
+  /// Per node of the subdivision (filled for leaves), from every set added so far.
+  std::vector<std::vector<uint32_t>> lists() const;
+  /// The same, leaving the lists empty where it gathers by lists (no copy).
+  std::vector<std::vector<uint32_t>> take();
+  bool bits() const;  ///< whether it gathers by bits
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 
 /// c(S) against the number of cells.
 struct CostCurve {
