@@ -108,6 +108,7 @@ TEST(Evaluate, WalksGiveTheSubdivisionsOwnLeafLists) {
 }
 
 TEST(Evaluate, BitsAndListsGatherTheSameLeafListsSetAfterSet) {
+  using Lists = std::vector<std::vector<uint32_t>>;
   // Both ways of gathering a leaf's objects (a row of bits per leaf, or lists made unique)
   // give the subdivision's own lists, walked at once or a set at a time (as the validated merge
   // and compare add the sets they draw), and read out between sets as well.
@@ -137,6 +138,10 @@ TEST(Evaluate, BitsAndListsGatherTheSameLeafListsSetAfterSet) {
     EXPECT_EQ(gathered.lists(), first_two_lists) << "read out between sets";
     gathered.add(sets[2], coherent_order(sets[2], s.view_box));
     EXPECT_EQ(gathered.lists(), all_lists);
+    EXPECT_EQ(gathered.take(), all_lists);
+    EXPECT_EQ(gathered.lists(), Lists(s.nodes.size())) << "empty after take";
+    gathered.add(sets[2]);
+    EXPECT_EQ(gathered.take(), at_once(sets[2], LeafGather::kLists));
     // An object the scene does not have is an error, not a write beyond the rows.
     EvaluationPvs too_few(s, 1, gather);
     EXPECT_THROW(too_few.add(sets[0]), Error);

@@ -119,6 +119,7 @@ class LeafBits {
     const uint64_t m = uint64_t{1} << (o % 64);
     if (!(__atomic_load_n(w, __ATOMIC_RELAXED) & m)) __atomic_fetch_or(w, m, __ATOMIC_RELAXED);
   }
+  void clear() { std::fill(bits_.begin(), bits_.end(), 0); }
   std::vector<uint32_t> list(size_t leaf) const {
     const uint64_t* row = &bits_[leaf * words_];
     size_t n = 0;
@@ -135,10 +136,6 @@ class LeafBits {
   size_t words_;
   std::vector<uint64_t> bits_;
 };
-
-}  // namespace
-
-namespace {
 
 /// Walks segment order[k], k in r, down `tree`, calling add(leaf ordinal, object a, object b)
 /// for every leaf it has length in.
@@ -253,7 +250,11 @@ void EvaluationPvs::add(const SegmentSet& eval, const std::vector<size_t>& order
 void EvaluationPvs::add(const SegmentSet& eval) { impl_->add(eval, coherent_order(eval, impl_->s.view_box)); }
 std::vector<std::vector<uint32_t>> EvaluationPvs::lists() const { return impl_->read(); }
 std::vector<std::vector<uint32_t>> EvaluationPvs::take() {
-  if (impl_->bits) return impl_->read();
+  if (impl_->bits) {
+    std::vector<std::vector<uint32_t>> out = impl_->read();
+    impl_->bits->clear();
+    return out;
+  }
   std::vector<std::vector<uint32_t>> out(impl_->s.nodes.size());
   out.swap(impl_->lists);
   return out;

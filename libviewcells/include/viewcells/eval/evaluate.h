@@ -50,7 +50,7 @@ class EvaluationPvs {
   void add(const SegmentSet& eval);
   /// Per node of the subdivision (filled for leaves), from every set added so far.
   std::vector<std::vector<uint32_t>> lists() const;
-  /// The same, leaving the lists empty where it gathers by lists (no copy).
+  /// The same, moved out (no copy of the lists): it is then empty, as if nothing had been added.
   std::vector<std::vector<uint32_t>> take();
   bool bits() const;  ///< whether it gathers by bits
 
