@@ -74,10 +74,10 @@ struct SubdivisionConfig {
   /// How the axis-aligned positions of a cell are drawn when it has more segment ends than
   /// max_axis_candidates. Exact (the paper's): a uniform random subset of the distinct end
   /// coordinates, which needs them all sorted (O(n log n) per cell and axis). Fast (the
-  /// default, once a cell has more than 4 x max_axis_candidates ends): the ends of a run of
-  /// the cell's parts from a random one on, until max_axis_candidates distinct ones per axis
-  /// (or 2 x as many parts read), so coordinates where many segments end (walls) are likelier:
-  /// O(k log k). Either way every chosen position is evaluated exactly.
+  /// default, once a cell has more than 4 x max_axis_candidates ends): the ends of parts of the
+  /// cell drawn at random, until max_axis_candidates distinct ones per axis (or 2 x as many
+  /// parts drawn), so coordinates where many segments end (walls) are likelier: O(k log k).
+  /// Either way every chosen position is evaluated exactly.
   bool exact_candidates = false;
   /// In a cell that is not a box, an axis position's volume below is a clip of the cell; the
   /// builder clips only where the volume can change the choice. True: at every position, for
@@ -151,7 +151,9 @@ struct Subdivision {
   std::vector<BspNode> nodes;
   std::vector<SplitRecord> splits;
   std::vector<ConvexPolyhedron> cells;          ///< per node; filled for leaves only
-  std::vector<std::vector<uint32_t>> segments;  ///< per node: ids of the segments it holds (leaves)
+  /// Per node: ids of the segments it holds (leaves), in the subdivision's own order (that of
+  /// coherent_order, not sorted).
+  std::vector<std::vector<uint32_t>> segments;
   double initial_cost = 0;                      ///< c(S) of the single cell
   SubdivisionStats stats;
 
