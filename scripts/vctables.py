@@ -720,7 +720,7 @@ def candidates(d, samples, cells):
     runs = _candidate_runs(d)
     cells = int(cells)
     print(f"AV-S from {int(samples):,} construction samples to {cells:,} cells, scored on 4x as many independent evaluation "
-          "samples (seed 99). Fast: the default candidate positions (the ends of a run of a cell's parts from a random one, until k distinct ones per axis); exact: "
+          "samples (seed 99). Fast: the default candidate positions (the ends of a cell's parts drawn at random, until k distinct ones per axis); exact: "
           "`--exact-candidates`, the paper's choice (a uniform subset of the distinct end coordinates). Both "
           "ways ran in the same compare, from the same samples; k is `--axis-candidates`. Cost ratios compare with "
           "the exact choice at the default k = 200. Office and rotated office of size 4, the city of the subdivision "

@@ -1128,14 +1128,13 @@ class Builder {
   /// inside the cell's bounds): all segment ends when there are at most max_axis_candidates,
   /// else a random choice, reproducible per node (SubdivisionConfig::exact_candidates).
   ///
-  /// The random choice reads the node's parts in their order from a random one on (wrapping;
-  /// such a node has more than 2k parts), and takes both ends of each, along every axis that
-  /// still needs positions, until each has k distinct ones or 2k parts are read (walls, where
-  /// many segments end, repeat). The parts
-  /// name their segments in the order they were sampled, which does not depend on where they
-  /// are, so a run of parts is as random a choice as parts drawn one by one; and each part
-  /// read (a cache miss for its segment) serves the three axes, where drawing an end per axis
-  /// cost two dependent misses per position.
+  /// The random choice draws parts of the node at random (reproducibly per node) and takes
+  /// both ends of each, along every axis that still needs positions, until each has k distinct
+  /// ones or 2k parts are drawn (walls, where many segments end, repeat); each part drawn (a
+  /// cache miss for its segment) serves the three axes, where drawing an end per axis cost two
+  /// dependent misses per position. (A run of consecutive parts from a random one served
+  /// until the parts were kept in the Z-order of their segments: a run is now one corner of
+  /// the cell.)
   std::array<std::vector<double>, 3> axis_positions(int32_t node, const Box3& bounds) const {
     const RawVector<SegRef>& refs = refs_[node];
     const size_t k = config_.max_axis_candidates;
@@ -1151,8 +1150,6 @@ class Builder {
       }
       return positions;
     }
-    // Parts drawn at random, not a run of consecutive ones: the parts are in the Z-order of
-    // their segments' ends, so a run would be one corner of the cell.
     Rng rng(config_.seed, static_cast<uint64_t>(node) << 2);
     std::vector<uint32_t> pick(2 * k);
     for (uint32_t& i : pick) i = static_cast<uint32_t>(rng.below(n));
