@@ -564,7 +564,7 @@ class Builder {
     // cell keeps its parts in that order: the parts of a cell, which lie near each other, then
     // read their ends (64 bytes a segment, 96 MB for the city's 1.5M) from nearby memory. In
     // the order they were sampled, every part's ends were a miss of its own (the city's
-    // subdivision to 50k cells: 0.87x the time, A/B).
+    // subdivision to 50k cells and oa_shouse's: 0.85x the time, A/B).
     order_ = coherent_order(segs_, segs_.view_box);
     tbb::parallel_for(tbb::blocked_range<uint32_t>(0, static_cast<uint32_t>(segs_.size()), 1 << 14),
                       [&](const tbb::blocked_range<uint32_t>& range) {
