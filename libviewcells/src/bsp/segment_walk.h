@@ -35,12 +35,19 @@ inline double cut_parameter(double t0, double t1, double d0, double d1) {
 template <class Tree, class Stop>
 void walk_segment(const Tree& tree, const Vec3& a, const Vec3& b,
                   std::vector<std::tuple<int32_t, double, double>>& stack, Stop&& stop, int32_t root = 0) {
+  // The node visited next is kept in registers, and only the part left for later goes on the
+  // stack (a push followed at once by its pop cost a stalled load of what was just stored);
+  // the nodes are visited in the order of a walk that pushes both children, the second first.
   stack.clear();
-  stack.emplace_back(root, 0.0, 1.0);
-  while (!stack.empty()) {
-    const auto [n, t0, t1] = stack.back();
-    stack.pop_back();
-    if (stop(n, t0, t1)) continue;
+  int32_t n = root;
+  double t0 = 0.0, t1 = 1.0;
+  for (;;) {
+    if (stop(n, t0, t1)) {
+      if (stack.empty()) return;
+      std::tie(n, t0, t1) = stack.back();
+      stack.pop_back();
+      continue;
+    }
     int s0, s1;
     double d0, d1;
     if (const int axis = tree.axis(n); axis >= 0) {
@@ -63,12 +70,14 @@ void walk_segment(const Tree& tree, const Vec3& a, const Vec3& b,
     if ((s0 < 0 && s1 > 0) || (s0 > 0 && s1 < 0)) {  // as the subdivision's own splits
       const double t = cut_parameter(t0, t1, d0, d1);
       stack.emplace_back(tree.child(n, s0 < 0 ? 0 : 1), t0, t);
-      stack.emplace_back(tree.child(n, s0 < 0 ? 1 : 0), t, t1);
+      n = tree.child(n, s0 < 0 ? 1 : 0);
+      t0 = t;
       continue;
     }
     const bool in_plane = s0 == 0 && s1 == 0;
-    if (in_plane || s0 < 0 || s1 < 0) stack.emplace_back(tree.child(n, 0), t0, t1);
-    if (in_plane || s0 > 0 || s1 > 0) stack.emplace_back(tree.child(n, 1), t0, t1);
+    const bool neg = in_plane || s0 < 0 || s1 < 0, pos = in_plane || s0 > 0 || s1 > 0;
+    if (neg && pos) stack.emplace_back(tree.child(n, 0), t0, t1);
+    n = tree.child(n, pos ? 1 : 0);
   }
 }
 

@@ -106,34 +106,46 @@ struct LeafLists {
   std::vector<uint32_t> limit;   ///< the size at which a list is next made unique
 };
 
-/// Every leaf's objects as a row of bits, shared by the threads: a bit is set by an atomic or
-/// only where a plain read finds it clear (most of a walk's objects are already in the leaf).
-/// The rows are read out in order, so the lists are sorted and unique as they come.
+/// Every leaf's objects as bits, shared by the threads: a bit is set by an atomic or only where
+/// a plain read finds it clear (most of a walk's objects are already in the leaf). The bits
+/// are stored per object, over the leaves in the walk tree's depth-first order: the leaves a
+/// segment crosses one after another are mostly near in that order, so that its two objects'
+/// bits for them share a few cache lines (stored per leaf, over the objects, every leaf cost a
+/// line of its own for each object). Read out a block of 512 leaves at a time, object by
+/// object, so the lists come out sorted and unique.
 class LeafBits {
  public:
-  LeafBits(size_t leaves, size_t objects) : words_((objects + 63) / 64), bits_(leaves * words_, 0) {}
-  static size_t bytes(size_t leaves, size_t objects) { return leaves * ((objects + 63) / 64) * 8; }
+  LeafBits(size_t leaves, size_t objects) : leaves_(leaves), words_((leaves + 63) / 64), bits_(objects * words_, 0) {}
+  static size_t bytes(size_t leaves, size_t objects) { return objects * ((leaves + 63) / 64) * 8; }
   void add(uint32_t leaf, uint32_t o) {
     if (o == kNoObject) return;
-    uint64_t* w = &bits_[static_cast<size_t>(leaf) * words_ + o / 64];
-    const uint64_t m = uint64_t{1} << (o % 64);
+    uint64_t* w = &bits_[static_cast<size_t>(o) * words_ + leaf / 64];
+    const uint64_t m = uint64_t{1} << (leaf % 64);
     if (!(__atomic_load_n(w, __ATOMIC_RELAXED) & m)) __atomic_fetch_or(w, m, __ATOMIC_RELAXED);
   }
   void clear() { std::fill(bits_.begin(), bits_.end(), 0); }
-  std::vector<uint32_t> list(size_t leaf) const {
-    const uint64_t* row = &bits_[leaf * words_];
-    size_t n = 0;
-    for (size_t k = 0; k < words_; ++k) n += static_cast<size_t>(__builtin_popcountll(row[k]));
-    std::vector<uint32_t> out;
-    out.reserve(n);
-    for (size_t k = 0; k < words_; ++k)
-      for (uint64_t w = row[k]; w; w &= w - 1)
-        out.push_back(static_cast<uint32_t>(k * 64 + static_cast<size_t>(__builtin_ctzll(w))));
-    return out;
+  /// Every leaf's list, by leaf ordinal, to out[node(ordinal)].
+  template <class Node>
+  void lists(std::vector<std::vector<uint32_t>>& out, Node&& node) const {
+    constexpr size_t kBlock = 8;  // words: one cache line of each object's bits
+    const size_t objects = words_ ? bits_.size() / words_ : 0;
+    tbb::parallel_for(size_t{0}, (words_ + kBlock - 1) / kBlock, [&](size_t block) {
+      const size_t first = block * kBlock, last = std::min(words_, first + kBlock);
+      size_t count[kBlock * 64] = {};
+      for (size_t o = 0; o < objects; ++o)
+        for (size_t k = first; k < last; ++k)
+          for (uint64_t w = bits_[o * words_ + k]; w; w &= w - 1)
+            ++count[(k - first) * 64 + static_cast<size_t>(__builtin_ctzll(w))];
+      for (size_t j = 0; j < (last - first) * 64 && first * 64 + j < leaves_; ++j) out[node(first * 64 + j)].reserve(count[j]);
+      for (size_t o = 0; o < objects; ++o)
+        for (size_t k = first; k < last; ++k)
+          for (uint64_t w = bits_[o * words_ + k]; w; w &= w - 1)
+            out[node(k * 64 + static_cast<size_t>(__builtin_ctzll(w)))].push_back(static_cast<uint32_t>(o));
+    });
   }
 
  private:
-  size_t words_;
+  size_t leaves_, words_;
   std::vector<uint64_t> bits_;
 };
 
@@ -167,11 +179,11 @@ uint32_t objects_seen(const SegmentSet& eval) {
 }
 
 constexpr size_t kMaxBitBytes = size_t{512} << 20;
-/// Bits only where a leaf's row fills a cache line, so that the threads' atomic ors never
-/// share a line between leaves. (On the office's 2,000 leaves and 100 objects, bits forced
-/// measured 1.79-1.83 s against the lists' 1.84-1.98 s for 4.4M segments in
-/// bench/eval_bench.cpp: few objects make short lists, which the check of the last pair keeps
-/// cheap, so the lists lose nothing measurable there.)
+/// Bits only from 512 objects on: few objects make short lists, which the check of the last
+/// pair keeps cheap, so the lists lose nothing measurable there. (On the office's 3,392 leaves
+/// and 100 objects, 4.4M segments in bench/eval_bench.cpp, bits forced took 1.76-2.23 s and
+/// the lists 1.95-2.52 s in alternating runs: within the noise; with the bits stored per leaf,
+/// 1.79-1.83 s against 1.84-1.98 s.)
 constexpr size_t kMinBitObjects = 512;
 
 /// Whether the automatic gather takes bits for rows of `leaves` x `objects`.
@@ -235,7 +247,7 @@ struct EvaluationPvs::Impl {
   std::vector<std::vector<uint32_t>> read() const {
     if (!bits) return lists;
     std::vector<std::vector<uint32_t>> out(s.nodes.size());
-    tbb::parallel_for(size_t{0}, tree.leaves(), [&](size_t k) { out[tree.leaf_node(k)] = bits->list(k); });
+    bits->lists(out, [&](size_t k) { return tree.leaf_node(k); });
     return out;
   }
 };

@@ -20,10 +20,11 @@ namespace viewcells {
 std::vector<std::vector<uint32_t>> evaluation_pvs(const Subdivision& s, const SegmentSet& eval);
 /// How evaluation_pvs gathers each leaf's objects; the lists are the same either way.
 /// kLists: per thread, lists that grow as segments meet the leaf, then sorted, made unique and
-/// joined. kBits: one row of bits over the objects per leaf, shared by the threads (a bit is
-/// set atomically where it is not set yet), read out in order at the end: no lists to grow,
-/// sort or join. kAutomatic: bits where the scene has at least 512 objects (a row fills a cache
-/// line) and the rows take at most 512 MB (and, for one call of
+/// joined. kBits: one bit per leaf and object, shared by the threads (a bit is set atomically
+/// where it is not set yet; stored per object over the leaves, so that the leaves a segment
+/// crosses in turn share cache lines), read out in order at the end: no lists to grow, sort or
+/// join. kAutomatic: bits where the scene has at least 512 objects and the bits take at most
+/// 512 MB (and, for one call of
 /// evaluation_pvs, at most 64 bytes per segment walked, so that a few segments do not clear and
 /// read rows for every leaf), else lists.
 enum class LeafGather { kAutomatic, kLists, kBits };
