@@ -109,8 +109,8 @@ TEST(Evaluate, WalksGiveTheSubdivisionsOwnLeafLists) {
 
 TEST(Evaluate, BitsAndListsGatherTheSameLeafListsSetAfterSet) {
   using Lists = std::vector<std::vector<uint32_t>>;
-  // Both ways of gathering a leaf's objects (a row of bits per leaf, or lists made unique)
-  // give the subdivision's own lists, walked at once or a set at a time (as the validated merge
+  // Both ways of gathering a leaf's objects (bits per object over the leaves, or lists made
+  // unique) give the subdivision's own lists, walked at once or a set at a time (as the validated merge
   // and compare add the sets they draw), and read out between sets as well.
   const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 1});
   const SegmentSet segs = sample(scene, 20000, 1);
@@ -146,9 +146,17 @@ TEST(Evaluate, BitsAndListsGatherTheSameLeafListsSetAfterSet) {
     EvaluationPvs too_few(s, 1, gather);
     EXPECT_THROW(too_few.add(sets[0]), Error);
   }
-  // Automatic: lists for the office's 100 objects, bits where a row fills a cache line.
+  // Automatic: lists for the office's 100 objects, bits from 512 objects on.
   EXPECT_FALSE(EvaluationPvs(s, scene.objects.size()).bits());
   EXPECT_TRUE(EvaluationPvs(s, 512).bits());
+  // Bits are read out 512 leaves at a time: a tree of more leaves than that, and not a
+  // multiple of 64, gives the same lists both ways.
+  const SegmentSet more = sample(scene, 60000, 5);
+  const Subdivision large = build(scene, more, "av-s", 1100);
+  ASSERT_GT(large.leaf_count(), 1024u);
+  ASSERT_NE(large.leaf_count() % 64, 0u);
+  const std::vector<size_t> order = coherent_order(all, large.view_box);
+  EXPECT_EQ(evaluation_pvs(large, all, order, LeafGather::kBits), evaluation_pvs(large, all, order, LeafGather::kLists));
 }
 
 TEST(Evaluate, ReplaysFromASharedCutGiveTheSameCosts) {
