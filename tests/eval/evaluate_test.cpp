@@ -152,9 +152,12 @@ TEST(Evaluate, BitsAndListsGatherTheSameLeafListsSetAfterSet) {
   // Bits are read out 512 leaves at a time: a tree of more leaves than that, and not a
   // multiple of 64, gives the same lists both ways.
   const SegmentSet more = sample(scene, 60000, 5);
-  const Subdivision large = build(scene, more, "av-s", 1100);
-  ASSERT_GT(large.leaf_count(), 1024u);
-  ASSERT_NE(large.leaf_count() % 64, 0u);
+  SubdivisionConfig config;
+  config.max_cells = 1100;
+  config.min_reduction = 0;  // no stagnation stop: 1,100 leaves whatever the samples
+  config.show_progress = false;
+  const Subdivision large = subdivide(scene, more, CostModel{}, config);
+  ASSERT_EQ(large.leaf_count(), 1100u);
   const std::vector<size_t> order = coherent_order(all, large.view_box);
   EXPECT_EQ(evaluation_pvs(large, all, order, LeafGather::kBits), evaluation_pvs(large, all, order, LeafGather::kLists));
 }
