@@ -496,9 +496,8 @@ struct ObjectExtremes {
   static constexpr int kEnds = 6;
   uint32_t object;
   Vec3 end[kEnds];  ///< [2 axis]: least along the axis, [2 axis + 1]: greatest
-  ObjectExtremes(uint32_t o, const Vec3& q) : object(o) {
-    for (Vec3& e : end) e = q;
-  }
+  /// From a part's ends, lowest and highest along each axis in the order of `end`.
+  ObjectExtremes(uint32_t o, const Vec3 (&part)[kEnds]) : object(o) { std::copy(part, part + kEnds, end); }
   /// A part's ends, lowest and highest along each axis in the order of `end`.
   void add(const Vec3 (&part)[kEnds]) {
     for (int axis = 0; axis < 3; ++axis) {
@@ -1460,14 +1459,15 @@ class Builder {
     // A part's ends lowest and highest along each axis (p0 on a tie), which update its objects'
     // extremes as p0 and then p1 would.
     Vec3 part_ends[ObjectExtremes::kEnds];
-    auto extend = [&](uint32_t o, const Vec3& p0) {
+    auto extend = [&](uint32_t o) {
       if (o == kNoObject) return;
       uint32_t& at = entry[o];
-      if (at == UINT32_MAX) {
-        at = static_cast<uint32_t>(extremes.size());
-        extremes.emplace_back(o, p0);
+      if (at != UINT32_MAX) {
+        extremes[at].add(part_ends);
+        return;
       }
-      extremes[at].add(part_ends);
+      at = static_cast<uint32_t>(extremes.size());
+      extremes.emplace_back(o, part_ends);
     };
     for (size_t i = 0; i < refs.size(); ++i) {
       prefetch_ends(refs, i);
@@ -1483,8 +1483,8 @@ class Builder {
           part_ends[2 * axis] = p1[axis] < p0[axis] ? p1 : p0;
           part_ends[2 * axis + 1] = p1[axis] > p0[axis] ? p1 : p0;
         }
-        extend(e.object_a, p0);
-        if (e.object_b != e.object_a) extend(e.object_b, p0);
+        extend(e.object_a);
+        if (e.object_b != e.object_a) extend(e.object_b);
       } else {
         parts[i] = {p0, p1, e.object_a, e.object_b};
       }
