@@ -760,51 +760,6 @@ TEST(Subdivision, GeometryAlignedBoundsKeepTheBestPlane) {
   }
 }
 
-/// Below the root, a large cell split off a large one bounds its geometry-aligned planes from
-/// what the split gathered (each object's extreme part ends, the plane-source triangles hit,
-/// the ends' box) instead of a pass of its own over its parts: the same planes, bounds and
-/// choices, so the same tree as reading the parts again, with one thread or two (the split's
-/// pass goes in chunks whose extremes are joined in order). The root's pass is checked against
-/// brute force above.
-TEST(Subdivision, PlanesBoundedFromTheSplitGiveTheSameTree) {
-  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 1});
-  const SegmentSet segs = sample(scene, 100000, 3);
-  ASSERT_GT(segs.size(), 65536u) << "the root's split should go in more than one chunk";
-  for (const bool viewpoints : {false, true}) {
-    SubdivisionConfig config;
-    config.max_cells = 200;
-    config.geometry_aligned = GeometryAlignedMode::kOn;
-    config.min_reduction = 0;
-    config.show_progress = false;
-    if (viewpoints) {
-      auto points = std::make_shared<std::vector<Vec3>>();
-      Rng rng(5);
-      const Box3 box = segs.view_box;
-      for (int i = 0; i < 3000; ++i)
-        points->push_back({rng.uniform(box.lo.x, box.hi.x), rng.uniform(box.lo.y, box.hi.y),
-                           rng.uniform(box.lo.z, 0.5 * (box.lo.z + box.hi.z))});
-      config.viewpoints = points;
-    }
-    SCOPED_TRACE(viewpoints ? "with viewpoints" : "volume as the weight");
-    Subdivision gathered;
-    {
-      ThreadLimit t(2);  // the root's split in two chunks (more than 65,536 parts)
-      gathered = subdivide(scene, segs, CostModel{}, config);
-    }
-    // Enough large cells below the root that the gathered path decides many splits.
-    EXPECT_GT(gathered.stats.geometry_cells_from_split, 20u);
-    config.planes_read_parts = true;
-    const Subdivision read = subdivide(scene, segs, CostModel{}, config);
-    EXPECT_EQ(read.stats.geometry_cells_from_split, 0u);
-    expect_same_tree(gathered, read);
-    EXPECT_EQ(gathered.stats.geometry_candidates, read.stats.geometry_candidates);
-    EXPECT_EQ(gathered.stats.geometry_full_passes, read.stats.geometry_full_passes);
-    config.planes_read_parts = false;
-    ThreadLimit t(1);
-    expect_same_tree(gathered, subdivide(scene, segs, CostModel{}, config));
-  }
-}
-
 TEST(Subdivision, FastCandidatesAreSegmentEndsEvaluatedExactly) {
   // More segment ends than candidates, so the fast choice draws them: the chosen plane lies at
   // a segment end, its recorded reduction is what brute force gives for it, and no integer

@@ -264,35 +264,6 @@ struct PointPart {
   uint32_t object_a, object_b;
 };
 
-/// Geometry-aligned planes in a cell of more than this many parts are first bounded from its
-/// objects' extreme part ends (ObjectExtremes; Builder::best_geometry_candidate).
-constexpr size_t kBoundedParts = 2048;
-
-/// One object's part ends that lie lowest and highest along each axis: real ends, so that the
-/// exact side of any of them is that of an end of one of the object's parts. (With the 4 body
-/// diagonals of a cube too, 7 directions, the bound let through 7% fewer planes to a pass over
-/// all parts, but oa_shouse's subdivision took 8% longer in alternating runs: 1.57-1.60 s
-/// against 1.44-1.48 s; with the 6 face diagonals as well, longer still. With two axes, 33%
-/// more passes and 1.52-1.57 s.)
-struct ObjectExtremes {
-  static constexpr int kEnds = 6;
-  uint32_t object;
-  Vec3 end[kEnds];  ///< [2 axis]: least along the axis, [2 axis + 1]: greatest
-  /// From a part's ends, lowest and highest along each axis in the order of `end`.
-  ObjectExtremes(uint32_t o, const Vec3 (&part)[kEnds]) : object(o) { std::copy(part, part + kEnds, end); }
-  ObjectExtremes(uint32_t o, const std::array<Vec3, kEnds>& e) : object(o) { std::copy(e.begin(), e.end(), end); }
-  /// A part's ends, lowest and highest along each axis in the order of `end`.
-  void add(const Vec3 (&part)[kEnds]) { add_to(end, part); }
-  /// Extremes `to` (in the order of `end`) with those of `from`: only an end strictly beyond
-  /// replaces one (on a tie the earlier stays).
-  static void add_to(Vec3* to, const Vec3* from) {
-    for (int axis = 0; axis < 3; ++axis) {
-      if (from[2 * axis][axis] < to[2 * axis][axis]) to[2 * axis] = from[2 * axis];
-      if (from[2 * axis + 1][axis] > to[2 * axis + 1][axis]) to[2 * axis + 1] = from[2 * axis + 1];
-    }
-  }
-};
-
 /// What the axis sweep needs of a node's segment parts, from one pass over them: per object
 /// seen, along each axis, the lowest low end and the highest high end of its parts that have
 /// length along that axis (+inf and -inf when none has), with the objects in the order the
@@ -310,15 +281,6 @@ struct NodeExtents {
   /// one part (so that r(PVS) adds their costs in the order a pass over the parts does).
   std::vector<uint8_t> paired;
   std::array<std::vector<PointPart>, 3> points;
-  /// With geometry-aligned planes, in a cell split off one of more than kBoundedParts parts
-  /// (has_ga): what the planes' evaluation needs of its parts, gathered by the same pass, so
-  /// that a large cell's parts are not read again for it (Builder::best_geometry_candidate):
-  /// per entry of objects, its extreme part ends; the plane-source triangles hit at part ends
-  /// inside the cell (sorted, distinct); and the box of all part ends.
-  bool has_ga = false;
-  std::vector<ObjectExtremes> extremes;
-  std::vector<uint32_t> tris;
-  Box3 ends_box;
   /// r(PVS) of the parts: each object's r once, added as a pass over the parts adds them.
   double pvs_cost(const std::vector<double>& r) const {
     double c = 0;
@@ -340,18 +302,12 @@ struct NodeExtents {
 struct ExtentSlots {
   std::vector<uint32_t> stamp;
   std::vector<NodeExtents::Range> range;  ///< per object; valid where stamped
-  /// With `with_ends`: per object, its extreme part ends (as ObjectExtremes::end); valid where
-  /// stamped. Filled in only for the cells whose NodeExtents gather them (has_ga).
-  std::vector<std::array<Vec3, ObjectExtremes::kEnds>> ends;
-  bool with_ends = false;
   uint32_t epoch = 0;
-  void reset(size_t n, bool gather_ends = false) {
+  void reset(size_t n) {
     if (stamp.size() < n) {
       stamp.assign(n, 0);
       range.resize(n);
     }
-    with_ends = gather_ends;
-    if (with_ends && ends.size() < n) ends.resize(n);
     if (++epoch == 0) {
       std::fill(stamp.begin(), stamp.end(), 0);
       epoch = 1;
@@ -371,11 +327,6 @@ struct ExtentSlots {
   void finish(NodeExtents& into) const {
     into.ranges.resize(into.objects.size());
     for (size_t i = 0; i < into.objects.size(); ++i) into.ranges[i] = range[into.objects[i]];
-    if (!with_ends) return;
-    into.has_ga = true;
-    into.extremes.clear();
-    into.extremes.reserve(into.objects.size());
-    for (uint32_t o : into.objects) into.extremes.emplace_back(o, ends[o]);
   }
   /// Adds the segment part p0-p1 seen by objects a and b.
   void add_part(const Vec3& p0, const Vec3& p1, uint32_t a, uint32_t b, NodeExtents& into) {
@@ -392,23 +343,9 @@ struct ExtentSlots {
         hi[axis] = std::max(c0, c1);
       }
     }
-    // With ends: the part's ends lowest and highest along each axis (p0 on a tie), which
-    // update its objects' extreme ends as p0 and then p1 would.
-    Vec3 part_ends[ObjectExtremes::kEnds];
-    if (with_ends)
-      for (int axis = 0; axis < 3; ++axis) {
-        part_ends[2 * axis] = p1[axis] < p0[axis] ? p1 : p0;
-        part_ends[2 * axis + 1] = p1[axis] > p0[axis] ? p1 : p0;
-      }
     const size_t before = into.objects.size();
     for (uint32_t o : {a, b == a ? kNoObject : b}) {
       if (o == kNoObject) continue;
-      if (with_ends) {
-        if (stamp[o] != epoch)
-          std::copy(part_ends, part_ends + ObjectExtremes::kEnds, ends[o].begin());
-        else
-          ObjectExtremes::add_to(ends[o].data(), part_ends);
-      }
       NodeExtents::Range& r = entry(o, into);
       for (int axis = 0; axis < 3; ++axis) {
         r.lo[axis] = std::min(r.lo[axis], lo[axis]);
@@ -422,13 +359,6 @@ struct ExtentSlots {
     for (size_t i = 0; i < later.objects.size(); ++i) {
       // A pair stays a pair only if both are new here (else the part adds one cost alone).
       const bool first_seen = stamp[later.objects[i]] != epoch;
-      if (with_ends) {  // the later chunk's extremes win only where strictly beyond
-        const Vec3* e = later.extremes[i].end;
-        if (first_seen)
-          std::copy(e, e + ObjectExtremes::kEnds, ends[later.objects[i]].begin());
-        else
-          ObjectExtremes::add_to(ends[later.objects[i]].data(), e);
-      }
       NodeExtents::Range& r = entry(later.objects[i], into);
       if (first_seen && later.paired[i] && stamp[later.objects[i + 1]] != epoch) into.paired.back() = 1;
       const NodeExtents::Range& l = later.ranges[i];
@@ -439,10 +369,6 @@ struct ExtentSlots {
     }
     for (int axis = 0; axis < 3; ++axis)
       into.points[axis].insert(into.points[axis].end(), later.points[axis].begin(), later.points[axis].end());
-    if (with_ends) {
-      into.tris.insert(into.tris.end(), later.tris.begin(), later.tris.end());
-      into.ends_box.extend(later.ends_box);
-    }
   }
 };
 
@@ -560,6 +486,27 @@ class FilteredSide {
   double box_eps_ = INFINITY;
 };
 
+/// One object's part ends that lie lowest and highest along each axis: real ends, so that the
+/// exact side of any of them is that of an end of one of the object's parts. (With the 4 body
+/// diagonals of a cube too, 7 directions, the bound let through 7% fewer planes to a pass over
+/// all parts, but oa_shouse's subdivision took 8% longer in alternating runs: 1.57-1.60 s
+/// against 1.44-1.48 s; with the 6 face diagonals as well, longer still. With two axes, 33%
+/// more passes and 1.52-1.57 s.)
+struct ObjectExtremes {
+  static constexpr int kEnds = 6;
+  uint32_t object;
+  Vec3 end[kEnds];  ///< [2 axis]: least along the axis, [2 axis + 1]: greatest
+  /// From a part's ends, lowest and highest along each axis in the order of `end`.
+  ObjectExtremes(uint32_t o, const Vec3 (&part)[kEnds]) : object(o) { std::copy(part, part + kEnds, end); }
+  /// A part's ends, lowest and highest along each axis in the order of `end`.
+  void add(const Vec3 (&part)[kEnds]) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (part[2 * axis][axis] < end[2 * axis][axis]) end[2 * axis] = part[2 * axis];
+      if (part[2 * axis + 1][axis] > end[2 * axis + 1][axis]) end[2 * axis + 1] = part[2 * axis + 1];
+    }
+  }
+};
+
 struct Candidate {
   bool valid = false;
   Plane plane;
@@ -569,7 +516,6 @@ struct Candidate {
 struct Evaluation {
   Candidate best;
   uint64_t axis = 0, geometry = 0, geometry_full = 0;
-  bool planes_from_split = false;  ///< see SubdivisionStats::geometry_cells_from_split
 };
 
 class Builder {
@@ -784,7 +730,6 @@ class Builder {
     out_.stats.splits_undone = splits_undone_;
     out_.stats.geometry_candidates = geometry_evaluated_;
     out_.stats.geometry_full_passes = geometry_full_;
-    out_.stats.geometry_cells_from_split = geometry_from_split_;
     out_.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
 
@@ -907,9 +852,6 @@ class Builder {
     std::vector<std::array<uint8_t, 2>> chunk_hits(chunks, {0, 0});  // per chunk: plane_hits of each side
     if (extents)
       for (auto& side_ext : chunk_ext) side_ext.resize(chunks);
-    // Children of a large cell may be large: their extents then carry what the planes'
-    // evaluation needs (NodeExtents::has_ga), from this pass, which reads every part anyway.
-    const bool gather_ga = ga_ && extents && n > kBoundedParts && !config_.planes_read_parts;
     auto for_chunks = [&](auto&& f) {
       if (chunks == 1) return f(size_t{0});
       tbb::parallel_for(size_t{0}, chunks, [&](size_t c) { f(c); });
@@ -918,20 +860,8 @@ class Builder {
       size_t count[2] = {0, 0};
       std::array<ExtentSlots, 2>& slots = split_slots_.local();
       if (extents)
-        for (ExtentSlots& sl : slots) sl.reset(r_.size(), gather_ga);
+        for (ExtentSlots& sl : slots) sl.reset(r_.size());
       uint8_t hits[2] = {0, 0};
-      std::array<Marks, 2>& tri_seen = split_tri_marks_.local();
-      if (gather_ga)
-        for (Marks& m : tri_seen) m.reset(scene_.triangles.size());
-      // With gather_ga: child k's part `ref` (its ends p0, p1): its plane-source triangles hit
-      // inside the child, each once a chunk, and its ends' box.
-      auto gather = [&](int k, const SegRef& ref, const SegEnds& e, const Vec3& p0, const Vec3& p1) {
-        NodeExtents& x = chunk_ext[k][c];
-        x.ends_box.extend(p0);
-        x.ends_box.extend(p1);
-        for (const uint32_t t : {ref.q0 == 0 ? e.triangle_a : kNoObject, ref.q1 == SegRef::kOne ? e.triangle_b : kNoObject})
-          if (t != kNoObject && plane_source_[t] && tri_seen[k].first(t)) x.tris.push_back(t);
-      };
       for (size_t i = c * grain; i < std::min(n, (c + 1) * grain); ++i) {
         prefetch_ends(refs, i);
         const SegRef& s = refs[i];
@@ -956,20 +886,13 @@ class Builder {
             const Vec3 mid = e.at(cut);
             slots[first].add_part(p0, mid, e.object_a, e.object_b, chunk_ext[first][c]);
             slots[1 - first].add_part(mid, p1, e.object_a, e.object_b, chunk_ext[1 - first][c]);
-            if (gather_ga) {
-              gather(first, {s.id, s.q0, q}, e, p0, mid);
-              gather(1 - first, {s.id, q, s.q1}, e, mid, p1);
-            }
           }
         } else {
           if (ga_ && hits_plane_source(s, e))
             for (int k = 0; k < 2; ++k) hits[k] |= (to >> k) & 1;
           if (extents)
             for (int k = 0; k < 2; ++k)
-              if (to & (1 << k)) {
-                slots[k].add_part(p0, p1, e.object_a, e.object_b, chunk_ext[k][c]);
-                if (gather_ga) gather(k, s, e, p0, p1);
-              }
+              if (to & (1 << k)) slots[k].add_part(p0, p1, e.object_a, e.object_b, chunk_ext[k][c]);
         }
         code[i] = static_cast<uint8_t>(to);
         count[0] += to & 1;
@@ -984,12 +907,7 @@ class Builder {
     for (const auto& h : chunk_hits)
       for (int k = 0; k < 2; ++k) out.plane_hits[k] |= h[k] != 0;
     if (extents)
-      for (int k = 0; k < 2; ++k) {
-        out.ext[k] = join_extents(chunk_ext[k]);
-        std::vector<uint32_t>& tris = out.ext[k].tris;  // chunks' triangles, each once overall
-        std::sort(tris.begin(), tris.end());
-        tris.erase(std::unique(tris.begin(), tris.end()), tris.end());
-      }
+      for (int k = 0; k < 2; ++k) out.ext[k] = join_extents(chunk_ext[k]);
     for (size_t c = 0; c < chunks; ++c)
       for (int k = 0; k < 2; ++k) at[c + 1][k] += at[c][k];
     RawVector<SegRef>* side = out.side;
@@ -1108,7 +1026,6 @@ class Builder {
     parts_evaluated_ += refs_[node].size();
     geometry_evaluated_ += e.geometry;
     geometry_full_ += e.geometry_full;
-    geometry_from_split_ += e.planes_from_split;
   }
 
   Evaluation evaluate(int32_t node) {
@@ -1139,7 +1056,7 @@ class Builder {
       double to_beat = -INFINITY;
       for (int t = 0; t < 3; ++t)
         if (results[t].valid) to_beat = std::max(to_beat, results[t].reduction);
-      results[3] = best_geometry_candidate(node, ev, r, to_beat, *ext);
+      results[3] = best_geometry_candidate(node, ev, r, to_beat);
     }
     for (const Candidate& c : results)  // in a fixed order: ties keep the earlier kind/axis
       if (c.valid && (!ev.best.valid || c.reduction > ev.best.reduction)) ev.best = c;
@@ -1353,7 +1270,7 @@ class Builder {
     if (chunks.size() == 1) return std::move(chunks[0]);
     NodeExtents all;
     ExtentSlots& slots = extent_slots_.local();
-    slots.reset(r_.size(), chunks[0].has_ga);
+    slots.reset(r_.size());
     for (const NodeExtents& c : chunks) slots.merge(c, all);
     slots.finish(all);
     return all;
@@ -1510,7 +1427,7 @@ class Builder {
   /// each costs O(n)), or none. In a large cell, only the planes whose bound may beat `to_beat`
   /// (the best axis-aligned reduction: ties keep the axis) are evaluated on all parts, so a
   /// plane left out could not have been chosen.
-  Candidate best_geometry_candidate(int32_t node, Evaluation& ev, const double* r, double to_beat, NodeExtents& ext) {
+  Candidate best_geometry_candidate(int32_t node, Evaluation& ev, const double* r, double to_beat) {
     // About half the cells of oa_shouse hold no end on a plane source: no pass over their parts.
     if (!plane_hits_[node]) return {};
     const RawVector<SegRef>& refs = refs_[node];
@@ -1522,10 +1439,8 @@ class Builder {
     // its planes in 25 is then evaluated on all of them (oa_shouse: 1,251 of 31,732), and
     // that pass reads them again from the segments. (Kept, and the extremes taken in a pass of
     // their own, the map's subdivision took 0.91 s against 0.87 s by medians of seven
-    // alternating runs: scripts/bench-ab-subdivision.sh 93e71b1 7 map:oa_shouse.) A large cell
-    // split off a large one has all of this from the split (NodeExtents::has_ga), whose pass
-    // read its parts anyway, and makes no pass here; the root, and every cell with
-    // SubdivisionConfig::planes_read_parts, makes its own.
+    // alternating runs: scripts/bench-ab-subdivision.sh 93e71b1 7 map:oa_shouse.)
+    constexpr size_t kBoundedParts = 2048;
     const bool large = refs.size() > kBoundedParts;
     struct PartEnds {
       Vec3 p0, p1;
@@ -1554,13 +1469,7 @@ class Builder {
       at = static_cast<uint32_t>(extremes.size());
       extremes.emplace_back(o, part_ends);
     };
-    if (large && ext.has_ga) {  // gathered when the cell was split off: no pass here
-      ev.planes_from_split = true;
-      extremes = std::move(ext.extremes);
-      tris = std::move(ext.tris);
-      points = ext.ends_box;
-    }
-    for (size_t i = 0; i < refs.size() && !(large && ext.has_ga); ++i) {
+    for (size_t i = 0; i < refs.size(); ++i) {
       prefetch_ends(refs, i);
       const SegRef& s = refs[i];
       const SegEnds& e = ends_[s.id];
@@ -1762,12 +1671,10 @@ class Builder {
   uint64_t slivers_refused_ = 0;
   uint64_t splits_undone_ = 0;
   std::vector<Candidate> best_;
-  std::atomic<uint64_t> axis_evaluated_{0}, geometry_evaluated_{0}, geometry_full_{0}, geometry_from_split_{0},
-      parts_evaluated_{0};
+  std::atomic<uint64_t> axis_evaluated_{0}, geometry_evaluated_{0}, geometry_full_{0}, parts_evaluated_{0};
   tbb::enumerable_thread_specific<Marks> marks_;
   tbb::enumerable_thread_specific<ExtentSlots> extent_slots_;
   tbb::enumerable_thread_specific<std::array<ExtentSlots, 2>> split_slots_;  ///< apply_split: both sides
-  tbb::enumerable_thread_specific<std::array<Marks, 2>> split_tri_marks_;  ///< partition: triangles, both sides
   /// Per node: the extents its split gathered, until the node is evaluated.
   std::vector<std::unique_ptr<NodeExtents>> pending_ext_;
   tbb::enumerable_thread_specific<PointMarks> point_marks_;

@@ -260,7 +260,6 @@ std::string report_json(const BuildResult& r) {
                            {"axis_candidates_evaluated", sub.stats.axis_candidates},
                            {"geometry_candidates_evaluated", sub.stats.geometry_candidates},
                            {"geometry_candidates_on_all_parts", sub.stats.geometry_full_passes},
-                           {"geometry_cells_bounded_from_split", sub.stats.geometry_cells_from_split},
                            {"segment_parts_evaluated", sub.stats.parts_evaluated},
                            {"sliver_splits_refused", sub.stats.slivers_refused},
                            {"splits_undone", sub.stats.splits_undone},

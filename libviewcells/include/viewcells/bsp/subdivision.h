@@ -83,12 +83,6 @@ struct SubdivisionConfig {
   /// builder clips only where the volume can change the choice. True: at every position, for
   /// tests that check it is the same choice.
   bool clip_every_position = false;
-  /// With geometry-aligned planes, a cell of more than 2,048 parts split off a cell of more
-  /// than 2,048 takes what bounding its planes needs (each object's extreme part ends, the
-  /// triangles hit, the box of the part ends) from the pass that split it off, which reads its
-  /// parts anyway. True: from a pass of its own over its parts, as the root does, for tests
-  /// that check it is the same choice.
-  bool planes_read_parts = false;
   GeometryAlignedMode geometry_aligned = GeometryAlignedMode::kAuto;
   uint32_t ga_candidates = 150;       ///< geometry-aligned planes per node at most (paper: 150)
   /// kAuto enables geometry-aligned candidates when at least this share of the surface area
@@ -138,9 +132,6 @@ struct SubdivisionStats {
   /// Geometry-aligned candidates evaluated on all of their cell's parts (the others were
   /// bounded from their objects' extreme part ends below a candidate that beats them).
   uint64_t geometry_full_passes = 0;
-  /// Cells whose geometry-aligned planes were bounded from what the split that made them
-  /// gathered (see SubdivisionConfig::planes_read_parts), with no pass over their parts.
-  uint64_t geometry_cells_from_split = 0;
   /// Segment parts read by candidate evaluation, summed over the cells evaluated (a segment
   /// lies in every cell it crosses, so this grows faster than the segments).
   uint64_t parts_evaluated = 0;
