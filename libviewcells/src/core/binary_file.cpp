@@ -8,6 +8,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <mutex>
 
 #include "viewcells/core/isa.h"
@@ -133,11 +134,12 @@ void write_text_file(const std::string& path, const std::string& text) {
 }
 
 std::string container_image(const char (&magic)[5], uint32_t version, const std::string& payload) {
-  std::string compressed(ZSTD_compressBound(payload.size()), '\0');
-  const size_t csize = ZSTD_compress(compressed.data(), compressed.size(), payload.data(),
-                                     payload.size(), /*level=*/1);
+  // Compressed into a buffer left uninitialised (the bound is about the payload's size, and
+  // zeroing it cost a pass over that much memory), then copied once behind the header.
+  const size_t bound = ZSTD_compressBound(payload.size());
+  const std::unique_ptr<char[]> compressed(new char[bound]);
+  const size_t csize = ZSTD_compress(compressed.get(), bound, payload.data(), payload.size(), /*level=*/1);
   if (ZSTD_isError(csize)) throw Error(std::string("zstd: ") + ZSTD_getErrorName(csize));
-  compressed.resize(csize);
   ByteWriter header;
   header.put<uint32_t>(0);  // placeholder replaced by the magic below
   // The version's third byte records the Embree ISA of the writing process (core/isa.h).
@@ -146,9 +148,11 @@ std::string container_image(const char (&magic)[5], uint32_t version, const std:
   header.put<uint64_t>(payload.size());
   header.put<uint64_t>(fnv1a64(payload));
   header.put<uint64_t>(csize);
-  std::string file = header.data();
+  std::string file;
+  file.reserve(header.data().size() + csize);
+  file = header.data();
   std::memcpy(file.data(), magic, 4);
-  file += compressed;
+  file.append(compressed.get(), csize);
   return file;
 }
 
@@ -170,7 +174,14 @@ std::string read_container(const std::string& path, const char (&magic)[5], uint
     throw Error(path, 0, std::filesystem::exists(path, ec) ? "not a regular file" : "no such file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path, 0, "cannot open file");
-  std::string file((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // Read whole in one call: through a character iterator, `extract` of the city's default
+  // 50k-cell hierarchy (72 MB) took 2.8-3.0 s, now 2.4-2.55 s (three alternating runs).
+  in.seekg(0, std::ios::end);
+  const std::streamoff length = in.tellg();
+  in.seekg(0, std::ios::beg);
+  if (!in || length < 0) throw Error(path, 0, "cannot read file");
+  std::string file(static_cast<size_t>(length), '\0');
+  if (!in.read(file.data(), length)) throw Error(path, 0, "cannot read file");
   ByteReader r(file, path);
   if (file.size() < 32) throw Error(path, 0, "not a " + std::string(magic) + " file (too short)");
   if (std::memcmp(file.data(), magic, 4) != 0)

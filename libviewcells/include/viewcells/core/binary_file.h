@@ -33,6 +33,8 @@ class ByteWriter {
     put<uint64_t>(s.size());
     data_.append(s);
   }
+  /// Room for `bytes` in all, so that a large payload is not copied as it grows.
+  void reserve(size_t bytes) { data_.reserve(bytes); }
   const std::string& data() const { return data_; }
   /// The bytes, moved out (the writer is empty afterwards).
   std::string take() { return std::move(data_); }
