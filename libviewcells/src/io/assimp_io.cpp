@@ -24,6 +24,7 @@
 #include <mutex>
 #include <unordered_map>
 
+#include "viewcells/core/binary_file.h"
 #include "viewcells/core/error.h"
 #include "viewcells/io/scene_io.h"
 
@@ -490,9 +491,7 @@ bool is_assimp_extension(const std::string& ext) {
 static RawMesh read_assimp_here(const std::string& path, AssimpObjects mode) {
   const std::string ext = lower_extension(path);
   if (is_gltf(ext)) {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path, 0, "cannot open file");
-    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string bytes = read_file_bytes(path);
     // A .gltf may be binary and a .glb text: the magic decides, as for Assimp.
     GltfCheck(path, std::filesystem::path(path).parent_path()).check(bytes, bytes.rfind("glTF", 0) == 0);
   }

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "viewcells/core/binary_file.h"
 #include "viewcells/core/error.h"
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/io/scene_io.h"
@@ -456,13 +457,6 @@ Scene load_scene(const std::string& path, ObjectGrouping grouping) {
   if (std::filesystem::is_directory(path, ec)) throw Error(path, 0, "is a directory, not a scene file");
   if (!std::filesystem::is_regular_file(path, ec)) throw Error(path, 0, "not a regular file");
   const std::string ext = lower_extension(path);
-  auto read_all = [&] {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw Error(path, 0, "cannot open file");
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    if (in.bad()) throw Error(path, 0, "read error");
-    return bytes;
-  };
   const bool assimp = is_assimp_extension(ext);
   if (!assimp && (grouping == ObjectGrouping::kNodes || grouping == ObjectGrouping::kMeshes))
     throw Error(path, 0, std::string("--objects ") + to_string(grouping) +
@@ -484,11 +478,11 @@ Scene load_scene(const std::string& path, ObjectGrouping grouping) {
       return text;
     });
   } else if (ext == ".ply") {
-    mesh = read_ply(read_all(), path);
+    mesh = read_ply(read_file_bytes(path), path);
   } else if (ext == ".off") {
-    mesh = read_off(read_all(), path);
+    mesh = read_off(read_file_bytes(path), path);
   } else if (ext == ".stl") {
-    mesh = read_stl(read_all(), path);
+    mesh = read_stl(read_file_bytes(path), path);
   } else if (ext == ".bsp") {
     // Quake 3 maps: the world's opaque surfaces, the sky and the solid brushes that close it
     // (neither rendered), patches at level 4.

@@ -101,8 +101,7 @@ std::vector<std::string> see_through_materials(std::string_view mtl, const std::
 }
 
 RawMesh read_obj(std::istream& in, const std::string& name, const MaterialLibraryReader& read_mtl) {
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw Error(name, 0, "read error");
+  std::string text = read_all(in, name);
   RawMesh mesh;
   std::unordered_map<std::string, uint32_t> group_index;
   constexpr uint32_t kUngrouped = 0xffffffffu;

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <sstream>
 
+#include "viewcells/core/binary_file.h"
 #include "viewcells/core/error.h"
 
 namespace viewcells {
@@ -335,10 +336,7 @@ Q3Map parse_q3bsp(const std::string& bytes, const std::string& name) {
 }
 
 Q3Map read_q3bsp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw Error(path, 0, "cannot open file");
-  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  return parse_q3bsp(bytes, path);
+  return parse_q3bsp(read_file_bytes(path), path);
 }
 
 namespace {

@@ -5,6 +5,7 @@
 /// Little-endian. Reading rejects wrong magic, newer versions, truncation and bit flips.
 #include <cstdint>
 #include <cstring>
+#include <istream>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -114,6 +115,12 @@ std::string read_container(const std::string& path, const char (&magic)[5], uint
 
 /// FNV-1a 64-bit hash of a byte string.
 uint64_t fnv1a64(const std::string& bytes);
+
+/// The rest of stream `in`, read in blocks (a character iterator took about 6 ns a byte:
+/// 0.45 s for a 72 MB hierarchy); throws Error naming `name` on a read error.
+std::string read_all(std::istream& in, const std::string& name);
+/// The whole file at `path`; throws Error naming it when it cannot be opened or read.
+std::string read_file_bytes(const std::string& path);
 
 /// Writes `text` to `path` atomically (a temporary file, then install_file); throws Error on
 /// failure, or when `path` exists as something other than a regular file.
