@@ -131,16 +131,16 @@ class LeafBits {
     const size_t objects = words_ ? bits_.size() / words_ : 0;
     tbb::parallel_for(size_t{0}, (words_ + kBlock - 1) / kBlock, [&](size_t block) {
       const size_t first = block * kBlock, last = std::min(words_, first + kBlock);
-      size_t count[kBlock * 64] = {};
-      for (size_t o = 0; o < objects; ++o)
-        for (size_t k = first; k < last; ++k)
-          for (uint64_t w = bits_[o * words_ + k]; w; w &= w - 1)
-            ++count[(k - first) * 64 + static_cast<size_t>(__builtin_ctzll(w))];
+      // f(object, leaf ordinal) for every bit set in the block, object by object.
+      auto each_bit = [&](auto&& f) {
+        for (size_t o = 0; o < objects; ++o)
+          for (size_t k = first; k < last; ++k)
+            for (uint64_t w = bits_[o * words_ + k]; w; w &= w - 1) f(o, k * 64 + static_cast<size_t>(__builtin_ctzll(w)));
+      };
+      size_t count[kBlock * 64] = {};  // first each list's size, so that each is allocated once
+      each_bit([&](size_t, size_t leaf) { ++count[leaf - first * 64]; });
       for (size_t j = 0; j < (last - first) * 64 && first * 64 + j < leaves_; ++j) out[node(first * 64 + j)].reserve(count[j]);
-      for (size_t o = 0; o < objects; ++o)
-        for (size_t k = first; k < last; ++k)
-          for (uint64_t w = bits_[o * words_ + k]; w; w &= w - 1)
-            out[node(k * 64 + static_cast<size_t>(__builtin_ctzll(w)))].push_back(static_cast<uint32_t>(o));
+      each_bit([&](size_t o, size_t leaf) { out[node(leaf)].push_back(static_cast<uint32_t>(o)); });
     });
   }
 

@@ -473,9 +473,7 @@ Scene load_scene(const std::string& path, ObjectGrouping grouping) {
       const std::filesystem::path mtl = std::filesystem::path(path).parent_path() / file;
       std::ifstream m(mtl, std::ios::binary);
       if (!m) throw Error("cannot open " + mtl.string() + " (without it, see-through materials are unknown)");
-      std::string text((std::istreambuf_iterator<char>(m)), std::istreambuf_iterator<char>());
-      if (m.bad()) throw Error("read error in " + mtl.string());
-      return text;
+      return read_all(m, mtl.string());
     });
   } else if (ext == ".ply") {
     mesh = read_ply(read_file_bytes(path), path);
