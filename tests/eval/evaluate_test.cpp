@@ -512,9 +512,10 @@ TEST(ValidatedMerge, PiecesNeverLoseAndTiesBelowABarrierKeepTheSubdivisionsOrder
   const CandidateScores b = scores([](size_t n) { return n > 32 ? 0.0 : n == 8 ? 0.003 : -0.05; });
   const double allowance = ValidatedMergeConfig{}.worst_allowed;
 
-  auto chain = [&](const std::vector<CandidateScores>& sc, double allowed) {
+  const double margin = ValidatedMergeConfig{}.spread_margin;
+  auto chain = [&](const std::vector<CandidateScores>& sc, double allowed, double spread = 0.0) {
     std::vector<std::array<int64_t, 3>> out;
-    for (const ChosenPiece& p : choose_merge_pieces(candidates, sc, counts, leaves, allowed))
+    for (const ChosenPiece& p : choose_merge_pieces(candidates, sc, counts, leaves, allowed, spread))
       out.push_back({p.candidate, p.from, p.to});
     return out;
   };
@@ -530,6 +531,28 @@ TEST(ValidatedMerge, PiecesNeverLoseAndTiesBelowABarrierKeepTheSubdivisionsOrder
   // Nothing gains: AV-S's own order throughout.
   EXPECT_EQ(chain({scores([](size_t) { return 0.0; }), scores([](size_t) { return 0.0; })}, allowance),
             (Chain{{-1, 64, 0}}));
+
+  // Two held-out sets. C gains 0.8% on one set and 0.02% on the other at 18 cells (as
+  // czest1tourney's choice did at 709 cells), 2% on both elsewhere above 16.
+  auto two_sets = [&](double worse_at_18) {
+    CandidateScores sc = a(0.0);
+    for (size_t j = 0; j < counts.size(); ++j)
+      if (counts[j] == 18) {
+        sc.log_ratio[j] = (-0.008 + worse_at_18) / 2;
+        sc.worst[j] = worse_at_18;
+      }
+    return sc;
+  };
+  const CandidateScores zero = scores([](size_t) { return 0.0; });
+  // Without the margin the worse set's 0.02% is a gain, and C is taken down to its barrier.
+  EXPECT_EQ(chain({two_sets(-0.0002), zero}, allowance), (Chain{{0, 64, 16}, {-1, 16, 0}}));
+  // With the default margin the sets' disagreement (0.39% from their mean) outweighs it: a tie,
+  // and AV-S's own order is kept.
+  EXPECT_EQ(chain({two_sets(-0.0002), zero}, allowance, margin), (Chain{{-1, 64, 0}}));
+  // Where the worse set gains 0.2% (a quarter of the 0.3% to the mean is 0.075%), it is taken.
+  EXPECT_EQ(chain({two_sets(-0.002), zero}, allowance, margin), (Chain{{0, 64, 16}, {-1, 16, 0}}));
+  // One set (worst == mean): the margin changes nothing.
+  EXPECT_EQ(chain({a(0.0), b}, allowance, margin), (Chain{{0, 64, 16}, {-1, 16, 0}}));
 }
 
 }  // namespace

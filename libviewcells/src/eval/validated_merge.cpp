@@ -94,7 +94,7 @@ bool merge_piece_allowed(double sum, double worst, size_t counts, double worst_a
 std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& candidates,
                                              const std::vector<CandidateScores>& scores,
                                              const std::vector<size_t>& counts, uint32_t leaves,
-                                             double worst_allowed) {
+                                             double worst_allowed, double spread_margin) {
   VC_CHECK(scores.size() == candidates.size());
   for (const CandidateScores& sc : scores)
     VC_CHECK(sc.log_ratio.size() == counts.size() && sc.worst.size() == counts.size() && sc.scored.size() == counts.size());
@@ -113,12 +113,14 @@ std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& cand
     double sum = 0, worst = 0;
     size_t counts = 0;
   };
-  auto piece = [&](size_t i, uint32_t below, uint32_t upto) {  // sum and worst on counts in (below, upto]
+  // Sum and worst on counts in (below, upto]; a count's worst raised by the margin on the sets'
+  // disagreement.
+  auto piece = [&](size_t i, uint32_t below, uint32_t upto) {
     Piece p;
     for (size_t j = 0; j < counts.size(); ++j)
       if (counts[j] > below && counts[j] <= upto) {
         p.sum += scores[i].log_ratio[j];
-        p.worst = std::max(p.worst, scores[i].worst[j]);
+        p.worst = std::max(p.worst, scores[i].worst[j] + spread_margin * (scores[i].worst[j] - scores[i].log_ratio[j]));
         p.counts += scores[i].scored[j];
       }
     return p;
@@ -292,7 +294,8 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   std::vector<CandidateScores> scores;
   for (Scored& sc : scored) scores.push_back(std::move(sc.at));
   const std::vector<ChosenPiece> pieces =
-      choose_merge_pieces(candidates, scores, counts, static_cast<uint32_t>(L), config.worst_allowed);
+      choose_merge_pieces(candidates, scores, counts, static_cast<uint32_t>(L), config.worst_allowed,
+                          config.spread_margin);
 
   // The chosen history's merges, piece by piece, named by least leaf.
   Merges chosen;

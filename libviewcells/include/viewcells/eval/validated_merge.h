@@ -16,8 +16,9 @@
 ///     Where a candidate's cut is AV-S's own (at its barrier), the histories below are
 ///     interchangeable, so the choice is made per range of counts: the lowest sum of the mean
 ///     log ratios over all counts (a dynamic program over the barriers), each piece within
-///     the allowance at every count on both B and C, and losing at its worst count no more
-///     than it gains on average (else it is a tie, and ties keep AV-S's order).
+///     the allowance at every count on both B and C (with a margin where B and C disagree),
+///     and losing at its worst count no more than it gains on average (else it is a tie, and
+///     ties keep AV-S's order).
 /// The history written has the chosen merges with PVSs from the construction samples, A, B
 /// and C together (what extraction and compression then store).
 #include <cstdint>
@@ -51,6 +52,16 @@ struct ValidatedMergeConfig {
   /// could lose up to 1% at some counts, and on 6 of 72 OpenArena maps independent samples
   /// then rated AV-M 0.1-0.8% worse than AV-S at q3map2's cluster count or a quarter of it.)
   double worst_allowed = 1e-9;
+  /// The held-out sets' disagreement at a count counted against a piece: its worst log ratio
+  /// there is raised by this times its distance from the sets' mean (half the sets' difference
+  /// with two sets) before it is held to `worst_allowed`. A gain one set shows and the other
+  /// barely does is a tie. With 0 (until 2026-12-04), czest1tourney took a greedy history
+  /// whose worse held-out set rated it 0.02% below AV-S at 709 cells and the better one 0.8%,
+  /// and independent samples rated it 0.03% above AV-S at 757 (q3map2's cluster count); with
+  /// 0.25 the same 71-map table changes only there and at oa_thor's quarter count (both to
+  /// AV-S's own order); with 1, AV-M / AV-S at the cluster count went from a median 0.964 to
+  /// 0.971 (docs/accuracy-vs-time.md). No effect with one held-out set.
+  double spread_margin = 0.25;
   /// Random samples held out as well (drawn as the construction samples are, with their own
   /// seed): the evaluator's kind of PVS. Each count's log ratio is then the mean of the two
   /// held-out sets', and must be within the allowance on each. Unset: the AGVS run alone.
@@ -133,11 +144,13 @@ struct ChosenPiece {
 /// its cut is AV-S's) and then the best choice below; the split is preferred when it does at
 /// least as well, so that merges the held-out samples cannot tell from AV-S's order give way
 /// to it. Every piece passes merge_piece_allowed. An option must beat the best so far by more
-/// than rounding: ties keep the earlier, AV-S's own order first. `counts` ascending.
+/// than rounding: ties keep the earlier, AV-S's own order first. `counts` ascending. A count's
+/// worst is raised by `spread_margin` times its distance from the count's mean
+/// (ValidatedMergeConfig::spread_margin) before a piece's worst is taken.
 std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& candidates,
                                              const std::vector<CandidateScores>& scores,
                                              const std::vector<size_t>& counts, uint32_t leaves,
-                                             double worst_allowed);
+                                             double worst_allowed, double spread_margin);
 
 /// `base`: the construction samples' leaf PVSs, per node of `s` (bsp/subdivision.h leaf_pvs);
 /// `s` needs its cells (neighbours). Deterministic for any thread count.
