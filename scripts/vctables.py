@@ -774,7 +774,7 @@ def merge_vs_time(*args):
     print(f"Each scene: {samples:,} construction samples, AV-S to {cells:,} cells, evaluated on "
           f"{4 * samples:,} independent samples (seed 99); the same leaves merged four ways. \"AGVS per run\" is "
           "the samples of each of the two AGVS runs over the leaves (one to merge on, one held out to choose the "
-          "start, with as many held-out random samples as the construction's); merge seconds are the leaf PVSs (construction samples and AGVS), the neighbour graph and "
+          "start, with four times as many held-out random samples as the construction drew, kHeldOutPerConstructionSample); merge seconds are the leaf PVSs (construction samples and AGVS), the neighbour graph and "
           "merging (every candidate start scored). Worst ratios are over every reported count from 16 cells up; "
           "\"both sets\", where the runs scored on a second evaluation set (seed 100), is the ratio of the costs "
           "summed over the two sets.\n")
