@@ -57,15 +57,19 @@ struct HeldOut {
     }
     return out;
   }
-  /// The mean over the counts scored, and the worst count, as MergeStart reports them.
-  void summarise(const CandidateScores& c, size_t min_cells, MergeStart& st) const {
+  /// The mean over the counts scored, and the worst count (raw and with `margin`), as
+  /// MergeStart reports them.
+  void summarise(const CandidateScores& c, size_t min_cells, double margin, MergeStart& st) const {
     st.score = 0;
     st.worst = 0;
+    st.worst_with_margin = 0;
     size_t terms = 0;
     for (size_t j = 0; j < counts.size(); ++j)
       if (counts[j] >= min_cells && counts[j] >= av_s_min_cells) {
         st.score += c.log_ratio[j];
+        const double raised = c.worst[j] + margin * (c.worst[j] - c.log_ratio[j]);
         st.worst = terms ? std::max(st.worst, c.worst[j]) : c.worst[j];
+        st.worst_with_margin = terms ? std::max(st.worst_with_margin, raised) : raised;
         ++terms;
       }
     if (terms) st.score /= static_cast<double>(terms);
@@ -280,7 +284,7 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
     stale += h.stats.stale;
     Scored& sc = scored[i];
     sc.at = held_out.score(scene, s, h, model);
-    held_out.summarise(sc.at, h.min_cells(), st);
+    held_out.summarise(sc.at, h.min_cells(), config.spread_margin, st);
     sc.merges = merges_by_least_leaf(h);
     sc.at.barrier_cut = st.barrier && h.min_cells() <= st.barrier &&
                      cut_labels(sc.merges, L, L - st.barrier) == cut_labels(av_s_merges, L, L - st.barrier);
@@ -332,7 +336,8 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   out.leaf_pvs.assign(s.nodes.size(), {});
   for (size_t i = 0; i < leaves.size(); ++i) out.leaf_pvs[leaves[i]] = std::move(partition.pvs[i]);
   // The whole chosen history's held-out score, as the candidates were scored.
-  held_out.summarise(held_out.score(scene, s, out.history, model), out.history.min_cells(), sum.chosen);
+  held_out.summarise(held_out.score(scene, s, out.history, model), out.history.min_cells(), config.spread_margin,
+                     sum.chosen);
   out.history.stats.seconds = sum.merge_seconds;
   out.history.stats.evaluations = evaluations.load();  // the replay itself chooses nothing
   out.history.stats.stale = stale.load();

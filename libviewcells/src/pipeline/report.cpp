@@ -157,7 +157,8 @@ json starts_json(const std::vector<MergeStart>& starts) {
                    {"barrier", st.barrier},
                    {"refined", st.refined},
                    {"score", st.score},
-                   {"worst", st.worst}});
+                   {"worst", st.worst},
+                   {"worst_with_margin", st.worst_with_margin}});
   return out;
 }
 

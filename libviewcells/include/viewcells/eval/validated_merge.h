@@ -76,6 +76,9 @@ struct MergeStart {
   /// The barrier's blocks refined first (refine_blocks, on the PVSs merging decides on), the
   /// cells of the cut at `cells` being the units moved: the cut at `barrier` is then not AV-S's.
   bool refined = false;
+  /// `worst` with each count's raised by the held-out sets' disagreement
+  /// (ValidatedMergeConfig::spread_margin): what the choice holds to the allowance.
+  double worst_with_margin = 0;
 };
 
 /// One piece of the chosen history: candidate `start`'s merges from `from` cells (a cut that
