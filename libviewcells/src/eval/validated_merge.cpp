@@ -32,6 +32,10 @@ std::vector<int32_t> cut_labels(const Merges& merges, size_t leaves, size_t k) {
   return up;
 }
 
+/// A count's worst held-out log ratio raised by `margin` times its distance from the sets' mean
+/// (ValidatedMergeConfig::spread_margin).
+double raised_worst(double worst, double mean, double margin) { return worst + margin * (worst - mean); }
+
 /// The held-out leaf PVS sets (B, and C when drawn), AV-S's costs on each, and the counts scored.
 struct HeldOut {
   std::vector<const std::vector<std::vector<uint32_t>>*> pvs;
@@ -67,7 +71,7 @@ struct HeldOut {
     for (size_t j = 0; j < counts.size(); ++j)
       if (counts[j] >= min_cells && counts[j] >= av_s_min_cells) {
         st.score += c.log_ratio[j];
-        const double raised = c.worst[j] + margin * (c.worst[j] - c.log_ratio[j]);
+        const double raised = raised_worst(c.worst[j], c.log_ratio[j], margin);
         st.worst = terms ? std::max(st.worst, c.worst[j]) : c.worst[j];
         st.worst_with_margin = terms ? std::max(st.worst_with_margin, raised) : raised;
         ++terms;
@@ -124,7 +128,7 @@ std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& cand
     for (size_t j = 0; j < counts.size(); ++j)
       if (counts[j] > below && counts[j] <= upto) {
         p.sum += scores[i].log_ratio[j];
-        p.worst = std::max(p.worst, scores[i].worst[j] + spread_margin * (scores[i].worst[j] - scores[i].log_ratio[j]));
+        p.worst = std::max(p.worst, raised_worst(scores[i].worst[j], scores[i].log_ratio[j], spread_margin));
         p.counts += scores[i].scored[j];
       }
     return p;
