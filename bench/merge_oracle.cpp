@@ -1,14 +1,15 @@
-// How low can any merge of AV-S's leaves go at a few cells? An optimistic reference for the
+// How low can a merge of a tree's leaves go at a few cells? An optimistic reference for the
 // merging issue's low-count goals (AV-M at most 0.8 x KD-CASM on the office from 16 cells up):
-// the leaves of AV-S (built as `compare` builds them) are merged with the PVSs of evaluation set
-// 1 itself, which is the evaluator's own objective on that set, greedily from AV-S's cuts at
-// every halving of the leaves, then refined (cells moved between neighbouring blocks while set
-// 1's cost drops, refine_blocks). Scored on set 1 this fits the evaluator's samples (no method
-// that is given only construction samples can see them), so it rates the cells better than any
-// honest method could expect; set 2 (independent) says what those cells are worth. If even set
-// 1 cannot bring the cells to the goal's ratio, no merge of these leaves that greedy merging and
+// the leaves of AV-S (built as `compare` builds them), and as a second base KD-CASM's, are
+// merged with the PVSs of evaluation set 1 itself, which is the evaluator's own objective on
+// that set: greedily from the tree's cuts at every halving of its leaves, each cut (and the
+// tree's own) then refined (single leaves moved between neighbouring blocks while set 1's cost
+// drops, refine_blocks). Scored on set 1 this fits the evaluator's samples (no method that is
+// given only construction samples can see them), so it rates the cells better than any honest
+// method could expect; set 2 (independent) says what those cells are worth. If even set 1
+// cannot bring the cells to the goal's ratio, no merge of these leaves that greedy merging and
 // refinement can find reaches it there.
-// Prints, per cell count: KD-CASM, AV-S and the best oracle cells on both sets.
+// Prints, per cell count: KD-CASM, AV-S and the oracle cells set 1 rates best, on both sets.
 // Usage: viewcells_merge_oracle SCENE SAMPLES CELLS EVAL_SAMPLES COUNT[,COUNT...] [VIEW_BOX|-] [SET2_SAMPLES]
 // (VIEW_BOX: xmin,ymin,zmin,xmax,ymax,zmax, as `compare --view-box`; set 2 draws EVAL_SAMPLES
 // unless SET2_SAMPLES is given, so that the cells can be fitted on fewer samples than score them.)
@@ -147,18 +148,29 @@ int main(int argc, char** argv) {
         throw Error("cell count " + std::to_string(k) + " is not between 2 and the " + std::to_string(leaves) +
                     " leaves built");
 
-    // The candidates: greedy merging on set 1 from AV-S's cut at every halving of the leaves.
-    std::vector<std::pair<std::string, MergeHistory>> histories;
-    for (size_t from = leaves; from >= 32; from /= 2) {
-      MergeConfig mc;
-      mc.show_progress = false;
-      mc.min_cells = std::max<uint32_t>(1, *std::min_element(counts.begin(), counts.end()) / 2);
-      if (from < leaves) mc.prefix = subdivision_prefix(s, from);
-      histories.emplace_back("greedy from " + std::to_string(from), merge_cells(scene, p1, model, mc));
+    // The candidates, from each tree's leaves (AV-S's, and KD-CASM's as a second base): greedy
+    // merging on set 1 from the tree's cut at every halving of its leaves.
+    struct Base {
+      std::string name;
+      const Subdivision* tree;
+      const CellPartition *fit, *score;
+      std::vector<std::pair<std::string, MergeHistory>> histories;
+      std::vector<int32_t> unit;  // single leaves
+    };
+    std::vector<Base> bases = {{"AV-S", &s, &p1, &p2, {}, {}}, {"KD-CASM", &kd, &kd1_cells, &kd2_cells, {}, {}}};
+    for (Base& b : bases) {
+      const size_t n = b.fit->size();
+      for (size_t from = n; from >= 32; from /= 2) {
+        MergeConfig mc;
+        mc.show_progress = false;
+        mc.min_cells = std::max<uint32_t>(1, *std::min_element(counts.begin(), counts.end()) / 2);
+        if (from < n) mc.prefix = subdivision_prefix(*b.tree, from);
+        b.histories.emplace_back("greedy from " + std::to_string(from), merge_cells(scene, *b.fit, model, mc));
+      }
+      b.unit.resize(n);
+      std::iota(b.unit.begin(), b.unit.end(), 0);
     }
-    std::vector<int32_t> unit(leaves);
-    std::iota(unit.begin(), unit.end(), 0);
-    std::printf("scene %s, %zu leaves; costs on evaluation set 1 (fitted) and set 2 (independent)\n", argv[1],
+    std::printf("scene %s, %zu AV-S leaves; costs on evaluation set 1 (fitted) and set 2 (independent)\n", argv[1],
                 leaves);
     std::printf("| cells | KD-CASM set 1 | set 2 | AV-S set 1 | set 2 | oracle set 1 | set 2 | oracle / KD-CASM set 1 | set 2 | best oracle |\n");
     std::printf("| ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |\n");
@@ -167,27 +179,30 @@ int main(int argc, char** argv) {
       const double avs1 = blocks_cost(p1, r, avs_blocks), avs2 = blocks_cost(p2, r, avs_blocks);
       double best1 = avs1, best2 = avs2;
       std::string best_name = "AV-S's cut";
-      auto consider = [&](const std::string& name, const std::vector<int32_t>& block) {
-        if (block_count(block) != k) return;
-        const double c1 = blocks_cost(p1, r, block);
-        if (c1 < best1) {
-          best1 = c1;
-          best2 = blocks_cost(p2, r, block);
-          best_name = name;
+      for (const Base& b : bases) {
+        auto consider = [&](const std::string& name, const std::vector<int32_t>& block) {
+          if (block_count(block) != k) return;
+          const double c1 = blocks_cost(*b.fit, r, block);
+          if (c1 < best1) {
+            best1 = c1;
+            best2 = blocks_cost(*b.score, r, block);
+            best_name = b.name + " leaves, " + name;
+          }
+        };
+        const std::vector<int32_t> cut = subdivision_blocks(*b.tree, k);
+        consider("its cut", cut);
+        consider("its cut, refined", refine_blocks(scene, *b.fit, model, b.unit, cut, 100));
+        for (const auto& [name, h] : b.histories) {
+          if (k < h.min_cells() || k > h.leaf_count) continue;
+          const std::vector<int32_t> block = cut_labels(h, k);
+          consider(name, block);
+          consider(name + ", refined", refine_blocks(scene, *b.fit, model, b.unit, block, 100));
         }
-      };
-      consider("AV-S's cut, refined", refine_blocks(scene, p1, model, unit, avs_blocks, 100));
-      for (const auto& [name, h] : histories) {
-        if (k < h.min_cells() || k > h.leaf_count) continue;
-        const std::vector<int32_t> block = cut_labels(h, k);
-        consider(name, block);
-        consider(name + ", refined", refine_blocks(scene, p1, model, unit, block, 100));
       }
       const double kd1 = blocks_cost(kd1_cells, r, subdivision_blocks(kd, k));
       const double kd2 = blocks_cost(kd2_cells, r, subdivision_blocks(kd, k));
-      std::printf("| %u | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.3f | %.3f | %s |\n", k, kd1, kd2,
-                  avs1, avs2, best1, best2, best1 / kd1, best2 / kd2,
-                  best_name.c_str());
+      std::printf("| %u | %.0f | %.0f | %.0f | %.0f | %.0f | %.0f | %.3f | %.3f | %s |\n", k, kd1, kd2, avs1, avs2, best1,
+                  best2, best1 / kd1, best2 / kd2, best_name.c_str());
       std::fflush(stdout);
     }
   } catch (const Error& e) {
