@@ -15,7 +15,9 @@
 // unless SET2_SAMPLES is given, so that the cells can be fitted on fewer samples than score them.)
 // (construction seed 1, evaluation sets seeds 1000004 and 1000005, as scripts/results.sh.)
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
+#include <exception>
 #include <cstdlib>
 #include <map>
 #include <numeric>
@@ -75,6 +77,19 @@ double blocks_cost(const CellPartition& p, const std::vector<double>& r, const s
   return total / weight;
 }
 
+/// A whole number from the command line (Error naming it if it is not one).
+uint64_t whole(const std::string& text, const char* what) {
+  size_t used = 0;
+  uint64_t v = 0;
+  try {
+    v = std::stoull(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size()) throw Error(std::string(what) + ": not a whole number: '" + text + "'");
+  return v;
+}
+
 size_t block_count(const std::vector<int32_t>& block) {
   std::vector<int32_t> b = block;
   std::sort(b.begin(), b.end());
@@ -94,27 +109,36 @@ int main(int argc, char** argv) {
     const auto caster = make_embree_caster(scene);
     // As `compare --samples SAMPLES --seed 1 --max-cells CELLS` builds AV-S and KD-CASM.
     SamplerConfig construction;
-    construction.samples = std::strtoull(argv[2], nullptr, 10);
+    construction.samples = whole(argv[2], "SAMPLES");
     construction.seed = 1;
     construction.show_progress = false;
     if (argc > 6 && std::string(argv[6]) != "-") {
       std::vector<double> v;
       std::stringstream ss(argv[6]);
-      for (std::string item; std::getline(ss, item, ',');) v.push_back(std::stod(item));
+      for (std::string item; std::getline(ss, item, ',');) {
+        size_t used = 0;
+        try {
+          v.push_back(std::stod(item, &used));
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != item.size()) throw Error("VIEW_BOX: not a number: '" + item + "'");
+      }
       if (v.size() != 6) throw Error("the view box needs six numbers: xmin,ymin,zmin,xmax,ymax,zmax");
       construction.view_box = Box3{{v[0], v[1], v[2]}, {v[3], v[4], v[5]}};
     }
     std::vector<uint32_t> counts;
     {
       std::stringstream ss(argv[5]);
-      for (std::string item; std::getline(ss, item, ',');) counts.push_back(static_cast<uint32_t>(std::stoul(item)));
+      for (std::string item; std::getline(ss, item, ',');)
+        counts.push_back(static_cast<uint32_t>(std::min<uint64_t>(whole(item, "COUNT"), UINT32_MAX)));
     }
     if (counts.empty()) throw Error("no cell counts given");
     const CostModel model;
     const SamplingResult built = sample_segments(scene, *caster, construction);
     auto build = [&](SplitStrategy strategy) {
       SubdivisionConfig sc;
-      sc.max_cells = static_cast<uint32_t>(std::strtoul(argv[3], nullptr, 10));
+      sc.max_cells = static_cast<uint32_t>(std::min<uint64_t>(whole(argv[3], "CELLS"), 10'000'000));
       sc.strategy = strategy;
       sc.seed = construction.seed;
       sc.show_progress = false;
@@ -139,9 +163,9 @@ int main(int argc, char** argv) {
       });
       return std::pair{partition_from_subdivision(s, of_s.take()), partition_from_subdivision(kd, of_kd.take())};
     };
-    const uint64_t set1 = std::strtoull(argv[4], nullptr, 10);
+    const uint64_t set1 = whole(argv[4], "EVAL_SAMPLES");
     const auto [p1, kd1_cells] = draw(1000004, set1);
-    const auto [p2, kd2_cells] = draw(1000005, argc > 7 ? std::strtoull(argv[7], nullptr, 10) : set1);
+    const auto [p2, kd2_cells] = draw(1000005, argc > 7 ? whole(argv[7], "SET2_SAMPLES") : set1);
     const size_t leaves = p1.size();
     for (uint32_t k : counts)
       if (k < 2 || k > leaves)
