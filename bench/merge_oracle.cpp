@@ -40,15 +40,9 @@ namespace {
 
 /// Per partition cell (leaf order), the label of its cell in `h`'s cut with `cells` cells.
 std::vector<int32_t> cut_labels(const MergeHistory& h, size_t cells) {
-  std::vector<int32_t> label(h.nodes.size());
-  std::iota(label.begin(), label.end(), 0);
-  const size_t merges = h.leaf_count - cells;
-  // Top-down: a node merged within the cut takes its parent's label.
-  for (size_t n = h.leaf_count + merges; n-- > 0;) {
-    const int32_t p = h.nodes[n].parent;
-    if (p >= 0 && static_cast<size_t>(p) < h.leaf_count + merges) label[n] = label[static_cast<size_t>(p)];
-  }
-  label.resize(h.leaf_count);
+  std::vector<int32_t> label(h.leaf_count);
+  for (int32_t n : h.cut_after(h.leaf_count - cells))
+    for (uint32_t leaf : h.leaves_under(n)) label[leaf] = n;
   return label;
 }
 

@@ -6,7 +6,8 @@
 #  4. Embree robust against fast mode: speed, and rays leaking through edges and vertices
 #     counted against the watertight brute-force caster.
 # Sections 5 (merging) and 6 (subdivision candidates) come from scripts/merge-vs-time.sh and
-# scripts/candidates-vs-time.sh; this script keeps what they last wrote.
+# scripts/candidates-vs-time.sh and hold measurements written beside their tables; this script
+# keeps them as they are.
 # Writes docs/accuracy-vs-time.md and its plots in docs/accuracy/.
 # Usage: scripts/accuracy-vs-time.sh [CELLS] [CITY_SIZE]
 set -euo pipefail
@@ -52,19 +53,28 @@ done
 [ "${ACCURACY_REUSE:-0}" = 1 ] && [ -f "$out/leaks.json" ] ||
   build-release/bench/viewcells_leaks "$small_city" "$city" 50000 4000000 "$out/leaks.json" >/dev/null
 
-python3 scripts/vctables.py accuracy "$out" "$cells" "$size" > docs/accuracy-vs-time.md
-# Section 5 is scripts/merge-vs-time.sh's; keep what it last wrote.
-printf '\n## 5. Merging: what the validated merge costs and gains\n\n<!-- merge:begin -->\nNot generated yet: run scripts/merge-vs-time.sh.\n<!-- merge:end -->\n' >> docs/accuracy-vs-time.md
-if [ -f docs/accuracy/merge.md ] && [ -f docs/accuracy/merge.command ]; then
-  python3 scripts/vctables.py replace-section docs/accuracy-vs-time.md merge "$(cat docs/accuracy/merge.command)" \
-    docs/accuracy/merge.md
+# Sections 1-4 are this script's. Sections 5 and 6 are scripts/merge-vs-time.sh's and
+# scripts/candidates-vs-time.sh's tables with the measurements written beside them: kept as they
+# are (their tables refreshed from what those scripts last wrote). The new file replaces the old
+# one only once it is whole.
+doc=docs/accuracy-vs-time.md
+new="$doc.new"
+python3 scripts/vctables.py accuracy "$out" "$cells" "$size" > "$new"
+if [ -f "$doc" ] && grep -q '^## 5\. ' "$doc"; then
+  printf '\n' >> "$new"
+  sed -n '/^## 5\. /,$p' "$doc" >> "$new"
+else
+  printf '\n## 5. Merging: what the validated merge costs and gains\n\n<!-- merge:begin -->\nNot generated yet: run scripts/merge-vs-time.sh.\n<!-- merge:end -->\n' >> "$new"
+  printf '\n## 6. Subdivision candidates: fast against exact, and positions per axis\n\n<!-- candidates:begin -->\nNot generated yet: run scripts/candidates-vs-time.sh.\n<!-- candidates:end -->\n' >> "$new"
 fi
-# Section 6 is scripts/candidates-vs-time.sh's; likewise.
-printf '\n## 6. Subdivision candidates: fast against exact, and positions per axis\n\n<!-- candidates:begin -->\nNot generated yet: run scripts/candidates-vs-time.sh.\n<!-- candidates:end -->\n' >> docs/accuracy-vs-time.md
+if [ -f docs/accuracy/merge.md ] && [ -f docs/accuracy/merge.command ]; then
+  python3 scripts/vctables.py replace-section "$new" merge "$(cat docs/accuracy/merge.command)" docs/accuracy/merge.md
+fi
 if [ -f docs/accuracy/candidates.md ] && [ -f docs/accuracy/candidates.command ]; then
-  python3 scripts/vctables.py replace-section docs/accuracy-vs-time.md candidates "$(cat docs/accuracy/candidates.command)" \
+  python3 scripts/vctables.py replace-section "$new" candidates "$(cat docs/accuracy/candidates.command)" \
     docs/accuracy/candidates.md
 fi
+mv "$new" "$doc"
 
 # Plots: evaluated cost against cells per construction sample count; AA / AA+GA ratio.
 for scene in office city; do
