@@ -99,10 +99,16 @@ bool merge_piece_allowed(double sum, double worst, size_t counts, double worst_a
   return worst <= worst_allowed && (counts == 0 || worst <= -sum / static_cast<double>(counts));
 }
 
+bool merge_piece_within(const PieceAllowance& allowed, bool refined, double sum, double worst, double worst_low,
+                        size_t counts) {
+  if (!refined) return merge_piece_allowed(sum, std::max(worst, worst_low), counts, allowed.greedy);
+  return worst_low <= allowed.refined_low && merge_piece_allowed(sum, worst, counts, allowed.refined);
+}
+
 std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& candidates,
                                              const std::vector<CandidateScores>& scores,
                                              const std::vector<size_t>& counts, uint32_t leaves,
-                                             double worst_allowed, double spread_margin) {
+                                             const PieceAllowance& allowed, double spread_margin) {
   VC_CHECK(scores.size() == candidates.size());
   for (const CandidateScores& sc : scores)
     VC_CHECK(sc.log_ratio.size() == counts.size() && sc.worst.size() == counts.size() && sc.scored.size() == counts.size());
@@ -118,23 +124,28 @@ std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& cand
     return tails[static_cast<size_t>(std::lower_bound(ends.begin(), ends.end(), c) - ends.begin())];
   };
   struct Piece {
-    double sum = 0, worst = 0;
+    double sum = 0, worst = 0, worst_low = 0;  // worst_low: below allowed.low_below
     size_t counts = 0;
+    bool refined = false;
   };
   // Sum and worst on counts in (below, upto]; a count's worst raised by the margin on the sets'
   // disagreement.
   auto piece = [&](size_t i, uint32_t below, uint32_t upto) {
     Piece p;
+    p.refined = candidates[i].refined;
     for (size_t j = 0; j < counts.size(); ++j)
       if (counts[j] > below && counts[j] <= upto) {
         p.sum += scores[i].log_ratio[j];
-        p.worst = std::max(p.worst, raised_worst(scores[i].worst[j], scores[i].log_ratio[j], spread_margin));
+        double& w = counts[j] < allowed.low_below ? p.worst_low : p.worst;
+        w = std::max(w, raised_worst(scores[i].worst[j], scores[i].log_ratio[j], spread_margin));
         p.counts += scores[i].scored[j];
       }
     return p;
   };
   constexpr double kGain = 1e-9;  // rounding, in a sum of log ratios
-  auto allowed = [&](const Piece& p) { return merge_piece_allowed(p.sum, p.worst, p.counts, worst_allowed); };
+  auto within = [&](const Piece& p) {
+    return merge_piece_within(allowed, p.refined, p.sum, p.worst, p.worst_low, p.counts);
+  };
   for (size_t e = 0; e < ends.size(); ++e) {
     const uint32_t c = ends[e];
     Tail best;  // AV-S's own order: 0
@@ -145,13 +156,13 @@ std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& cand
       // that does at least as well.
       const Piece whole = piece(i, 0, c);
       std::optional<Tail> option;
-      if (allowed(whole)) option = Tail{whole.sum, whole.worst, static_cast<int>(i), false};
+      if (within(whole)) option = Tail{whole.sum, std::max(whole.worst, whole.worst_low), static_cast<int>(i), false};
       if (st.barrier && scores[i].barrier_cut) {
         const Piece upper = piece(i, st.barrier, c);
         const Tail& below = tail_at(st.barrier);
         const double split = upper.sum + below.sum;
-        if (allowed(upper) && (!option || split <= option->sum + kGain))
-          option = Tail{split, std::max(upper.worst, below.worst), static_cast<int>(i), true};
+        if (within(upper) && (!option || split <= option->sum + kGain))
+          option = Tail{split, std::max({upper.worst, upper.worst_low, below.worst}), static_cast<int>(i), true};
       }
       if (option && option->sum < best.sum - kGain) best = *option;
     }
@@ -225,17 +236,17 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
       candidates.push_back({static_cast<uint32_t>(start), static_cast<uint32_t>(barrier), 0.0, 0.0});
   }
   // Refined at low counts: from AV-S's cut at `cells`, its cells are moved between the blocks
-  // of AV-S's cut at `barrier` where the merge PVSs say it lowers the cost; merging joins
-  // within those blocks down to `barrier`, and at every halving below, the cells of the count
-  // above are moved between the blocks greedy merging reaches, and merging goes on within them.
-  // The units moved are AV-S's cells at 4 to 64 per block: finer ones fit the merge PVSs'
-  // noise (on the office, refined histories from 2,500 and 5,000 cells scored 1-9% worse than
-  // AV-S on the held-out samples, from 312 cells 2-5% better).
-  constexpr uint32_t kRefinedBarrier = 64;
+  // of AV-S's cut at `barrier` (64 or 32 cells) where the merge PVSs say it lowers the cost;
+  // merging joins within those blocks down to `barrier`, and at every halving below, the cells
+  // of the count above are moved between the blocks greedy merging reaches, and merging goes on
+  // within them. The units moved are AV-S's cells at 4 to 64 per block: finer ones fit the
+  // merge PVSs' noise (on the office, refined histories from 2,500 and 5,000 cells scored 1-9%
+  // worse than AV-S on the held-out samples, from 312 cells 2-5% better). Blocks of 32 cells:
+  // the office's choice from 424 cells (docs/accuracy-vs-time.md, section 5).
   if (!model.pixel_term())
-    for (size_t start = L; start >= 4 * kRefinedBarrier; start /= 2)
-      if (start <= 64 * kRefinedBarrier)
-        candidates.push_back({static_cast<uint32_t>(start), kRefinedBarrier, 0.0, 0.0, true});
+    for (const uint32_t barrier : {64u, 32u})
+      for (size_t start = L; start >= 4 * barrier; start /= 2)
+        if (start <= 64 * barrier) candidates.push_back({static_cast<uint32_t>(start), barrier, 0.0, 0.0, true});
   // AV-S's replay on each held-out set, kept at every candidate's start (its first L - start
   // merges are AV-S's own), and AV-S's curves.
   std::vector<size_t> starts;
@@ -302,8 +313,7 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   std::vector<CandidateScores> scores;
   for (Scored& sc : scored) scores.push_back(std::move(sc.at));
   const std::vector<ChosenPiece> pieces =
-      choose_merge_pieces(candidates, scores, counts, static_cast<uint32_t>(L), config.worst_allowed,
-                          config.spread_margin);
+      choose_merge_pieces(candidates, scores, counts, static_cast<uint32_t>(L), config.allowed, config.spread_margin);
 
   // The chosen history's merges, piece by piece, named by least leaf.
   Merges chosen;

@@ -37,6 +37,28 @@
 
 namespace viewcells {
 
+/// How far above AV-S's cut of the same size the held-out samples may rate the counts of a
+/// piece merge_validated takes (log cost ratios; each count's worst held-out set, raised by the
+/// sets' disagreement). Every piece must also lose at its worst count no more than it gains on
+/// average (merge_piece_allowed).
+struct PieceAllowance {
+  /// Greedy pieces, at every count: rounding, so no count of such a piece may be rated worse
+  /// than AV-S's cut by either held-out set. (Until 2026-12-03 it was 0.01: pieces that gained
+  /// on average could lose up to 1% at some counts, and on 6 of 72 OpenArena maps independent
+  /// samples then rated AV-M 0.1-0.8% worse than AV-S at q3map2's cluster count or a quarter.)
+  double greedy = 1e-9;
+  /// Refined pieces (MergeStart::refined), at counts from `low_below` up. A refined history's
+  /// cut is not AV-S's below its barrier, so it cannot give way to AV-S's order at the few
+  /// counts where it loses the way a greedy piece does at its barrier: held to rounding, the
+  /// street-level town's refined histories, 0.4-2.4% better than AV-S at 6-93 cells on both
+  /// held-out sets, were refused for 0.1% at 147 cells (docs/accuracy-vs-time.md, section 5).
+  double refined = 0.002;
+  /// Refined pieces at counts below `low_below`, where refinement that stops at a few cells
+  /// costs most (2-3.5% at 4 cells on that town) and the goals' curves do not reach.
+  double refined_low = 0.02;
+  size_t low_below = 16;
+};
+
 struct ValidatedMergeConfig {
   /// Sampling and stopping rule of each of the two AGVS runs; the validation run's seed is
   /// agvs.seed + 1.
@@ -45,16 +67,13 @@ struct ValidatedMergeConfig {
   /// Counts scored, log-spaced from min(4, leaves) to the leaves, factor 1.25 (4, 6, 8, 11, 14,
   /// 18, ...): a small map is cut to a few cells.
   uint32_t score_from = 4;
-  /// A start (or a piece of one) is taken only when its worst count is at most this (a log
-  /// ratio) above AV-S's, and at most its mean gain (merge_piece_allowed). The default is
-  /// rounding: no count of a piece taken may be rated worse than AV-S's cut of the same size
-  /// by either held-out set. (Until 2026-12-03 it was 0.01: a piece that gained on average
-  /// could lose up to 1% at some counts, and on 6 of 72 OpenArena maps independent samples
-  /// then rated AV-M 0.1-0.8% worse than AV-S at q3map2's cluster count or a quarter of it.)
-  double worst_allowed = 1e-9;
+  /// How far above AV-S's cut of the same size the held-out samples may rate a piece's counts
+  /// (PieceAllowance): greedy pieces not at all, refined ones by 0.2% from 16 cells up and 2%
+  /// below.
+  PieceAllowance allowed;
   /// The held-out sets' disagreement at a count counted against a piece: its worst log ratio
   /// there is raised by this times its distance from the sets' mean (half the sets' difference
-  /// with two sets) before it is held to `worst_allowed`. A gain one set shows and the other
+  /// with two sets) before it is held to the allowance. A gain one set shows and the other
   /// barely does is a tie. With 0 (until 2026-12-04), czest1tourney took a greedy history
   /// whose worse held-out set rated it 0.02% below AV-S at 709 cells and the better one 0.8%,
   /// and independent samples rated it 0.03% above AV-S at 757 (q3map2's cluster count); with
@@ -126,6 +145,14 @@ std::string describe_chain(const MergeSummary& summary);
 /// samples' noise, and a tie keeps AV-S's own order (merging must not make a cut worse).
 bool merge_piece_allowed(double sum, double worst, size_t counts, double worst_allowed);
 
+/// merge_validated's test of a piece under `allowed`: `worst` is the largest log ratio of its
+/// counts from allowed.low_below up, `worst_low` of those below (each at least 0). A greedy
+/// piece is held at every count to allowed.greedy; a refined one to allowed.refined from
+/// low_below up and to allowed.refined_low below. Both pass merge_piece_allowed with the worst
+/// that is held to the goals' counts (every count for a greedy piece).
+bool merge_piece_within(const PieceAllowance& allowed, bool refined, double sum, double worst, double worst_low,
+                        size_t counts);
+
 /// A candidate history's held-out scores at the counts scored (0 where it or AV-S does not
 /// reach the count).
 struct CandidateScores {
@@ -146,14 +173,14 @@ struct ChosenPiece {
 /// ratios over the counts scored. Each candidate is taken whole, or down to its barrier (where
 /// its cut is AV-S's) and then the best choice below; the split is preferred when it does at
 /// least as well, so that merges the held-out samples cannot tell from AV-S's order give way
-/// to it. Every piece passes merge_piece_allowed. An option must beat the best so far by more
+/// to it. Every piece passes merge_piece_within. An option must beat the best so far by more
 /// than rounding: ties keep the earlier, AV-S's own order first. `counts` ascending. A count's
 /// worst is raised by `spread_margin` times its distance from the count's mean
 /// (ValidatedMergeConfig::spread_margin) before a piece's worst is taken.
 std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& candidates,
                                              const std::vector<CandidateScores>& scores,
                                              const std::vector<size_t>& counts, uint32_t leaves,
-                                             double worst_allowed, double spread_margin);
+                                             const PieceAllowance& allowed, double spread_margin);
 
 /// `base`: the construction samples' leaf PVSs, per node of `s` (bsp/subdivision.h leaf_pvs);
 /// `s` needs its cells (neighbours). Deterministic for any thread count.
