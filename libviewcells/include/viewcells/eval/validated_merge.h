@@ -8,17 +8,19 @@
 ///     united with those of an AGVS run over the cells ("merge" run, A);
 ///  2. the greedy merging starts from a cut of the subdivision's own order (AV-S's, undone
 ///     split by split from the leaves), chosen on samples that no decision has seen: a
-///     second, independent AGVS run (B) and as many random samples as the construction drew,
-///     drawn the same way (C, the evaluator's kind of PVS). Each candidate,
-///     greedy from every cut by halves, with and without barriers, is scored by its log cost
-///     ratio to AV-S's cuts at log-spaced counts, on B and on C separately. Pure AV-S (ratio
-///     0) is a candidate, so merging is kept only where the held-out samples say it pays.
-///     Where a candidate's cut is AV-S's own (at its barrier), the histories below are
-///     interchangeable, so the choice is made per range of counts: the lowest sum of the mean
-///     log ratios over all counts (a dynamic program over the barriers), each piece within
-///     the allowance at every count on both B and C (with a margin where B and C disagree),
-///     and losing at its worst count no more than it gains on average (else it is a tie, and
-///     ties keep AV-S's order).
+///     second, independent AGVS run (B) and four times as many random samples as the
+///     construction drew, drawn the same way (C, the evaluator's kind of PVS). Each candidate,
+///     greedy from every cut by halves, with and without barriers, or within blocks refined at
+///     low counts, is scored by its log cost ratio to AV-S's cuts at log-spaced counts, on B
+///     and on C separately. Pure AV-S (ratio 0) is a candidate, so merging is kept only where
+///     the held-out samples say it pays. Where a candidate's cut is AV-S's own (at its
+///     barrier), the histories below are interchangeable, so the choice is made per range of
+///     counts: the lowest sum of the mean log ratios over all counts (a dynamic program over
+///     the barriers), each piece within the allowance at every count on both B and C (with a
+///     margin where B and C disagree; PieceAllowance: none for greedy pieces, a little for
+///     refined ones, which cannot give way to AV-S's order below their barrier), and losing
+///     at its worst count no more than it gains on average (else it is a tie, and ties keep
+///     AV-S's order).
 /// The history written has the chosen merges with PVSs from the construction samples, A, B
 /// and C together (what extraction and compression then store).
 #include <cstdint>
