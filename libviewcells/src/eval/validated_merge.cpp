@@ -88,7 +88,7 @@ struct Scored {
 
 /// The lowest sum of log ratios for the counts at most `c`, from AV-S's cut at `c` down.
 struct Tail {
-  double sum = 0, worst = 0;
+  double sum = 0;
   int candidate = -1;  ///< -1: AV-S's own order
   bool split = false;  ///< the candidate down to its barrier, then tails[barrier]
 };
@@ -156,13 +156,13 @@ std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& cand
       // that does at least as well.
       const Piece whole = piece(i, 0, c);
       std::optional<Tail> option;
-      if (within(whole)) option = Tail{whole.sum, std::max(whole.worst, whole.worst_low), static_cast<int>(i), false};
+      if (within(whole)) option = Tail{whole.sum, static_cast<int>(i), false};
       if (st.barrier && scores[i].barrier_cut) {
         const Piece upper = piece(i, st.barrier, c);
         const Tail& below = tail_at(st.barrier);
         const double split = upper.sum + below.sum;
         if (within(upper) && (!option || split <= option->sum + kGain))
-          option = Tail{split, std::max({upper.worst, upper.worst_low, below.worst}), static_cast<int>(i), true};
+          option = Tail{split, static_cast<int>(i), true};
       }
       if (option && option->sum < best.sum - kGain) best = *option;
     }
@@ -242,7 +242,7 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   // within them. The units moved are AV-S's cells at 4 to 64 per block: finer ones fit the
   // merge PVSs' noise (on the office, refined histories from 2,500 and 5,000 cells scored 1-9%
   // worse than AV-S on the held-out samples, from 312 cells 2-5% better). Blocks of 32 cells:
-  // the office's choice from 424 cells (docs/accuracy-vs-time.md, section 5).
+  // the office's and the town's choice at low counts (docs/accuracy-vs-time.md, section 5).
   if (!model.pixel_term())
     for (const uint32_t barrier : {64u, 32u})
       for (size_t start = L; start >= 4 * barrier; start /= 2)
