@@ -53,7 +53,8 @@ struct PieceAllowance {
   /// cut is not AV-S's below its barrier, so it cannot give way to AV-S's order at the few
   /// counts where it loses the way a greedy piece does at its barrier: held to rounding, the
   /// street-level town's refined histories, 0.4-2.4% better than AV-S at 6-93 cells on both
-  /// held-out sets, were refused for 0.1% at 147 cells (docs/accuracy-vs-time.md, section 5).
+  /// held-out sets, were refused for losing 0.2-3.5% at 4 cells or 0.1% at 147 on one set
+  /// (docs/accuracy-vs-time.md, section 5).
   double refined = 0.002;
   /// Refined pieces at counts below `low_below`, where refinement that stops at a few cells
   /// costs most (2-3.5% at 4 cells on that town) and the goals' curves do not reach.
