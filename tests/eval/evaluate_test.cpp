@@ -500,6 +500,16 @@ TEST(ValidatedMerge, PiecesThatGainLessThanTheyLoseAreTies) {
   EXPECT_TRUE(merge_piece_within(allowed, true, -0.0005 * 40, 0.0, 0.015, 40));  // below 16: only the 2%
 }
 
+/// choose_merge_pieces' choice as (candidate, from, to) per piece.
+using Chain = std::vector<std::array<int64_t, 3>>;
+Chain chosen_chain(const std::vector<MergeStart>& candidates, const std::vector<CandidateScores>& scores,
+                   const std::vector<size_t>& counts, uint32_t leaves, const PieceAllowance& allowed, double spread) {
+  Chain out;
+  for (const ChosenPiece& p : choose_merge_pieces(candidates, scores, counts, leaves, allowed, spread))
+    out.push_back({p.candidate, p.from, p.to});
+  return out;
+}
+
 /// The choice between candidate histories: a piece with a loss at one count is refused under
 /// the default allowance, and a candidate whose merges below its barrier tie with AV-S's order
 /// on the held-out samples gives way to AV-S's order there.
@@ -531,12 +541,8 @@ TEST(ValidatedMerge, PiecesNeverLoseAndTiesBelowABarrierKeepTheSubdivisionsOrder
   auto chain = [&](const std::vector<CandidateScores>& sc, double greedy, double spread = 0.0) {
     PieceAllowance allowed;
     allowed.greedy = greedy;
-    std::vector<std::array<int64_t, 3>> out;
-    for (const ChosenPiece& p : choose_merge_pieces(candidates, sc, counts, leaves, allowed, spread))
-      out.push_back({p.candidate, p.from, p.to});
-    return out;
+    return chosen_chain(candidates, sc, counts, leaves, allowed, spread);
   };
-  using Chain = std::vector<std::array<int64_t, 3>>;
   // Default: B is refused; A down to 16 cells, then AV-S's own order.
   EXPECT_EQ(chain({a(0.0), b}, allowance), (Chain{{0, 64, 16}, {-1, 16, 0}}));
   // Where A also gains below 16, it is taken whole.
@@ -593,13 +599,8 @@ TEST(ValidatedMerge, RefinedPiecesMayLoseALittleWhereGreedyOnesMayNot) {
   ASSERT_NE(std::find(counts.begin(), counts.end(), size_t{147}), counts.end());
   const PieceAllowance allowed = ValidatedMergeConfig{}.allowed;
   auto chain = [&](bool refined, const CandidateScores& sc) {
-    const std::vector<MergeStart> candidates{{128, 32, 0.0, 0.0, refined}};
-    std::vector<std::array<int64_t, 3>> out;
-    for (const ChosenPiece& p : choose_merge_pieces(candidates, {sc}, counts, leaves, allowed, 0.25))
-      out.push_back({p.candidate, p.from, p.to});
-    return out;
+    return chosen_chain({{128, 32, 0.0, 0.0, refined}}, {sc}, counts, leaves, allowed, 0.25);
   };
-  using Chain = std::vector<std::array<int64_t, 3>>;
   const Chain taken{{0, leaves, 0}}, av_s{{-1, leaves, 0}};
   EXPECT_EQ(chain(true, scores(0.019, 0.001)), taken);
   EXPECT_EQ(chain(false, scores(0.019, 0.001)), av_s);

@@ -126,13 +126,11 @@ std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& cand
   struct Piece {
     double sum = 0, worst = 0, worst_low = 0;  // worst_low: below allowed.low_below
     size_t counts = 0;
-    bool refined = false;
   };
   // Sum and worst on counts in (below, upto]; a count's worst raised by the margin on the sets'
   // disagreement.
   auto piece = [&](size_t i, uint32_t below, uint32_t upto) {
     Piece p;
-    p.refined = candidates[i].refined;
     for (size_t j = 0; j < counts.size(); ++j)
       if (counts[j] > below && counts[j] <= upto) {
         p.sum += scores[i].log_ratio[j];
@@ -143,8 +141,8 @@ std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& cand
     return p;
   };
   constexpr double kGain = 1e-9;  // rounding, in a sum of log ratios
-  auto within = [&](const Piece& p) {
-    return merge_piece_within(allowed, p.refined, p.sum, p.worst, p.worst_low, p.counts);
+  auto within = [&](size_t i, const Piece& p) {
+    return merge_piece_within(allowed, candidates[i].refined, p.sum, p.worst, p.worst_low, p.counts);
   };
   for (size_t e = 0; e < ends.size(); ++e) {
     const uint32_t c = ends[e];
@@ -156,12 +154,12 @@ std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& cand
       // that does at least as well.
       const Piece whole = piece(i, 0, c);
       std::optional<Tail> option;
-      if (within(whole)) option = Tail{whole.sum, static_cast<int>(i), false};
+      if (within(i, whole)) option = Tail{whole.sum, static_cast<int>(i), false};
       if (st.barrier && scores[i].barrier_cut) {
         const Piece upper = piece(i, st.barrier, c);
         const Tail& below = tail_at(st.barrier);
         const double split = upper.sum + below.sum;
-        if (within(upper) && (!option || split <= option->sum + kGain))
+        if (within(i, upper) && (!option || split <= option->sum + kGain))
           option = Tail{split, static_cast<int>(i), true};
       }
       if (option && option->sum < best.sum - kGain) best = *option;
