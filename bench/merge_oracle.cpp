@@ -15,6 +15,7 @@
 // unless SET2_SAMPLES is given, so that the cells can be fitted on fewer samples than score them.)
 // (construction seed 1, evaluation sets seeds 1000004 and 1000005, as scripts/results.sh.)
 #include <algorithm>
+#include <cctype>
 #include <cstdint>
 #include <cstdio>
 #include <exception>
@@ -76,7 +77,8 @@ uint64_t whole(const std::string& text, const char* what) {
   size_t used = 0;
   uint64_t v = 0;
   try {
-    v = std::stoull(text, &used);
+    // stoull takes "-5" and wraps it: only digits are a whole number here.
+    if (!text.empty() && std::isdigit(static_cast<unsigned char>(text[0]))) v = std::stoull(text, &used);
   } catch (const std::exception&) {
     used = 0;
   }
