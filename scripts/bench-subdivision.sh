@@ -5,7 +5,8 @@
 # subdivision time grows with 0.5M, 1M, 1.5M, 2M segments; and one compare at 1.5M segments
 # that scores both subdivisions on independent evaluation samples at 1k, 10k and 50k cells; and
 # the glass city (see-through surfaces) at 1.5M segments both ways; and, on oa_shouse (a Quake 3
-# map with much water and glass), build both ways and compare with its defaults (peak memory).
+# map with much water and glass), build both ways, time per candidate against the city's by
+# medians of alternating runs (RATIO_RUNS, default 5), and compare with its defaults (peak memory).
 # The stagnation stop is switched off (--min-reduction 0) so that every run reaches CELLS.
 # Rewrites the subdivision section of BENCHMARKS.md. Usage: scripts/bench-subdivision.sh [SIZE] [CELLS]
 set -euo pipefail
@@ -40,6 +41,17 @@ if [ -f "$map" ]; then
     --report "$dir/build-map.json"
   peak "$dir/build-map-exact.kb" "$vc" build "$map" --samples 300000 --max-cells 1500 --seed 1 -q --no-merge \
     --exact-candidates --report "$dir/build-map-exact.json"
+  # Time per candidate, map against city, in one sitting: the map's subdivision is under a second,
+  # so one run of it moves with this machine's speed from minute to minute; RATIO_RUNS alternating
+  # runs of the city at 1.5M segments (fast), the map, and the map without geometry-aligned
+  # planes, compared by medians.
+  for r in $(seq "${RATIO_RUNS:-5}"); do
+    "$vc" build "$scene" --segments 1500000 --max-cells "$cells" --min-reduction 0 --seed 1 -q --no-merge \
+      --report "$dir/ratio-city-$r.json"
+    "$vc" build "$map" --samples 300000 --max-cells 1500 --seed 1 -q --no-merge --report "$dir/ratio-map-$r.json"
+    "$vc" build "$map" --samples 300000 --max-cells 1500 --seed 1 -q --no-merge --no-ga \
+      --report "$dir/ratio-map-noga-$r.json"
+  done
   # compare on it with every default (its methods, samples and cell count): time and peak memory.
   rm -rf "$dir/compare-map"
   peak "$dir/compare-map.kb" "$vc" compare "$map" --seed 1 -q -o "$dir/compare-map"

@@ -125,11 +125,11 @@ def subdivision(*args):
     print(f"\nSubdivision time per doubling of segments, fast: 1M / 0.5M = {fast[1000000] / fast[500000]:.2f}, "
           f"2M / 1M = {fast[2000000] / fast[1000000]:.2f}; exact: {exact[1000000] / exact[500000]:.2f} and "
           f"{exact[2000000] / exact[1000000]:.2f} (2.0 would be linear in the number of segments).")
+    def per_candidate(r):
+        s = r["subdivision"]
+        return 1e6 * r["timings"]["subdivision_seconds"] / max(1, s["axis_candidates_evaluated"] + s["geometry_candidates_evaluated"])
     glass = f"{d}/build-glass.json"
     if os.path.exists(glass) and os.path.exists(f"{d}/build-glass-exact.json"):
-        def per_candidate(r):
-            s = r["subdivision"]
-            return 1e6 * r["timings"]["subdivision_seconds"] / max(1, s["axis_candidates_evaluated"] + s["geometry_candidates_evaluated"])
         g, ge = json.load(open(glass)), json.load(open(f"{d}/build-glass-exact.json"))
         c15, c15e = json.load(open(f"{d}/build-1500000.json")), json.load(open(f"{d}/build-exact-1500000.json"))
         gs, ges = g["timings"]["subdivision_seconds"], ge["timings"]["subdivision_seconds"]
@@ -155,6 +155,24 @@ def subdivision(*args):
                   f"{per_candidate(me) / per_candidate(c15e):.2f} exact ({m['counts']['see_through_segments']:,} see-through "
                   f"segments; a geometry-aligned candidate costs a pass over the cell's parts, an axis-aligned one a "
                   f"share of one pass).")
+    ratio_runs = sorted(int(m.group(1)) for m in (re.match(r"ratio-city-(\d+)\.json$", f) for f in os.listdir(d)) if m)
+    if ratio_runs:
+        def per_part(r):
+            return 1e9 * r["timings"]["subdivision_seconds"] / max(1, r["subdivision"].get("segment_parts_evaluated", 0))
+        runs = {k: [json.load(open(f"{d}/ratio-{k}-{i}.json")) for i in ratio_runs] for k in ("city", "map", "map-noga")}
+        med = {k: (statistics.median(per_candidate(r) for r in v), statistics.median(per_part(r) for r in v),
+                   statistics.median(r["timings"]["subdivision_seconds"] for r in v)) for k, v in runs.items()}
+        spread = {k: (min(per_candidate(r) for r in v), max(per_candidate(r) for r in v)) for k, v in runs.items()}
+        print(f"\nTime per candidate in one sitting ({len(ratio_runs)} alternating runs of the city at 1.5M segments, "
+              f"oa_shouse as above, and oa_shouse with `--no-ga`; medians, the runs' range in brackets):\n")
+        print("| scene | subdivision s | µs per candidate | ns per segment part evaluated | / city, per candidate | / city, per part |")
+        print("| --- | ---: | ---: | ---: | ---: | ---: |")
+        for k, name in (("city", "city"), ("map", "oa_shouse (GA on)"), ("map-noga", "oa_shouse, `--no-ga`")):
+            c, p, t = med[k]
+            print(f"| {name} | {t:.2f} | {c:.3f} ({spread[k][0]:.3f}-{spread[k][1]:.3f}) | {p:.1f} | "
+                  f"{c / med['city'][0]:.2f} | {p / med['city'][1]:.2f} |")
+        print(f"\noa_shouse / city, time per candidate by these medians: **{med['map'][0] / med['city'][0]:.2f}** "
+              f"(goal: 2); without geometry-aligned planes {med['map-noga'][0] / med['city'][0]:.2f}.")
     cm, cmkb = f"{d}/compare-map/summary.json", f"{d}/compare-map.kb"
     if os.path.exists(cm) and os.path.exists(cmkb):
         c = json.load(open(cm))
