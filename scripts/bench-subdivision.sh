@@ -36,6 +36,7 @@ peak "$dir/build-glass-exact.kb" "$vc" build "$glass" --segments 1500000 --max-c
 # A Quake 3 map with much water and glass whose walls are not axis-aligned (geometry-aligned
 # candidates on): the path that was slowest per candidate, both ways.
 map=data/maps/bsp/oa_shouse.bsp
+rm -f "$dir"/ratio-city-*.json "$dir"/ratio-map-*.json  # an earlier run's, which the table would read
 if [ -f "$map" ]; then
   peak "$dir/build-map.kb" "$vc" build "$map" --samples 300000 --max-cells 1500 --seed 1 -q --no-merge \
     --report "$dir/build-map.json"
