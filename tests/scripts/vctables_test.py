@@ -156,6 +156,33 @@ class Tables(unittest.TestCase):
         self.assertIn("methods av-m, av-s, 2,691 cells): 40 s of loading, sampling, building and evaluating, "
                       "peak memory 1.05 GB (goal: under 2 GB)", t)
 
+    def test_subdivision_map_per_candidate_by_medians_of_one_sitting(self):
+        for n in (500000, 1000000, 1500000, 2000000):
+            for name in ("build", "build-exact"):
+                dump(f"{self.d}/{name}-{n}.json", {
+                    "timings": {"sampling_seconds": 1, "subdivision_seconds": 10.0},
+                    "subdivision": {"final_cost": 5, "axis_candidates_evaluated": 7,
+                                    "geometry_candidates_evaluated": 0, "segment_parts_evaluated": 9}})
+        # Three runs each; the medians are the middle runs: city 10 s for 50M candidates and 200M
+        # parts (0.2 µs, 50 ns), map 1.0 s for 1.9M + 0.1M candidates and 20M parts (0.5 µs,
+        # 50 ns), map without planes 0.5 s for 2M candidates and 25M parts (0.25 µs, 20 ns).
+        for i, (c, m, g) in enumerate([(12.0, 0.9, 0.7), (10.0, 1.2, 0.5), (9.0, 1.0, 0.4)], start=1):
+            dump(f"{self.d}/ratio-city-{i}.json", {"timings": {"subdivision_seconds": c}, "subdivision": {
+                "axis_candidates_evaluated": 50000000, "geometry_candidates_evaluated": 0,
+                "segment_parts_evaluated": 200000000}})
+            dump(f"{self.d}/ratio-map-{i}.json", {"timings": {"subdivision_seconds": m}, "subdivision": {
+                "axis_candidates_evaluated": 1900000, "geometry_candidates_evaluated": 100000,
+                "segment_parts_evaluated": 20000000}})
+            dump(f"{self.d}/ratio-map-noga-{i}.json", {"timings": {"subdivision_seconds": g}, "subdivision": {
+                "axis_candidates_evaluated": 2000000, "geometry_candidates_evaluated": 0,
+                "segment_parts_evaluated": 25000000}})
+        t = run("subdivision", self.d, 23, 50000)
+        self.assertIn("(3 alternating runs of the city", t)
+        self.assertEqual(row(t, "city")[1:], ["10.00", "0.200 (0.180-0.240)", "50.0", "1.00", "1.00"])
+        self.assertEqual(row(t, "oa_shouse (GA on)")[1:], ["1.00", "0.500 (0.450-0.600)", "50.0", "2.50", "1.00"])
+        self.assertEqual(row(t, "oa_shouse, `--no-ga`")[1:], ["0.50", "0.250 (0.200-0.350)", "20.0", "1.25", "0.40"])
+        self.assertIn("time per candidate by these medians: **2.50** (goal: 2); without geometry-aligned planes 1.25.", t)
+
     def test_candidates_ratios_to_exact_at_200(self):
         for k, fast_cost, exact_cost, fast_s in [(50, 12.0, 11.0, 1.0), (200, 10.5, 10.0, 2.0)]:
             run_dir = f"{self.d}/city-{k}"
