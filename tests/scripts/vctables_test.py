@@ -137,13 +137,17 @@ class Tables(unittest.TestCase):
         self.assertEqual(row(t, "10,000")[3], "0.9901")
         self.assertIn("subdivision 30.0 s fast, 90.0 s exact", t)
 
-    def test_subdivision_compare_on_a_map_reports_peak_memory(self):
+    def dump_city_sizes(self):
+        """The city's fast and exact builds at the four sizes, all alike: what the map rows need beside them."""
         for n in (500000, 1000000, 1500000, 2000000):
             for name in ("build", "build-exact"):
                 dump(f"{self.d}/{name}-{n}.json", {
                     "timings": {"sampling_seconds": 1, "subdivision_seconds": 10.0},
                     "subdivision": {"final_cost": 5, "axis_candidates_evaluated": 7,
                                     "geometry_candidates_evaluated": 0, "segment_parts_evaluated": 9}})
+
+    def test_subdivision_compare_on_a_map_reports_peak_memory(self):
+        self.dump_city_sizes()
         dump(f"{self.d}/compare-map/summary.json", {
             "settings": {"construction_samples": 1000000, "evaluation_samples": 4000000,
                          "methods": ["av-m", "av-s"], "max_cells": 2691},
@@ -157,12 +161,7 @@ class Tables(unittest.TestCase):
                       "peak memory 1.05 GB (goal: under 2 GB)", t)
 
     def test_subdivision_map_per_candidate_by_medians_of_one_sitting(self):
-        for n in (500000, 1000000, 1500000, 2000000):
-            for name in ("build", "build-exact"):
-                dump(f"{self.d}/{name}-{n}.json", {
-                    "timings": {"sampling_seconds": 1, "subdivision_seconds": 10.0},
-                    "subdivision": {"final_cost": 5, "axis_candidates_evaluated": 7,
-                                    "geometry_candidates_evaluated": 0, "segment_parts_evaluated": 9}})
+        self.dump_city_sizes()
         # Three runs each; the medians are the middle runs: city 10 s for 50M candidates and 200M
         # parts (0.2 µs, 50 ns), map 1.0 s for 1.9M + 0.1M candidates and 20M parts (0.5 µs,
         # 50 ns), map without planes 0.5 s for 2M candidates and 25M parts (0.25 µs, 20 ns).
