@@ -567,18 +567,30 @@ uint32_t deepest_node(const vc_pvs& f, const double lo[3], const double hi[3]) {
   return n;
 }
 
-/// About two grid cells per BSP node, cubes as near as the box allows, at most 2^21 in all.
+/// About two grid cells per BSP node, cubes as near as the box allows, at most 2^21 in all. A
+/// box whose extent or grid scale is not a finite, positive double on some axis (a span of
+/// 1e-310, or of 2e308, which overflows) gets one grid cell: location then starts at the root,
+/// which is right for any box, since the grid is only a shortcut.
 void build_grid(vc_pvs& f) {
   double extent[3], volume = 1;
-  for (int k = 0; k < 3; ++k) volume *= extent[k] = f.hi[k] - f.lo[k];
+  bool usable = true;
+  for (int k = 0; k < 3; ++k) {
+    volume *= extent[k] = f.hi[k] - f.lo[k];
+    usable &= std::isfinite(extent[k]) && extent[k] > 0 && std::isfinite(1.0 / extent[k]);
+  }
   const double target = std::min<double>(2.0 * f.nodes.size(), 1 << 21);
   const double side = std::cbrt(volume / target);
+  usable &= std::isfinite(volume) && side > 0 && std::isfinite(side);
   size_t total = 1;
   for (int k = 0; k < 3; ++k) {
-    const double n = std::ceil(extent[k] / side);
+    const double n = usable ? std::ceil(extent[k] / side) : 1.0;
     f.grid_n[k] = static_cast<int>(std::clamp(std::isfinite(n) ? n : 1.0, 1.0, 256.0));
-    f.grid_scale[k] = f.grid_n[k] / extent[k];
+    f.grid_scale[k] = usable ? f.grid_n[k] / extent[k] : 0.0;
     total *= static_cast<size_t>(f.grid_n[k]);
+  }
+  if (!usable) {
+    f.grid_start.assign(1, 0);
+    return;
   }
   f.grid_start.resize(total);
   // Each grid cell enlarged by far more than the rounding of a point's grid index, so that a
@@ -710,32 +722,35 @@ int vc_pvs_open_compact(const char* path, vc_pvs** out, char* error, size_t erro
 
 void vc_pvs_close(vc_pvs* pvs) { delete pvs; }
 
-int vc_pvs_is_compact(const vc_pvs* pvs) { return pvs->compact ? 1 : 0; }
+int vc_pvs_is_compact(const vc_pvs* pvs) { return pvs && pvs->compact ? 1 : 0; }
 
 size_t vc_pvs_list_bytes(const vc_pvs* pvs) {
+  if (!pvs) return 0;
   return pvs->compact ? pvs->coded.size() + pvs->node_bit.size() * sizeof(uint32_t) +
                             pvs->node_parent.size() * sizeof(int32_t)
                       : pvs->offsets.size() * sizeof(uint64_t) + pvs->ids.size() * sizeof(uint32_t);
 }
 
-uint32_t vc_pvs_cell_count(const vc_pvs* pvs) { return pvs->cell_count; }
-uint32_t vc_pvs_object_count(const vc_pvs* pvs) { return pvs->object_count; }
-size_t vc_pvs_row_bytes(const vc_pvs* pvs) { return (static_cast<size_t>(pvs->object_count) + 7) / 8; }
-uint64_t vc_pvs_scene_fingerprint(const vc_pvs* pvs) { return pvs->fingerprint; }
-const char* vc_pvs_rule(const vc_pvs* pvs) { return pvs->rule.c_str(); }
+uint32_t vc_pvs_cell_count(const vc_pvs* pvs) { return pvs ? pvs->cell_count : 0; }
+uint32_t vc_pvs_object_count(const vc_pvs* pvs) { return pvs ? pvs->object_count : 0; }
+size_t vc_pvs_row_bytes(const vc_pvs* pvs) { return pvs ? (static_cast<size_t>(pvs->object_count) + 7) / 8 : 0; }
+uint64_t vc_pvs_scene_fingerprint(const vc_pvs* pvs) { return pvs ? pvs->fingerprint : 0; }
+const char* vc_pvs_rule(const vc_pvs* pvs) { return pvs ? pvs->rule.c_str() : ""; }
 
 void vc_pvs_view_box(const vc_pvs* pvs, double lo[3], double hi[3]) {
+  const double none = std::numeric_limits<double>::quiet_NaN();
   for (int k = 0; k < 3; ++k) {
-    lo[k] = pvs->lo[k];
-    hi[k] = pvs->hi[k];
+    if (lo) lo[k] = pvs ? pvs->lo[k] : none;
+    if (hi) hi[k] = pvs ? pvs->hi[k] : none;
   }
 }
 
 const char* vc_pvs_object_name(const vc_pvs* pvs, uint32_t object) {
-  return object < pvs->names.size() ? pvs->names[object].c_str() : "";
+  return pvs && object < pvs->names.size() ? pvs->names[object].c_str() : "";
 }
 
 size_t vc_pvs_memory_bytes(const vc_pvs* pvs) {
+  if (!pvs) return 0;
   size_t n = sizeof(vc_pvs) + pvs->rule.capacity();
   for (const std::string& s : pvs->names) n += sizeof(s) + s.capacity();
   return n + pvs->nodes.capacity() * sizeof(Node) + pvs->planes.capacity() * sizeof(GeneralPlane) +
@@ -748,11 +763,14 @@ namespace {
 
 /// The leaf holding p, or null outside the view box (NaN coordinates included).
 inline const Node* leaf_at(const vc_pvs* pvs, double x, double y, double z) {
+  if (!pvs) return nullptr;
   const Vec p{{x, y, z}};
   size_t cell = 0, stride = 1;
   for (int k = 0; k < 3; ++k) {
     if (!(p.v[k] >= pvs->lo[k] && p.v[k] <= pvs->hi[k])) return nullptr;  // NaN fails too
-    const int i = std::min(static_cast<int>((p.v[k] - pvs->lo[k]) * pvs->grid_scale[k]), pvs->grid_n[k] - 1);
+    // Clamped in double before the conversion: an index of inf or NaN never reaches an int.
+    const double t = (p.v[k] - pvs->lo[k]) * pvs->grid_scale[k];
+    const int i = t > 0 ? static_cast<int>(std::min(t, static_cast<double>(pvs->grid_n[k] - 1))) : 0;
     cell += stride * static_cast<size_t>(i);
     stride *= static_cast<size_t>(pvs->grid_n[k]);
   }
@@ -776,14 +794,14 @@ int32_t vc_pvs_locate(const vc_pvs* pvs, double x, double y, double z) {
 int32_t vc_pvs_locate_objects(const vc_pvs* pvs, double x, double y, double z, const uint32_t** objects,
                               size_t* count) {
   const Node* n = leaf_at(pvs, x, y, z);
-  const bool listed = n && !pvs->compact;
+  const bool listed = n && !pvs->compact;  // n is null for a null handle
   if (objects) *objects = listed ? pvs->ids.data() + n->list[0] : nullptr;
   if (count) *count = listed ? n->list[1] : 0;
   return n ? static_cast<int32_t>(n->meta) : -1;
 }
 
 size_t vc_pvs_cell_objects(const vc_pvs* pvs, int32_t cell, const uint32_t** objects) {
-  if (cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count || pvs->compact) {
+  if (!pvs || cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count || pvs->compact) {
     if (objects) *objects = nullptr;
     return 0;
   }
@@ -793,7 +811,7 @@ size_t vc_pvs_cell_objects(const vc_pvs* pvs, int32_t cell, const uint32_t** obj
 }
 
 size_t vc_pvs_cell_objects_copy(const vc_pvs* pvs, int32_t cell, uint32_t* objects, size_t capacity) {
-  if (cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count) return 0;
+  if (!pvs || cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count) return 0;
   if (!pvs->compact) {
     const uint64_t first = pvs->offsets[cell], count = pvs->offsets[cell + 1] - first;
     if (objects) std::copy_n(pvs->ids.data() + first, std::min<uint64_t>(count, capacity), objects);
@@ -806,7 +824,7 @@ size_t vc_pvs_cell_objects_copy(const vc_pvs* pvs, int32_t cell, uint32_t* objec
 }
 
 int vc_pvs_cell_bits(const vc_pvs* pvs, int32_t cell, uint8_t* row, size_t row_bytes) {
-  if (cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count || !row || row_bytes < vc_pvs_row_bytes(pvs))
+  if (!pvs || cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count || !row || row_bytes < vc_pvs_row_bytes(pvs))
     return -1;
   std::memset(row, 0, row_bytes);
   if (pvs->compact) {
@@ -821,7 +839,7 @@ int vc_pvs_cell_bits(const vc_pvs* pvs, int32_t cell, uint8_t* row, size_t row_b
 }
 
 int vc_pvs_cell_sees(const vc_pvs* pvs, int32_t cell, uint32_t object) {
-  if (cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count) return 0;
+  if (!pvs || cell < 0 || static_cast<uint32_t>(cell) >= pvs->cell_count) return 0;
   if (pvs->compact) {
     thread_local std::vector<uint32_t> ids;
     decode_cell(pvs, static_cast<uint32_t>(cell), ids);

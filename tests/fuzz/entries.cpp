@@ -2,6 +2,8 @@
 
 #include <unistd.h>
 
+#include <cmath>
+#include <cstring>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -149,6 +151,61 @@ void entry_pvs(const uint8_t* data, size_t size) {
       if (cell >= 0 && copied != f.pvs.cell_pvs(static_cast<uint32_t>(cell))) std::abort();
     }
   });
+}
+void entry_runtime(const uint8_t* data, size_t size) {
+  // Byte 0 picks the format version; bytes 1-48 are two query points as raw doubles (any bit
+  // pattern: NaN, infinities, denormals); the rest is the payload, in a valid container.
+  constexpr size_t kPoints = 48;
+  double raw[6] = {0, 0, 0, 0, 0, 0};
+  if (size > kPoints) std::memcpy(raw, data + 1, kPoints);
+  std::string input(bytes_of(data, size));
+  if (size > kPoints) input.erase(1, kPoints);
+  const std::string path = container_file(reinterpret_cast<const uint8_t*>(input.data()), input.size(), "VPVS", 2,
+                                          ".pvs");
+  vc_pvs* full = nullptr;
+  vc_pvs* compact = nullptr;
+  const bool full_ok = vc_pvs_open(path.c_str(), &full, nullptr, 0) == 0;
+  std::unique_ptr<vc_pvs, void (*)(vc_pvs*)> full_owner(full, vc_pvs_close);
+  const bool compact_ok = vc_pvs_open_compact(path.c_str(), &compact, nullptr, 0) == 0;
+  std::unique_ptr<vc_pvs, void (*)(vc_pvs*)> compact_owner(compact, vc_pvs_close);
+  if (full_ok != compact_ok || full_ok != (full != nullptr)) std::abort();
+  std::optional<PvsFile> read;
+  try {
+    read.emplace(read_pvs(path));
+  } catch (const Error&) {
+  }
+  if (read.has_value() != full_ok) std::abort();  // the runtime opens exactly what the toolkit reads
+  // Every call, also on the handle that may be NULL: defined for every argument.
+  for (vc_pvs* h : {full, compact}) {
+    double lo[3], hi[3];
+    vc_pvs_view_box(h, lo, hi);
+    std::vector<Vec3> points = {{raw[0], raw[1], raw[2]}, {raw[3], raw[4], raw[5]}, {lo[0], lo[1], lo[2]},
+                                {hi[0], hi[1], hi[2]},    {0.5 * lo[0] + 0.5 * hi[0], 0.5 * lo[1] + 0.5 * hi[1], 0.5 * lo[2] + 0.5 * hi[2]},
+                                {lo[0], raw[1], hi[2]}};
+    const uint32_t cells = vc_pvs_cell_count(h), objects = vc_pvs_object_count(h);
+    std::vector<uint32_t> ids(objects);
+    std::vector<uint8_t> row(vc_pvs_row_bytes(h));
+    for (const Vec3& p : points) {
+      const int32_t cell = vc_pvs_locate(h, p.x, p.y, p.z);
+      if (cell < -1 || (cell >= 0 && static_cast<uint32_t>(cell) >= cells)) std::abort();
+      if (read && cell != (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) ? read->locate(p) : -1))
+        std::abort();
+      const uint32_t* list = nullptr;
+      size_t count = 0;
+      if (vc_pvs_locate_objects(h, p.x, p.y, p.z, &list, &count) != cell) std::abort();
+      const size_t copied = vc_pvs_cell_objects_copy(h, cell, ids.data(), ids.size());
+      if (cell >= 0 && std::vector<uint32_t>(ids.begin(), ids.begin() + copied) != read->pvs.cell_pvs(cell))
+        std::abort();
+      vc_pvs_cell_bits(h, cell, row.data(), row.size());
+      vc_pvs_cell_sees(h, cell, static_cast<uint32_t>(raw[0]) % (objects + 1));
+    }
+    const int32_t some = static_cast<int32_t>(size > 1 ? data[size - 1] : 0) - 1;  // -1 and a few cells
+    vc_pvs_cell_objects(h, some, nullptr);
+    vc_pvs_object_name(h, static_cast<uint32_t>(some));
+    vc_pvs_rule(h);
+    vc_pvs_memory_bytes(h);
+    vc_pvs_list_bytes(h);
+  }
 }
 void entry_vagvs(const uint8_t* data, size_t size) {
   AgvsFixture& f = agvs_fixture();

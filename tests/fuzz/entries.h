@@ -22,6 +22,9 @@ void entry_fbx(const uint8_t* data, size_t size);
 void entry_vseg(const uint8_t* data, size_t size);
 void entry_vcells(const uint8_t* data, size_t size);
 void entry_pvs(const uint8_t* data, size_t size);
+/// The engines' reader (runtime/): bytes 1-48 of the input are two query points (raw doubles),
+/// the rest a .pvs payload in a valid container; every C API call, checked against the toolkit.
+void entry_runtime(const uint8_t* data, size_t size);
 /// Loads the state into an AGVS solver over a small office, and samples on when it loads.
 void entry_vagvs(const uint8_t* data, size_t size);
 /// Writes a state of entry_vagvs's solver (for the seed corpus).

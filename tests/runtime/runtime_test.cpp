@@ -398,5 +398,125 @@ TEST(Runtime, ReadsVersionOneAndRefusesMalformedLists) {
   EXPECT_EQ(open_code(path), 0);
 }
 
+/// The payload of the .pvs at `path` with the view box's coordinates of `axis` set to [lo, hi]
+/// (the payload: fingerprint, object count, names, rule, then lo[3] and hi[3]), in a valid
+/// container: what a file written elsewhere, or damaged before its checksum was taken, holds.
+std::string with_view_box(const std::string& path, int axis, double lo, double hi, const std::string& name) {
+  uint32_t version = 0;
+  std::string payload = read_container(path, "VPVS", 2, version);
+  size_t at = 12;
+  auto skip_string = [&] {
+    uint64_t n = 0;
+    std::memcpy(&n, payload.data() + at, 8);
+    at += 8 + n;
+  };
+  uint64_t names = 0;
+  std::memcpy(&names, payload.data() + at, 8);
+  at += 8;
+  for (uint64_t i = 0; i < names; ++i) skip_string();
+  skip_string();  // the rule
+  std::memcpy(payload.data() + at + 8 * axis, &lo, 8);
+  std::memcpy(payload.data() + at + 24 + 8 * axis, &hi, 8);
+  const std::string out = test::temp_path(name);
+  write_container(out, "VPVS", version, payload);
+  return out;
+}
+
+TEST(Runtime, LocatesLikeTheToolkitInExtremeViewBoxes) {
+  // Boxes a valid container can carry: a span of 1e-310 (its grid scale overflows), of 2e308
+  // (hi - lo overflows), far from the origin. The runtime once indexed its grid with
+  // static_cast<int>(inf or NaN) here and crashed while `viewcells query` answered.
+  const Level& l = level();
+  const Box3& box = l.file.bsp.view_box;
+  const double huge = std::numeric_limits<double>::max();
+  struct Case {
+    int axis;
+    double lo, hi;
+  };
+  size_t opened = 0, located = 0;
+  for (const Case& c : {Case{0, 0, 1e-310}, Case{0, -1e308, 1e308}, Case{1, -huge, huge}, Case{2, 1e300, 1.5e300},
+                        Case{0, -5e-324, 5e-324}, Case{2, box.lo.z, 1e308}, Case{1, -1e308, box.hi.y}}) {
+    SCOPED_TRACE("axis " + std::to_string(c.axis) + " [" + std::to_string(c.lo) + ", " + std::to_string(c.hi) + "]");
+    const std::string path = with_view_box(l.path, c.axis, c.lo, c.hi, "extreme_box.pvs");
+    PvsFile f;
+    try {
+      f = read_pvs(path);
+    } catch (const Error&) {
+      EXPECT_NE(open_code(path), 0) << "the toolkit refuses it, so must the runtime";
+      continue;
+    }
+    ASSERT_EQ(open_code(path), 0) << "the toolkit reads it, so must the runtime";
+    ++opened;
+    const runtime::PvsFile r(path), compact(path, true);
+    const Box3& b = f.bsp.view_box;
+    std::vector<Vec3> points = {b.lo, b.hi, b.center(), box.center(), box.lo, box.hi, Vec3{0, 0, 0}};
+    Rng rng(3);
+    for (int k = 0; k < 500; ++k) {
+      Vec3 p;
+      for (int a = 0; a < 3; ++a) {
+        const double u = rng.uniform();
+        // Half uniform in the box (which may overflow to inf: then its ends), half in the level's box.
+        const double t = k % 2 ? b.lo[a] + u * (b.hi[a] - b.lo[a]) : box.lo[a] + u * (box.hi[a] - box.lo[a]);
+        p[a] = std::isfinite(t) ? t : (u < 0.5 ? b.lo[a] : b.hi[a]);
+      }
+      points.push_back(p);
+    }
+    const double odd[] = {NAN, INFINITY, -INFINITY, huge, -huge, 5e-324, -0.0};
+    for (double v : odd) points.push_back(Vec3{v, box.center().y, box.center().z});
+    for (const Vec3& p : points) {
+      const int32_t want = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z) ? f.locate(p) : -1;
+      ASSERT_EQ(r.locate(p.x, p.y, p.z), want) << p.x << " " << p.y << " " << p.z;
+      ASSERT_EQ(compact.locate(p.x, p.y, p.z), want);
+      int32_t at = -2;
+      const runtime::ObjectList seen = r.objects_at(p.x, p.y, p.z, &at);
+      ASSERT_EQ(at, want);
+      if (want >= 0) {
+        ++located;
+        ASSERT_EQ(std::vector<uint32_t>(seen.begin(), seen.end()), f.pvs.cell_pvs(static_cast<uint32_t>(want)));
+        ASSERT_EQ(compact.objects_copy(want), f.pvs.cell_pvs(static_cast<uint32_t>(want)));
+      }
+    }
+  }
+  EXPECT_GE(opened, 5u);
+  EXPECT_GT(located, 1000u);
+}
+
+TEST(Runtime, EveryFunctionTakesANullHandle) {
+  const vc_pvs* none = nullptr;
+  EXPECT_EQ(vc_pvs_cell_count(none), 0u);
+  EXPECT_EQ(vc_pvs_object_count(none), 0u);
+  EXPECT_EQ(vc_pvs_row_bytes(none), 0u);
+  EXPECT_EQ(vc_pvs_scene_fingerprint(none), 0u);
+  EXPECT_STREQ(vc_pvs_rule(none), "");
+  EXPECT_STREQ(vc_pvs_object_name(none, 0), "");
+  EXPECT_EQ(vc_pvs_memory_bytes(none), 0u);
+  EXPECT_EQ(vc_pvs_list_bytes(none), 0u);
+  EXPECT_EQ(vc_pvs_is_compact(none), 0);
+  double lo[3] = {1, 1, 1}, hi[3] = {1, 1, 1};
+  vc_pvs_view_box(none, lo, hi);
+  EXPECT_TRUE(std::isnan(lo[0]) && std::isnan(hi[2]));
+  vc_pvs_view_box(none, nullptr, nullptr);
+  EXPECT_EQ(vc_pvs_locate(none, 0, 0, 0), -1);
+  const uint32_t* ids = reinterpret_cast<const uint32_t*>(&lo);
+  size_t count = 7;
+  EXPECT_EQ(vc_pvs_locate_objects(none, 0, 0, 0, &ids, &count), -1);
+  EXPECT_EQ(ids, nullptr);
+  EXPECT_EQ(count, 0u);
+  EXPECT_EQ(vc_pvs_locate_objects(none, 0, 0, 0, nullptr, nullptr), -1);
+  EXPECT_EQ(vc_pvs_cell_objects(none, 0, &ids), 0u);
+  uint32_t buffer[4];
+  EXPECT_EQ(vc_pvs_cell_objects_copy(none, 0, buffer, 4), 0u);
+  uint8_t row[4];
+  EXPECT_EQ(vc_pvs_cell_bits(none, 0, row, sizeof row), -1);
+  EXPECT_EQ(vc_pvs_cell_sees(none, 0, 0), 0);
+  vc_pvs_close(nullptr);
+  // And NULL outputs on a real handle.
+  const runtime::PvsFile r(level().path);
+  vc_pvs_view_box(r.handle(), nullptr, hi);
+  EXPECT_EQ(hi[0], level().file.bsp.view_box.hi.x);
+  EXPECT_GT(vc_pvs_cell_objects_copy(r.handle(), 0, nullptr, 100), 0u);
+  EXPECT_EQ(vc_pvs_cell_bits(r.handle(), 0, nullptr, 100), -1);
+}
+
 }  // namespace
 }  // namespace viewcells

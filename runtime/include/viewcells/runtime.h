@@ -12,7 +12,12 @@
  *
  * Lookups are O(1) after location: opening decodes every cell's visible set once into one
  * array (4 bytes per entry; see vc_pvs_memory_bytes). A handle is read-only after opening
- * and may be shared between threads. */
+ * and may be shared between threads.
+ *
+ * Every function is defined for every argument: a NULL handle gives 0, "", -1 or NaN (for
+ * vc_pvs_view_box) and never dereferences it, NULL output pointers are skipped, a point
+ * location takes any doubles (NaN, infinities, denormals) and any view box a valid file can
+ * carry. */
 #ifndef VIEWCELLS_RUNTIME_H
 #define VIEWCELLS_RUNTIME_H
 
