@@ -39,7 +39,7 @@ int run_build(const BuildArgs& a, const Common& c) {
 }
 
 struct ExportArgs {
-  std::string input, scene;
+  std::string input, scene, objects = "auto";
   pipeline::ViewsConfig views;
 };
 
@@ -52,9 +52,8 @@ int run_export(const ExportArgs& e, const Common& c) {
         fmt(file.subdivision.cost(), 1));
   std::unique_ptr<Scene> scene;
   if (!e.scene.empty()) {
-    scene = std::make_unique<Scene>(load_scene(e.scene));
-    if (scene->fingerprint() != file.scene_fingerprint)
-      c.log("viewcells: warning: " + e.scene + " is not the scene these cells were built from");
+    scene = std::make_unique<Scene>(
+        pipeline::load_matching_scene(e.scene, parse_grouping(e.objects), file.scene_fingerprint, e.input));
   }
   pipeline::write_views(file.subdivision, scene.get(), e.views, c.logger());
   return 0;
@@ -79,7 +78,10 @@ void add_build_commands(CLI::App& app, const Common& common, Commands& commands)
   auto* ex = app.add_subcommand("export", "Look at a built hierarchy: cells as PLY, or a slice as PNG");
   ex->add_option("cells", e->input, "Hierarchy file (.vcells)")->required();
   add_view_options(ex, e->views, "PLY of the cells, coloured by render cost", "PNG of a horizontal slice");
-  ex->add_option("--scene", e->scene, "Draw this scene's cross-section into the slice");
+  ex->add_option("--scene", e->scene,
+                 "Draw this scene's cross-section into the slice (the scene the cells were built from)");
+  ex->add_option("--objects", e->objects, "With --scene: the object grouping the cells were built with")
+      ->capture_default_str();
   commands.push_back({ex, [e, &common] { return run_export(*e, common); }});
 }
 

@@ -9,6 +9,7 @@
 #include "options.h"
 #include "viewcells/core/cluster.h"
 #include "viewcells/core/error.h"
+#include "viewcells/core/interrupt.h"
 #include "viewcells/core/isa.h"
 #include "viewcells/core/binary_file.h"
 
@@ -25,7 +26,7 @@ int run(int argc, char** argv) {
   app.fallthrough();
   Common common;
   app.add_option("--threads", common.threads, "Worker threads (0 = all cores); results do not depend on it")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative());
   app.add_flag("-q,--quiet", common.quiet, "No progress bars or log lines on stderr");
   std::string isa;
   app.add_option("--embree-isa", isa,
@@ -54,11 +55,17 @@ int run(int argc, char** argv) {
     OutputBatch outputs;
     int rc = 0;
     for (const Command& c : commands)
-      if (*c.app) rc = c.run();
+      if (*c.app) {
+        check_no_empty_values(*c.app);
+        rc = c.run();
+      }
     // On a cluster every rank computes the same files; rank 0 installs them, the others'
     // staged copies go with their batch.
     if (rc == 0 && cluster::writer()) outputs.commit();
     return rc;
+  } catch (const Interrupted& e) {
+    std::cerr << "viewcells: " << e.what() << '\n';
+    return 130;  // as a shell reports a process ended by SIGINT
   } catch (const Error& e) {
     std::cerr << "viewcells: error: " << e.what() << '\n';
     return 1;

@@ -30,6 +30,7 @@ struct CompareArgs {
 };
 
 int run_compare(const CompareArgs& a, const Common& c) {
+  check_files({a.sampling.scene}, {}, {a.output});
   ThreadLimit threads(c.threads);
   pipeline::CompareRunConfig config;
   config.scene = a.sampling.source();
@@ -68,7 +69,7 @@ void add_compare_command(CLI::App& app, const Common& common, Commands& commands
       ->each([a](const std::string&) { a->methods_given = true; });
   cm->add_option("--max-cells", a->max_cells, "Cells per method at most (on a Quake 3 map: 3 x its clusters)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber)
+      ->check(positive())
       ->each([a](const std::string&) { a->max_cells_given = true; });
   cm->add_option("--eval-samples", a->eval_samples, "Evaluation samples (default: 4 x --samples)")
       ->check(whole(1, kMaxSamples));
@@ -78,23 +79,23 @@ void add_compare_command(CLI::App& app, const Common& common, Commands& commands
                  "method is scored on each, in curves.csv's cost and cost_2, cost_3, ... columns. Their "
                  "disagreement is the evaluator's own noise")
       ->capture_default_str()
-      ->check(CLI::Range(1, 16));
+      ->check(whole(1, 16));
   cm->add_option("--histogram-cells", a->histogram_cells, "Cell count of the cost histograms (default: --max-cells)");
   cm->add_option("--cost-a", a->cost_a, "Render cost model: minimum cost of an object")->capture_default_str();
   cm->add_option("--cost-b", a->cost_b, "Render cost model: cost per triangle")->capture_default_str();
   cm->add_flag("--no-ga", a->no_ga, "AV-S/AV-M without geometry-aligned candidates");
   cm->add_option("--axis-candidates", a->axis_candidates, "AV-S/AV-M: axis-aligned positions per axis and cell")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   cm->add_flag("--exact-candidates", a->exact_candidates, std::string("AV-S/AV-M: ") + kExactCandidatesHelp);
   cm->add_option("--min-reduction", a->min_reduction,
                  "AV-S/AV-M: stop when splits reduce the cost by less than this share of the initial cost for 50 "
                  "splits running (0: always reach --max-cells)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative());
   cm->add_option("--ga-candidates", a->ga_candidates, "AV-S/AV-M: geometry-aligned planes per cell")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   add_merge_options(cm, a->merge);
   cm->add_option("-o,--output", a->output, "Directory for curves.csv, histogram.csv, summary.json")->required();
   commands.push_back({cm, [a, &common] { return run_compare(*a, common); }});

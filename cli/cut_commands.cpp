@@ -15,7 +15,7 @@ namespace viewcells::cli {
 namespace {
 
 struct ExtractArgs {
-  std::string input, output, scene;
+  std::string input, output, scene, objects = "auto";
   CutOptions cut;
   pipeline::ViewsConfig views;
 };
@@ -26,6 +26,7 @@ int run_extract(const ExtractArgs& e, const Common& c) {
   config.hierarchy_path = e.input;
   config.cut = e.cut.rule();
   config.scene_path = e.scene;
+  config.grouping = parse_grouping(e.objects);
   config.views = e.views;
   const pipeline::ExtractResult result = pipeline::extract(config, c.logger());
   write_report_to(e.output, result, c, "view cells");
@@ -93,7 +94,7 @@ struct ViewArgs {
 
 int run_view(const ViewArgs& a, const Common& c) {
   if (a.site.empty() && a.gltf.empty()) throw Error("view writes a web page (-o DIR) or glTF (--gltf FILE): give one");
-  check_files({a.input, a.scene}, {a.gltf});
+  check_files({a.input, a.scene}, {a.gltf}, {a.site});
   if (!a.site.empty()) require_web_viewer();  // before any work
   CostModel model;
   model.a = a.cost_a;
@@ -124,7 +125,10 @@ void add_cut_commands(CLI::App& app, const Common& common, Commands& commands) {
   xt->add_option("-o,--output", e->output, "JSON file of the view cells (default: printed)");
   add_view_options(xt, e->views, "PLY of the BSP leaves coloured by their view cell's render cost",
                    "PNG of a horizontal slice, borders between view cells");
-  xt->add_option("--scene", e->scene, "Draw this scene's cross-section into the slice");
+  xt->add_option("--scene", e->scene,
+                 "Draw this scene's cross-section into the slice (the scene the cells were built from)");
+  xt->add_option("--objects", e->objects, "With --scene: the object grouping the cells were built with")
+      ->capture_default_str();
   commands.push_back({xt, [e, &common] { return run_extract(*e, common); }});
 
   auto cmp = std::make_shared<CompressArgs>();

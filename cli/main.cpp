@@ -4,11 +4,15 @@
 #include <iostream>
 
 #include "viewcells/core/cluster.h"
+#include "viewcells/core/interrupt.h"
 
 int main(int argc, char** argv) {
   // Under mpirun or srun (with VIEWCELLS_MPI), every rank runs the same command; rank 0 writes
   // the files and the output.
   viewcells::cluster::Session session(&argc, &argv);
   if (!viewcells::cluster::writer()) std::cout.setstate(std::ios::failbit);
+  // Ctrl-C ends a long stage with an error and leaves the outputs as they were. On several
+  // ranks mpirun or srun stop them all: one rank leaving a collective alone would hang the rest.
+  if (viewcells::cluster::size() == 1) viewcells::install_interrupt_handlers();
   return viewcells::cli::run(argc, argv);
 }

@@ -51,6 +51,41 @@ CLI::Validator positive() {
       "NUMBER > 0");
 }
 
+namespace {
+
+/// A validator of one finite number that `ok` accepts; `wanted` completes "give ...".
+CLI::Validator number_check(std::function<bool(double)> ok, const std::string& wanted, const std::string& name) {
+  return CLI::Validator(
+      [ok, wanted](const std::string& text) -> std::string {
+        try {
+          size_t used = 0;
+          const double v = std::stod(text, &used);
+          if (used == text.size() && std::isfinite(v) && ok(v)) return "";
+        } catch (const std::exception&) {
+        }
+        return "'" + text + "' is not allowed: give " + wanted;
+      },
+      name);
+}
+
+std::string short_number(double v) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", v);
+  return text;
+}
+
+}  // namespace
+
+CLI::Validator non_negative() {
+  return number_check([](double v) { return v >= 0; }, "a number of at least 0", "NUMBER >= 0");
+}
+
+CLI::Validator in_range(double lo, double hi) {
+  const std::string range = short_number(lo) + " to " + short_number(hi);
+  return number_check([lo, hi](double v) { return v >= lo && v <= hi; }, "a number from " + range,
+                      "NUMBER in [" + short_number(lo) + ", " + short_number(hi) + "]");
+}
+
 std::vector<double> parse_numbers(const std::string& text, const std::string& option) {
   std::vector<double> v;
   std::stringstream ss(text);
@@ -103,7 +138,14 @@ std::vector<std::string> split_list(const std::string& text) {
   return out;
 }
 
-void check_files(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs) {
+void check_no_empty_values(const CLI::App& command) {
+  for (const CLI::Option* o : command.get_options())
+    for (const std::string& value : o->results())
+      if (value.empty()) throw Error(o->get_name() + " was given an empty value: give a name or leave the option out");
+}
+
+void check_files(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs,
+                 const std::vector<std::string>& directories) {
   namespace fs = std::filesystem;
   auto key = [](const std::string& p) {
     std::error_code ec;
@@ -123,6 +165,19 @@ void check_files(const std::vector<std::string>& inputs, const std::vector<std::
         throw Error(out + ": is " + (i < input_count ? "an input of this command" : "given for two outputs") +
                     " (" + seen[i].second + "); write it elsewhere");
     seen.push_back({k, out});
+  }
+  for (const std::string& dir : directories) {
+    if (dir.empty()) continue;
+    std::error_code ec;
+    if (fs::exists(fs::symlink_status(dir, ec)) && !fs::is_directory(dir, ec))
+      throw Error(dir, 0, "exists and is not a directory: it is asked for as a directory");
+    const std::string k = key(dir);
+    for (size_t i = 0; i < seen.size(); ++i)
+      if (seen[i].first == k)
+        throw Error(dir, 0, std::string("is a directory this command writes, and also given as ") +
+                                (i < input_count ? "an input" : "an output file") + " (" + seen[i].second +
+                                "); give another directory");
+    seen.push_back({k, dir});
   }
 }
 
@@ -269,7 +324,7 @@ void add_cell_options(CLI::App* cmd, CellOptions& a, const std::string& max_cell
       ->capture_default_str();
   cmd->add_option("--axis-candidates", a.axis_candidates, "Axis-aligned positions tried per axis and cell at most")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   cmd->add_flag("--exact-candidates", a.exact_candidates, kExactCandidatesHelp);
   cmd->add_option("--min-reduction", a.min_reduction,
                   "Stop when splits reduce the cost by less than this share of the initial cost for 50 splits running")

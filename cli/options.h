@@ -57,6 +57,10 @@ using Commands = std::vector<Command>;
 CLI::Validator whole(uint64_t lo, uint64_t hi);
 /// A finite number above zero.
 CLI::Validator positive();
+/// A finite number of at least zero.
+CLI::Validator non_negative();
+/// A finite number from lo to hi (NaN is refused, and the message says the range enforced).
+CLI::Validator in_range(double lo, double hi);
 
 /// Comma-separated numbers of option `option`; throws Error naming the option.
 std::vector<double> parse_numbers(const std::string& text, const std::string& option);
@@ -65,9 +69,14 @@ Box3 parse_box(const std::string& text);
 uint64_t parse_bytes(const std::string& text);
 std::vector<std::string> split_list(const std::string& text);
 
-/// Before any work: refuses an output that is also an input or another output, or that exists
-/// as something other than a regular file. Empty names are options not given.
-void check_files(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs);
+/// Before any work: refuses an output that is also an input or another output, that exists as
+/// something other than a regular file, or whose directory is missing. `directories` are outputs
+/// that are directories (a work directory, a web page's): they may exist as directories, not as
+/// anything else, and are no other input or output. Empty names are options not given.
+void check_files(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs,
+                 const std::vector<std::string>& directories = {});
+/// Refuses an option given with an empty value (`-o ""`): no option of viewcells takes one.
+void check_no_empty_values(const CLI::App& command);
 
 /// Scene and sampling options shared by sample, build, compare and bake.
 struct SamplingOptions {

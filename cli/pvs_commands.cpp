@@ -37,11 +37,12 @@ struct AgvsOptions {
   }
 };
 
-void add_agvs_options(CLI::App* cmd, AgvsOptions& a, bool with_method, const std::string& samples_name) {
+void add_agvs_options(CLI::App* cmd, AgvsOptions& a, bool with_method, const std::string& samples_name,
+                      const std::string& time_name = "--time") {
   cmd->add_option("--pixel-error", a.pixel_error,
                   "Stop when the estimated pixel error (pixels of a 1024x1024 image that differ) is at most this")
       ->check(positive());
-  cmd->add_option("--time", a.seconds, "Stop after this many seconds")->check(positive());
+  cmd->add_option(time_name, a.seconds, "Stop AGVS after this many seconds of sampling")->check(positive());
   cmd->add_option(samples_name, a.samples,
                   "Stop after this many AGVS samples (checked between batches: a run may pass it by less than a batch)")
       ->check(whole(1, kMaxSamples));
@@ -60,7 +61,7 @@ void add_agvs_options(CLI::App* cmd, AgvsOptions& a, bool with_method, const std
                   "AGVS: share of every batch kept for view space-direction samples whatever their weight; they are "
                   "the pixel error estimator's camera rays (more: a finer estimate, fewer samples for the mutations)")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(in_range(0.0, 1.0));
 }
 
 struct PvsArgs {
@@ -140,7 +141,7 @@ void add_pvs_command(CLI::App& app, const Common& common, Commands& commands) {
                  "With --save: also write the state every this many seconds (a checkpoint a cut-off run resumes "
                  "from, with any number of ranks)")
       ->needs(save)
-      ->check(CLI::PositiveNumber);
+      ->check(positive());
   pv->add_option("--resume", a->resume,
                  "Continue from a state written by --save (same scene, cells, method, seed and batch); --samples "
                  "and --time count from the start of the computation, the saved part included");
@@ -171,7 +172,7 @@ void add_pvs_command(CLI::App& app, const Common& common, Commands& commands) {
                  "1024x1024) is at most this. The PVSs are measured after one batch and at every doubling of the "
                  "samples (each measurement in the report's measured_curve), so a run may sample up to twice what "
                  "it needed; other limits still apply")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative());
   pv->add_option("--measure-size", a->measure_size, "Width and height of the measuring cameras, in pixels")
       ->capture_default_str()
       ->check(whole(1, 2048));
@@ -192,10 +193,11 @@ struct BakeArgs {
   double checkpoint = 60;
   double measured_error = 0;
   uint32_t measure_cameras = 0;
+  double seconds = 0;  ///< --time: the whole bake
 };
 
 int run_bake(BakeArgs a, const Common& c) {
-  check_files({a.sampling.scene}, {a.output, a.report});
+  check_files({a.sampling.scene}, {a.output, a.report}, {a.work});
   ThreadLimit threads(c.threads);
   pipeline::BakeConfig config;
   config.model = a.cells.model();
@@ -205,10 +207,13 @@ int run_bake(BakeArgs a, const Common& c) {
   config.merge_agvs = a.merge.agvs(c, a.sampling.seed, config.sampling.samples);
   config.cells = a.view_cells;
   config.memory = a.memory.empty() ? 0 : parse_bytes(a.memory);
+  if (!a.memory.empty() && config.memory == 0) throw Error("--memory must be above 0 bytes (got '" + a.memory + "')");
   if (a.memory_of != "file" && a.memory_of != "lists") throw Error("--memory-of is file or lists, not '" + a.memory_of + "'");
   config.memory_of_lists = a.memory_of == "lists";
-  if (!a.agvs.samples && !(a.agvs.seconds > 0) && !(a.agvs.pixel_error > 0) && !(a.measured_error > 0))
+  if (!a.agvs.samples && !(a.agvs.seconds > 0) && !(a.agvs.pixel_error > 0) && !(a.measured_error > 0) &&
+      !(a.seconds > 0))
     a.agvs.pixel_error = 10;
+  config.max_seconds = a.seconds;
   config.measured_error = a.measured_error;
   config.measure_cameras = a.measure_cameras ? a.measure_cameras : a.measured_error > 0 ? 5000 : 0;
   config.agvs = a.agvs.config(c);
@@ -246,7 +251,12 @@ void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
       ->check(whole(1, kMaxCells));
   add_cell_options(bk, a->cells, "");
   add_merge_options(bk, a->merge);
-  add_agvs_options(bk, a->agvs, false, "--agvs-samples");
+  add_agvs_options(bk, a->agvs, false, "--agvs-samples", "--agvs-time");
+  bk->add_option("--time", a->seconds,
+                 "Bound the whole bake to this many seconds: each of the merge's two AGVS runs stops at a quarter of "
+                 "it, the PVSs' AGVS when it runs out (a hierarchy that uses it all up is an error, and with --work "
+                 "is kept for a rerun). --agvs-time bounds the PVSs' AGVS alone")
+      ->check(positive());
   bk->add_option("--work", a->work,
                  "Work directory: keeps the hierarchy and the AGVS state, so that a rerun with the same scene and "
                  "settings skips the hierarchy and continues sampling (e.g. with a smaller --pixel-error)");
@@ -254,12 +264,12 @@ void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
                  "With --work: save the AGVS state this often, in seconds, so that a bake cut off continues from "
                  "there when run again (0: only at the end)")
       ->capture_default_str()
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative());
   bk->add_option("--measured-error", a->measured_error,
                  "Stop AGVS once cameras measure at most this many wrong pixels per 1024x1024 frame (mean over the "
                  "cameras), instead of trusting the estimate: measured after one batch and at every doubling of the "
                  "samples (a run may sample up to twice what it needed; --time and the other limits still apply)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(non_negative());
   bk->add_option("--measure-cameras", a->measure_cameras,
                  "Cameras that measure the PVSs, placed and counted as `viewcells measure` does (on a Quake 3 map "
                  "player eyes above floors reachable from the spawn points, else random points of the view box; "
@@ -268,8 +278,8 @@ void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
       ->check(whole(1, 1'000'000));
   bk->add_option("-o,--output", a->output, "The .pvs file to write")->required();
   bk->add_option("--report", a->report, "JSON report: budget, cells, file bytes, pixel error, samples, timings");
-  bk->footer("Without --pixel-error, --measured-error, --time or --agvs-samples, AGVS runs to an estimated pixel "
-             "error of 10 (of 1024x1024).");
+  bk->footer("Without --pixel-error, --measured-error, --time, --agvs-time or --agvs-samples, AGVS runs to an "
+             "estimated pixel error of 10 (of 1024x1024).");
   commands.push_back({bk, [a, &common] {
                         if (a->view_cells == 0 && a->memory.empty())
                           throw Error("bake needs a budget: --cells N or --memory BYTES");
@@ -330,10 +340,10 @@ void add_measure_command(CLI::App& app, const Common& common, Commands& commands
   ms->add_option("--count", a->count, "Number of cameras")->capture_default_str()->check(whole(1, 10'000'000));
   ms->add_option("--width", a->width, "Frame width in pixels")->capture_default_str()->check(whole(1, 2048));
   ms->add_option("--height", a->height, "Frame height in pixels")->capture_default_str()->check(whole(1, 2048));
-  ms->add_option("--fov", a->fov, "Horizontal field of view in degrees")->capture_default_str()->check(CLI::Range(1.0, 179.0));
+  ms->add_option("--fov", a->fov, "Horizontal field of view in degrees")->capture_default_str()->check(in_range(1.0, 179.0));
   ms->add_option("--max-pitch", a->max_pitch, "Play cameras: largest pitch up or down, in degrees")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 89.0));
+      ->check(in_range(0.0, 89.0));
   ms->add_option("--seed", a->seed, "Random seed of the cameras")->capture_default_str();
   ms->add_option("--cost-a", a->cost_a, "Render cost model: r = max(a, b * triangles)")->capture_default_str();
   ms->add_option("--cost-b", a->cost_b, "Render cost model: cost per triangle")->capture_default_str();

@@ -80,7 +80,7 @@ for map in "${maps[@]}"; do
   fi
   if "$vc" measure "$map" --report "$d/q3map2.json" -q 2> "$d/err" &&
      start=$(date +%s.%N) &&
-     "$vc" bake "$map" --cells "$clusters" --pixel-error "$err" --time "$secs" --seed 1 --no-play-space -o "$d/ours.pvs" \
+     "$vc" bake "$map" --cells "$clusters" --pixel-error "$err" --agvs-time "$secs" --seed 1 --no-play-space -o "$d/ours.pvs" \
        --report "$d/bake.json" -q 2>> "$d/err" &&
      python3 scripts/vctables.py elapsed "$start" > "$d/bake_wall_seconds" &&
      "$vc" measure "$map" "$d/ours.pvs" --report "$d/ours.json" -q 2>> "$d/err"; then

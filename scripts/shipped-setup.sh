@@ -10,7 +10,7 @@ shipped_fit() {
   local map="$1" d="$2" budget="$3" name="$4" what="$5"
   shift 5
   [ -f "$d/$name.json" ] && return 0
-  if "$vc" bake "$map" --memory "$budget" --memory-of lists --pixel-error "$err" --time "$secs" --seed 1 "$@" \
+  if "$vc" bake "$map" --memory "$budget" --memory-of lists --pixel-error "$err" --agvs-time "$secs" --seed 1 "$@" \
        -o "$d/$name.pvs" --report "$d/$name-bake.json" -q 2>> "$d/err" &&
      "$vc" measure "$map" "$d/$name.pvs" --report "$d/$name.json" -q 2>> "$d/err"; then
     echo "shipped: $(basename "$d"): lists fit $what ($budget bytes) at $(python3 scripts/vctables.py get "$d/$name.json" cells) cells, ours / q3map2 $(python3 scripts/vctables.py shipped-ratio "$d" "$name")"

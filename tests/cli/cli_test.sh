@@ -133,7 +133,7 @@ assert r['final_cost'] < r['subdivision']['initial_cost']
 expect_ok "$VC" export pixel.vcells --mesh pixel.ply -q
 expect_error "--screen" "$VC" build office.obj --samples 1000 --cost-c 1 --screen 640-480
 expect_error "field of view" "$VC" build office.obj --samples 1000 --cost-c 1 --fov 200
-expect_error "must be finite and non-negative" "$VC" build office.obj --samples 1000 --cost-c -1
+expect_error "must be a number from 0 to 1e12" "$VC" build office.obj --samples 1000 --cost-c -1
 # Merging (default), extraction, compression and queries.
 python3 -c "
 import json; r=json.load(open('build.json')); m=r['merge']

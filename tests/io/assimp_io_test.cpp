@@ -33,8 +33,9 @@ std::string base64(const std::string& bytes) {
 /// A glTF 2.0 file: one unit cube mesh (y-up) instanced by nodes "left" (at x = -2) and
 /// "right" (at x = +2, scaled by 2 along y), and node "glass" with the same cube under an
 /// alpha-blended material, a child of "right" (so at x = +2 + 0, y-scaled, then moved up 3).
-std::string cube_gltf(const std::string& alpha_mode = "BLEND") {
-  const float p[8][3] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
+/// `first_x`: the first vertex's x (NaN or infinity for a broken file).
+std::string cube_gltf(const std::string& alpha_mode = "BLEND", float first_x = 0) {
+  const float p[8][3] = {{first_x, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {0, 0, 1}, {1, 0, 1}, {0, 1, 1}, {1, 1, 1}};
   const uint16_t idx[36] = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
                             2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
   std::string buffer(reinterpret_cast<const char*>(p), sizeof p);
@@ -142,9 +143,53 @@ void expect_error(const std::string& path, const std::string& fragment) {
   }
 }
 
+/// `text` with every `from` replaced by `to`.
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+  for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()))
+    text.replace(at, from.size(), to);
+  return text;
+}
+
+TEST(AssimpIo, WhatAssimpWouldDropOrCrashOnIsAnErrorSayingWhy) {
+  // A NaN or infinite vertex: the mesh was dropped without a word (Assimp's FindInvalidData),
+  // where the OBJ reader names it; now both do. A file of NaNs alone said "No meshes remaining".
+  for (float bad : {NAN, INFINITY, -INFINITY})
+    expect_error(write_temp("nan.gltf", cube_gltf("BLEND", bad)), "mesh 'cube' has a vertex (0) whose coordinates are not finite");
+  // Lines and points only: no triangles, said so.
+  expect_error(write_temp("lines.gltf", replaced(cube_gltf(), R"("indices":1,)", R"("indices":1,"mode":1,)")),
+               "holds no triangles (only points or lines");
+  // A valid file whose node chain is deeper than Assimp's stack takes (it crashed in Assimp,
+  // "malformed"): refused before Assimp, saying it is a limit.
+  std::string chain = R"("nodes":[)";
+  for (int i = 0; i < 20000; ++i) chain += R"({"name":"n)" + std::to_string(i) + R"(","children":[)" + std::to_string(i + 1) + "]},";
+  chain += R"({"name":"leaf","mesh":0}],)";
+  std::string deep = cube_gltf();
+  const size_t from = deep.find(R"("nodes":[{"name":"left")"), to = deep.find(R"("meshes")");
+  deep.replace(from, to - from, chain);
+  deep = replaced(deep, R"("scenes":[{"nodes":[0,1]}])", R"("scenes":[{"nodes":[0]}])");
+  expect_error(write_temp("deep.gltf", deep), "more than the 256 levels viewcells reads");
+  // Assimp's messages quote bytes of the file: binary ones are shown as \xNN, never raw. A
+  // binary FBX whose one node has a property of type code 0xfe: "unexpected type code: \xfe".
+  std::string fbx = std::string("Kaydara FBX Binary  \0\x1a\0", 23) + std::string("\xe8\x1c\0\0", 4);
+  const std::string name = "Objects", property = "\xfe\x01\x02\x03\x04";
+  const uint32_t record[3] = {static_cast<uint32_t>(27 + 13 + name.size() + property.size()), 1,
+                              static_cast<uint32_t>(property.size())};
+  fbx.append(reinterpret_cast<const char*>(record), sizeof record);
+  fbx += static_cast<char>(name.size());
+  fbx += name + property + std::string(213, '\0');
+  try {
+    load_scene(write_temp("binary.fbx", fbx));
+    FAIL() << "no error for a broken FBX";
+  } catch (const Error& e) {
+    const std::string what = e.what();
+    EXPECT_NE(what.find("type code: \\xfe"), std::string::npos) << what;
+    for (unsigned char ch : what) EXPECT_TRUE(ch >= 0x20 && ch < 0x7f) << what;
+  }
+}
+
 TEST(AssimpIo, BrokenFilesAreErrorsNamingTheFile) {
   expect_error(kModels + "glTF2/IndexOutOfRange/IndexOutOfRange.gltf", "out-of-range");
-  expect_error(kModels + "glTF2/RecursiveNodes/RecursiveNodes.gltf", "not a readable scene");
+  expect_error(kModels + "glTF2/RecursiveNodes/RecursiveNodes.gltf", "the node tree has a cycle");
   expect_error(kModels + "glTF2/MissingBin/BoxTextured.gltf", "BoxTextured0.bin");
   expect_error(kModels + "glTF2/TestNoRootNode/NoScene.gltf", "not a readable scene");
   // Truncated binary glTF and FBX, at several lengths.

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <optional>
 
+#include "viewcells/core/interrupt.h"
 #include "viewcells/core/progress.h"
 
 namespace viewcells {
@@ -88,6 +89,7 @@ void AgvsSolver::run() {
   auto last_checkpoint = start;
   if (!m.partitioned) m.synced_entries = m.global_entries = m.pvs.entries();
   while (true) {
+    throw_if_interrupted("AGVS");
     const double seconds = before + std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (c.max_samples && m.stats.samples >= c.max_samples) {
       m.stats.stop_reason = "reached " + std::to_string(c.max_samples) + " samples";

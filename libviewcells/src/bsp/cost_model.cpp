@@ -5,14 +5,16 @@
 #include <numbers>
 
 #include "viewcells/core/error.h"
+#include "viewcells/core/format.h"
 
 namespace viewcells {
 
 void CostModel::validate() const {
+  // Costs are sums over objects, cells and viewpoints: a bound on each factor keeps every sum
+  // finite (1e12 x 2^32 triangles x 2^32 objects is far inside double's range).
   for (const auto& [name, v] : {std::pair{"a", a}, std::pair{"b", b}, std::pair{"c", c}})
-    if (!(v >= 0) || !std::isfinite(v))
-      throw Error(std::string("cost model: ") + name + " must be finite and non-negative (got " + std::to_string(v) +
-                  ")");
+    if (!(v >= 0) || !(v <= kMaxFactor))
+      throw Error(std::string("cost model: ") + name + " must be a number from 0 to 1e12 (got " + fmt(v, 3) + ")");
   if (!pixel_term()) return;
   if (screen_width < 1 || screen_height < 1 || screen_width > 65536 || screen_height > 65536)
     throw Error("cost model: the screen must be between 1x1 and 65536x65536 pixels");

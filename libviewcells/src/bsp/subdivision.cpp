@@ -29,6 +29,7 @@
 #include "bsp/segment_walk.h"
 #include "viewcells/core/default_init.h"
 #include "viewcells/core/error.h"
+#include "viewcells/core/interrupt.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/core/rng.h"
 
@@ -637,6 +638,7 @@ class Builder {
     out_.stats.stop_reason = "reached the maximum number of cells";
     bool stopped = false;
     while (!stopped && out_.leaf_count() < config_.max_cells) {
+      throw_if_interrupted("subdivision");
       if (queue.empty()) {
         out_.stats.stop_reason = config_.strategy == SplitStrategy::kCost
                                      ? "no cell can be split further (no candidate reduces the cost)"

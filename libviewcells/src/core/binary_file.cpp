@@ -33,12 +33,19 @@ std::vector<std::pair<std::string, std::string>>* g_batch = nullptr;
 }  // namespace
 
 void check_output_target(const std::string& path) {
+  if (path.empty()) throw Error("an output file needs a name (an empty path was given)");
   std::error_code ec;
   const auto st = std::filesystem::symlink_status(path, ec);
-  if (ec || st.type() == std::filesystem::file_type::not_found || st.type() == std::filesystem::file_type::regular)
-    return;
-  throw Error(path, 0, "exists and is not a regular file (a directory, device, FIFO or symbolic link): outputs are "
-                       "replaced by new files, so viewcells will not write there");
+  if (!ec && st.type() != std::filesystem::file_type::not_found && st.type() != std::filesystem::file_type::regular)
+    throw Error(path, 0, "exists and is not a regular file (a directory, device, FIFO or symbolic link): outputs are "
+                         "replaced by new files, so viewcells will not write there");
+  // The new file is made beside it and renamed into place: its directory must be there.
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  const std::filesystem::path dir = parent.empty() ? std::filesystem::path(".") : parent;
+  if (!std::filesystem::is_directory(dir, ec))
+    throw Error(path, 0, "cannot be written: its directory " + dir.string() + " does not exist");
+  if (access(dir.c_str(), W_OK) != 0)
+    throw Error(path, 0, "cannot be written: its directory " + dir.string() + " is not writable");
 }
 
 std::string temporary_for(const std::string& path) { return path + ".tmp." + std::to_string(getpid()); }

@@ -12,6 +12,9 @@
 
 #include "agvs/halton.h"
 #include "viewcells/core/error.h"
+#include "viewcells/core/format.h"
+#include "viewcells/core/progress.h"
+#include "viewcells/core/interrupt.h"
 
 namespace viewcells {
 
@@ -61,10 +64,20 @@ std::vector<Camera> view_box_cameras(const RayCaster& caster, const CellLocator&
   return cams;
 }
 
+void check_frame_budget(uint64_t cameras, uint32_t width, uint32_t height) {
+  if (cameras == 0 || width == 0 || height == 0) throw Error("the pixel error needs cameras and pixels");
+  const uint64_t pixels = uint64_t{width} * height;
+  if (cameras > kMaxFrameRays / pixels)
+    throw Error(std::to_string(cameras) + " cameras of " + std::to_string(width) + "x" + std::to_string(height) +
+                " pixels cast " + fmt(static_cast<double>(cameras) * static_cast<double>(pixels), 0) +
+                " primary rays, above the ceiling of " +
+                std::to_string(kMaxFrameRays) + " (2^32) a measurement may cast: fewer cameras or pixels");
+}
+
 PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, std::span<const Camera> cameras,
                                  std::span<const int32_t> cells, const GlobalPvs& pvs, const FrameConfig& config) {
   const uint32_t width = config.width, height = config.height;
-  if (cameras.empty() || width == 0 || height == 0) throw Error("the pixel error needs cameras and pixels");
+  check_frame_budget(cameras.size(), width, height);
   if (!(config.fov_degrees > 0 && config.fov_degrees < 180))
     throw Error("the field of view must be between 0 and 180 degrees");
   if (cells.size() != cameras.size()) throw Error("measure_frames: one cell per camera");
@@ -74,11 +87,13 @@ PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, st
   const double aspect = static_cast<double>(height) / width;
   const uint32_t n = static_cast<uint32_t>(cameras.size());
   std::vector<std::vector<WrongView>> wrong_of(n);
+  Progress progress("frames", n);
   tbb::parallel_for(tbb::blocked_range<uint32_t>(0, n, 1), [&](const tbb::blocked_range<uint32_t>& range) {
     std::vector<Ray> rays(size_t(width) * height);
     std::vector<Hit> hits(rays.size());
     std::vector<uint32_t> objects;
     for (uint32_t k = range.begin(); k < range.end(); ++k) {
+      throw_if_interrupted("measuring frames");
       const Camera& cam = cameras[k];
       for (uint32_t y = 0; y < height; ++y)
         for (uint32_t x = 0; x < width; ++x) {
@@ -101,8 +116,10 @@ PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, st
         wrong_of[k].push_back({k, objects[i], static_cast<uint32_t>(j - i)});
         i = j;
       }
+      progress.advance();
     }
   });
+  progress.finish();
   PixelErrorMeasure out;
   out.cameras = n;
   std::vector<uint64_t> per_camera(n, 0);

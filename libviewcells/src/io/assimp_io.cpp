@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -35,6 +36,26 @@ namespace {
 // instancing that multiplies a small file into more geometry than any level holds.
 constexpr size_t kMaxNodeDepth = 256;
 constexpr uint64_t kMaxInstancedTriangles = 200'000'000;
+
+/// Assimp's message as printable text: its FBX reader quotes bytes of the file, which may be
+/// binary; those are shown as \xNN, and a long message is cut.
+std::string printable(const std::string& text) {
+  std::string out;
+  for (unsigned char ch : text) {
+    if (out.size() > 300) {
+      out += "...";
+      break;
+    }
+    if (ch >= 0x20 && ch < 0x7f) {
+      out += static_cast<char>(ch);
+    } else {
+      char hex[8];
+      std::snprintf(hex, sizeof hex, "\\x%02x", ch);
+      out += hex;
+    }
+  }
+  return out;
+}
 
 /// True when a material lets one see through it: alpha-blended or alpha-tested in glTF, glTF's
 /// transmission, or an opacity below one (FBX, COLLADA, 3DS, glTF's base colour alpha).
@@ -142,9 +163,16 @@ class Builder {
       const aiVector3D& p = mesh->mVertices[v];
       // In double: a level's large offsets survive the transform better than in float.
       const double x = p.x, y = p.y, z = p.z;
-      mesh_.vertices.push_back({world.a1 * x + world.a2 * y + world.a3 * z + world.a4,
-                                world.b1 * x + world.b2 * y + world.b3 * z + world.b4,
-                                world.c1 * x + world.c2 * y + world.c3 * z + world.c4});
+      const Vec3 q{world.a1 * x + world.a2 * y + world.a3 * z + world.a4,
+                   world.b1 * x + world.b2 * y + world.b3 * z + world.b4,
+                   world.c1 * x + world.c2 * y + world.c3 * z + world.c4};
+      // As the OBJ reader: a NaN or infinite coordinate (in the file or after the node's
+      // transform) is an error, never a mesh dropped without a word.
+      if (!std::isfinite(q.x) || !std::isfinite(q.y) || !std::isfinite(q.z))
+        throw Error(name_, 0, "mesh '" + std::string(mesh->mName.C_Str()) + "' has a vertex (" + std::to_string(v) +
+                                  ") whose coordinates are not finite" +
+                                  (std::isfinite(x) && std::isfinite(y) && std::isfinite(z) ? " after its node's transform" : ""));
+      mesh_.vertices.push_back(q);
     }
     for (unsigned f = 0; f < mesh->mNumFaces; ++f) {
       const aiFace& face = mesh->mFaces[f];
@@ -200,7 +228,7 @@ class CollectWarnings {
         std::string text = w;
         while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
         if (const size_t colon = text.find(": "); colon != std::string::npos && colon < 12) text = text.substr(colon + 2);
-        throw Error(name, 0, "broken scene data (Assimp: " + text + ")");
+        throw Error(name, 0, "broken scene data (Assimp: " + printable(text) + ")");
       }
     }
   }
@@ -289,10 +317,59 @@ class GltfCheck {
       if (count > 0 && (offset >= view->second || count - 1 > view->second - offset))
         fail("an accessor declares more elements than its buffer view holds");
     });
+    check_node_depth(doc);
   }
 
  private:
   [[noreturn]] void fail(const std::string& why) const { throw Error(name_, 0, "broken glTF: " + why); }
+
+  /// Assimp walks the node tree recursively and overflows its stack on a chain some ten
+  /// thousand deep: a valid file too deep (or cyclic) is refused here, by name, before it.
+  void check_node_depth(const nlohmann::json& doc) const {
+    std::map<std::string, std::vector<std::string>> children;
+    for_each(doc, "nodes", [&](const std::string& id, const nlohmann::json& n) {
+      auto& mine = children[id];
+      if (!n.is_object() || !n.contains("children")) return;
+      const auto& c = n["children"];
+      if (!c.is_array()) fail("a node's children are not an array");
+      for (const auto& child : c) {
+        if (child.is_string()) mine.push_back(child.get<std::string>());
+        else if (child.is_number_unsigned() || (child.is_number_integer() && child.get<int64_t>() >= 0))
+          mine.push_back(std::to_string(child.get<uint64_t>()));
+        else fail("a node's child is not a reference");
+      }
+    });
+    // Longest path below each node, iteratively (post-order); a node met again on the path is a cycle.
+    std::map<std::string, size_t> depth;
+    std::map<std::string, bool> on_path;
+    for (const auto& [root, unused] : children) {
+      if (depth.count(root)) continue;
+      std::vector<std::pair<std::string, size_t>> stack{{root, 0}};  // (node, next child)
+      on_path[root] = true;
+      while (!stack.empty()) {
+        auto& [node, next] = stack.back();
+        const auto it = children.find(node);
+        if (it != children.end() && next < it->second.size()) {
+          const std::string child = it->second[next++];
+          if (on_path[child]) fail("the node tree has a cycle");
+          if (!depth.count(child)) {
+            on_path[child] = true;
+            stack.push_back({child, 0});
+          }
+          continue;
+        }
+        size_t d = 1;
+        if (it != children.end())
+          for (const std::string& c : it->second) d = std::max(d, 1 + depth[c]);
+        if (d > kMaxNodeDepth)  // a valid file, beyond what is read: not "broken"
+          throw Error(name_, 0, "its node tree is " + std::to_string(d) + " or more nodes deep, more than the " +
+                                    std::to_string(kMaxNodeDepth) + " levels viewcells reads (flatten the hierarchy)");
+        depth[node] = d;
+        on_path[node] = false;
+        stack.pop_back();
+      }
+    }
+  }
 
   static uint32_t u32(std::string_view b, uint64_t at) {
     uint32_t v = 0;
@@ -465,12 +542,15 @@ bool is_gltf(const std::string& ext) { return ext == ".gltf" || ext == ".glb"; }
 
 
 constexpr unsigned kFlags = aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_SortByPType |
-                            aiProcess_ValidateDataStructure | aiProcess_FindInvalidData;
+                            aiProcess_ValidateDataStructure;
 
 RawMesh convert(Assimp::Importer& importer, const aiScene* scene, AssimpObjects mode, const std::string& name) {
   if (!scene) {
-    std::string why = importer.GetErrorString();
+    std::string why = printable(importer.GetErrorString());
     if (why.empty()) why = "Assimp could not read it";
+    // Point and line meshes are removed on reading (they draw no surface and hide nothing).
+    if (why.find("No meshes remaining") != std::string::npos)
+      throw Error(name, 0, "the file holds no triangles (only points or lines, or no meshes)");
     throw Error(name, 0, "not a readable scene: " + why);
   }
   if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) throw Error(name, 0, "the file holds no meshes (incomplete scene)");

@@ -38,7 +38,8 @@ std::string hierarchy_key(const BakeConfig& c, uint32_t max_cells) {
     << d.density.lo << ' ' << d.density.hi << ' ' << d.density.outside << (d.play_space ? " play space" : "") << '\n';
   if (c.merge_agvs)
     k << "merge agvs " << c.merge_agvs->seed << ' ' << c.merge_agvs->max_samples << ' ' << c.merge_agvs->pixel_error << ' '
-      << c.merge_agvs->batch_size << '\n';
+      << c.merge_agvs->batch_size << (c.merge_agvs->max_seconds > 0 ? " seconds " + fmt(c.merge_agvs->max_seconds, 3) : "")
+      << '\n';
   else
     k << "merge samples\n";
   return k.str();
@@ -219,18 +220,42 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     throw Error("the measured pixel error must be a finite number >= 0");
   if (c.measured_error > 0 && !c.measure_cameras)
     throw Error("a measured pixel error needs measuring cameras");
-  if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0) && !(c.measured_error > 0))
+  if (c.measure_cameras) check_frame_budget(c.measure_cameras, c.frame.width, c.frame.height);
+  if (!(c.max_seconds >= 0) || !std::isfinite(c.max_seconds)) throw Error("the bake's time limit must be finite and >= 0");
+  if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0) && !(c.measured_error > 0) &&
+      !(c.max_seconds > 0))
     throw Error("give when the PVSs are good enough: a pixel error (estimated or measured), a time or a number of "
                 "AGVS samples");
+  if (c.cells && c.subdivision.max_cells && c.cells > c.subdivision.max_cells)
+    throw Error("--cells " + std::to_string(c.cells) + " asks for more view cells than the " +
+                std::to_string(c.subdivision.max_cells) + " elementary cells of --max-cells: raise --max-cells or "
+                "lower --cells");
   Stopwatch total;
   BakeResult out;
   out.config = c;
+  // The whole bake's clock: a quarter for each of the merge's AGVS runs (the hierarchy's only
+  // stages without a bound of their own), what is left for the PVSs' AGVS.
+  BakeConfig run = c;
+  if (c.max_seconds > 0 && run.merge_agvs) {
+    const double share = 0.25 * c.max_seconds;
+    run.merge_agvs->max_seconds = run.merge_agvs->max_seconds > 0 ? std::min(run.merge_agvs->max_seconds, share) : share;
+  }
   out.threads = worker_threads();
   const uint32_t max_cells = c.subdivision.max_cells ? c.subdivision.max_cells : (c.cells ? 4 * c.cells : 4096);
   LoadedScene loaded = load_scene_for_rays(c.scene, log);
-  SubdivisionFile file = hierarchy(c, loaded, max_cells, out, log);
+  SubdivisionFile file = hierarchy(run, loaded, max_cells, out, log);
   const MergeHistory& h = *file.history;
   out.hierarchy_seconds = total.seconds();
+  if (c.max_seconds > 0) {
+    const double left = c.max_seconds - total.seconds();
+    if (!(left > 0))
+      throw Error(c.output, 0, "the time limit of " + fmt(c.max_seconds, 3) + " s ran out in the hierarchy (" +
+                                   fmt(total.seconds(), 2) + " s: sampling, subdivision, merging) before any PVS was "
+                                   "sampled: give more time, fewer --samples or --max-cells" +
+                                   (c.work_dir.empty() ? std::string(", or --work to keep the hierarchy for a rerun")
+                                                       : std::string(" (the hierarchy is kept in " + c.work_dir + ")")));
+    run.agvs.max_seconds = run.agvs.max_seconds > 0 ? std::min(run.agvs.max_seconds, left) : left;
+  }
   out.elementary_cells = static_cast<uint32_t>(h.leaf_count);
   out.scene_fingerprint = file.scene_fingerprint;
   out.object_count = file.object_count;
@@ -248,7 +273,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     log("viewcells: bake: " + std::to_string(cams->cameras.size()) + " measuring cameras (" + cams->rule + ") in " +
         fmt(sw.seconds(), 2) + " s");
   }
-  const std::vector<std::vector<uint32_t>> lists = sample_pvs(c, loaded, sampled, cells, cams, out, log);
+  const std::vector<std::vector<uint32_t>> lists = sample_pvs(run, loaded, sampled, cells, cams, out, log);
   out.agvs_cells = static_cast<uint32_t>(set.cells.size());
   ViewCellSet written = set;
   std::vector<std::vector<uint32_t>> written_lists = lists;

@@ -164,6 +164,11 @@ BuildResult build(const BuildConfig& config, LoadedScene loaded, const Log& log)
   out.merge = config.merge;
   out.sampling = sample_loaded(std::move(loaded), config.sampling, log);
   const SamplingRun& s = out.sampling;
+  if (s.result.stats.valid_segments == 0)
+    throw Error(config.scene.path, 0,
+                "none of the " + std::to_string(s.result.stats.samples) + " samples saw an object (0 valid segments): "
+                "the view space lies inside solids or sees no geometry; give a --view-box where a viewer can be, or "
+                "--empty-space off when the objects' insides are not solid");
   const Box3& box = s.result.segments.view_box;
   if (!std::isnan(config.views.slice_z) && !(config.views.slice_z >= box.lo.z && config.views.slice_z <= box.hi.z))
     throw Error("--slice-z " + fmt(config.views.slice_z) + " lies outside the view space (z from " + fmt(box.lo.z) +

@@ -101,6 +101,15 @@ RecodeResult recode(const std::string& input, const std::string& output, uint32_
   return out;
 }
 
+Scene load_matching_scene(const std::string& path, ObjectGrouping grouping, uint64_t file_fingerprint,
+                          const std::string& cells_path) {
+  Scene scene = load_scene(path, grouping);
+  if (file_fingerprint && scene.fingerprint() != file_fingerprint)
+    throw Error(path, 0, "is not the scene " + cells_path + " was built from (fingerprints differ: another scene, "
+                         "another version of it, or another --objects grouping)");
+  return scene;
+}
+
 ExtractResult extract(const ExtractConfig& config, const Log& log) {
   ExtractResult out;
   out.input = config.hierarchy_path;
@@ -115,7 +124,9 @@ ExtractResult extract(const ExtractConfig& config, const Log& log) {
     rebuild_cells(s);
     const CellView view = merged_cell_view(s, h, out.set.cells);
     std::unique_ptr<Scene> scene;
-    if (!config.scene_path.empty()) scene = std::make_unique<Scene>(load_scene(config.scene_path));
+    if (!config.scene_path.empty())
+      scene = std::make_unique<Scene>(
+          load_matching_scene(config.scene_path, config.grouping, out.file.scene_fingerprint, config.hierarchy_path));
     write_views(s, scene.get(), config.views, log, &view);
   }
   return out;

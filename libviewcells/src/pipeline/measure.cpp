@@ -116,6 +116,7 @@ CameraSet draw_cameras(const Scene& scene, const RayCaster& caster, const Q3Map*
 
 MeasureResult measure(const MeasureConfig& c, const Log& log) {
   Stopwatch total;
+  check_frame_budget(c.cameras.count, c.frame.width, c.frame.height);  // before any work
   MeasureResult out;
   out.config = c;
   out.threads = worker_threads();

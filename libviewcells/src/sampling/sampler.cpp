@@ -15,6 +15,7 @@
 #include "viewcells/core/binary_file.h"
 #include "viewcells/core/cluster.h"
 #include "viewcells/core/error.h"
+#include "viewcells/core/interrupt.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/core/rng.h"
 
@@ -420,6 +421,7 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
     constexpr uint64_t kRoundBatches = 64;
     SegmentSet batch_segs;
     while (!finished) {
+      throw_if_interrupted("sampling");
       const uint64_t first = next_batch;
       uint64_t n = 0;
       while (n < kRoundBatches && (first + n) * config.batch_size < limit) ++n;

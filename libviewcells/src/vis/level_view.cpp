@@ -8,6 +8,7 @@
 
 #include "viewcells/core/binary_file.h"
 #include "viewcells/core/error.h"
+#include "viewcells/core/format.h"
 #include "viewcells/vis/cell_views.h"
 #include "web_assets.h"
 
@@ -19,10 +20,15 @@ namespace {
 
 constexpr double kShrink = 0.97;  // as the PLY view: neighbouring leaves stay apart
 
+/// glTF and the web page store positions as floats: a vertex beyond their range would be
+/// written as inf (a .glb whose accessor bounds are null), so it is an error instead.
 void push_vertex(GroupedMesh& m, const Vec3& p) {
-  m.positions.push_back(static_cast<float>(p.x));
-  m.positions.push_back(static_cast<float>(p.y));
-  m.positions.push_back(static_cast<float>(p.z));
+  const float xyz[3] = {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
+  if (!std::isfinite(xyz[0]) || !std::isfinite(xyz[1]) || !std::isfinite(xyz[2]))
+    throw Error("view: a vertex at (" + fmt(p.x) + ", " + fmt(p.y) + ", " + fmt(p.z) +
+                ") is not finite in float, in which glTF and the web page store positions (is the view box beyond "
+                "+-3.4e38?)");
+  m.positions.insert(m.positions.end(), xyz, xyz + 3);
 }
 
 void close_group(GroupedMesh& m) {

@@ -31,8 +31,11 @@ struct CostModel {
   int screen_width = 1024, screen_height = 768;
   double fov_degrees = 90.0;  ///< horizontal field of view
 
+  /// The largest a, b or c: every cost sum stays finite.
+  static constexpr double kMaxFactor = 1e12;
+
   bool pixel_term() const { return c > 0; }
-  /// Throws Error for negative, non-finite or otherwise unusable parameters.
+  /// Throws Error for negative, non-finite, larger than kMaxFactor or otherwise unusable parameters.
   void validate() const;
   /// One line saying whether the pixel term is computed, and with which screen.
   std::string describe_pixel_term() const;

@@ -7,9 +7,10 @@
 
 namespace viewcells {
 
+/// Fixed decimals; magnitudes from 1e15 up in scientific notation (a fixed 1e308 has 309 digits).
 inline std::string fmt(double v, int precision = 3) {
   std::ostringstream os;
-  os.setf(std::ios::fixed);
+  os.setf(v < 1e15 && v > -1e15 ? std::ios::fixed : std::ios::scientific, std::ios::floatfield);
   os.precision(precision);
   os << v;
   return os.str();

@@ -37,6 +37,14 @@ Camera camera_looking(const Vec3& eye, double yaw, double pitch);
 std::vector<Camera> view_box_cameras(const RayCaster& caster, const CellLocator& locator, uint32_t count,
                                      uint64_t seed, bool skip_inside_solids, std::vector<int32_t>& cells);
 
+/// The most primary rays one measurement casts (cameras x width x height): 2^32, about 4.3
+/// billion, so that no option, however large, makes a run without a bound (at a few million
+/// rays a second a core, this ceiling is already about ten minutes on two cores).
+constexpr uint64_t kMaxFrameRays = uint64_t{1} << 32;
+
+/// Throws Error when `cameras` frames of width x height exceed kMaxFrameRays (or are empty).
+void check_frame_budget(uint64_t cameras, uint32_t width, uint32_t height);
+
 struct FrameConfig {
   uint32_t width = 32, height = 32;
   double fov_degrees = 90;            ///< horizontal

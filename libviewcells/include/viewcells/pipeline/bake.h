@@ -29,6 +29,10 @@ struct BakeConfig {
   /// compiler's vis rows), not the whole file with point location and object names.
   bool memory_of_lists = false;
   AgvsConfig agvs;                 ///< stopping rule (pixel error, time, samples), seed, batch
+  /// The whole bake's time limit in seconds (0: none): each of the merge's two AGVS runs
+  /// stops at a quarter of it, the PVSs' AGVS at what the hierarchy left (and at
+  /// agvs.max_seconds); a hierarchy that leaves nothing is an Error (its --work copy is kept).
+  double max_seconds = 0;
   /// Cameras that measure the PVSs as `viewcells measure` does (its placement, seed and
   /// frames: on a Quake 3 map player eyes above reachable floors); 0: none. The file
   /// written is measured, and its measured pixel error reported.

@@ -49,9 +49,15 @@ void write_pvs_checked(const std::string& path, const PvsFile& pf, const std::ve
 struct ExtractConfig {
   std::string hierarchy_path;
   CutRule cut;
-  std::string scene_path;  ///< drawn into the slice when given
+  std::string scene_path;  ///< drawn into the slice when given; must be the scene the cells were built from
+  ObjectGrouping grouping = ObjectGrouping::kAuto;  ///< as the hierarchy was built (the fingerprint counts it)
   ViewsConfig views;
 };
+
+/// The scene at `path` when it is the one `file_fingerprint` names (an Error naming both
+/// otherwise: cells drawn over another scene's geometry would mislead).
+Scene load_matching_scene(const std::string& path, ObjectGrouping grouping, uint64_t file_fingerprint,
+                          const std::string& cells_path);
 
 struct ExtractResult {
   std::string input;
