@@ -9,6 +9,7 @@
 #include "support/test_scenes.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/binary_file.h"
+#include "viewcells/io/q3bsp.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pipeline/bake.h"
 #include "viewcells/pipeline/cut.h"
@@ -218,6 +219,130 @@ TEST(Pipeline, BakeByCellsWritesThatManyAndContinuesFromItsWorkDirectory) {
   // Settings that change the hierarchy are not served from the work directory.
   c.sampling.seed = 2;
   EXPECT_FALSE(pipeline::bake(c, quiet).hierarchy_reused);
+}
+
+TEST(Pipeline, BakedMapGivesEveryPointOfItsNonSolidSpaceACell) {
+  // q3map2 rounds leaf bounds to whole units and derives them from portals: some non-solid
+  // leaves reach past the union of the stored bounds (the bake's view box), and a player (or a
+  // spectator, a noclip camera) there found no cell. The written file's cells reach out to
+  // q3_cover_box, and the runtime, the toolkit and measure's play cameras all find one.
+  const std::string path = test::oa_dm2_path(VIEWCELLS_DATA_DIR);
+  if (path.empty()) GTEST_SKIP() << "oa_dm2.bsp not fetched (scripts/fetch-maps.sh)";
+  pipeline::BakeConfig c;
+  c.scene.path = path;
+  c.sampling.samples = 30000;
+  c.sampling.show_progress = false;
+  c.subdivision.max_cells = 60;
+  c.subdivision.show_progress = false;
+  c.subdivision.play_space = true;
+  c.cells = 20;
+  c.agvs.max_samples = 20000;
+  c.agvs.show_progress = false;
+  c.output = test::temp_path("covered.pvs");
+  pipeline::bake(c, quiet);
+  const Q3Map map = read_q3bsp(path);
+  const Box3 stored = q3_view_box(map), cover = q3_cover_box(map);
+  const PvsFile f = read_pvs(c.output);
+  const runtime::PvsFile r(c.output);
+  EXPECT_TRUE(f.bsp.view_box.contains(cover.lo) && f.bsp.view_box.contains(cover.hi));
+  // Points of non-solid leaves within their stored bounds enlarged by one unit: in each leaf's
+  // bounds, and in the slabs of the cover box beyond the stored bounds' box.
+  Rng rng(9);
+  size_t tried = 0, beyond = 0;
+  auto check = [&](const Vec3& p) {
+    const int32_t l = map.leaf_at(p);
+    const Q3Leaf& leaf = map.leaves[l];
+    if (leaf.cluster < 0) return;
+    for (int a = 0; a < 3; ++a)
+      if (p[a] < leaf.bounds.lo[a] - 1 || p[a] > leaf.bounds.hi[a] + 1) return;
+    ++tried;
+    beyond += !stored.contains(p);
+    const int32_t cell = r.locate(p.x, p.y, p.z);
+    ASSERT_GE(cell, 0) << "leaf " << l << " at " << p.x << " " << p.y << " " << p.z;
+    ASSERT_EQ(cell, f.locate(p));
+  };
+  for (const Q3Leaf& leaf : map.leaves) {
+    if (leaf.cluster < 0 || leaf.bounds.empty()) continue;
+    for (int k = 0; k < 40; ++k) {
+      Vec3 p;
+      for (int a = 0; a < 3; ++a) p[a] = rng.uniform(leaf.bounds.lo[a] - 1, leaf.bounds.hi[a] + 1);
+      check(p);
+    }
+  }
+  for (int a = 0; a < 3; ++a)
+    for (int side = 0; side < 2; ++side)
+      for (int k = 0; k < 20000; ++k) {
+        Vec3 p{rng.uniform(cover.lo.x, cover.hi.x), rng.uniform(cover.lo.y, cover.hi.y),
+               rng.uniform(cover.lo.z, cover.hi.z)};
+        p[a] = side ? rng.uniform(stored.hi[a], cover.hi[a]) : rng.uniform(cover.lo[a], stored.lo[a]);
+        check(p);
+      }
+  EXPECT_GT(tried, 1000u);
+  EXPECT_GT(beyond, 0u) << "no point beyond the stored bounds: the test would pass without the cover box";
+  // measure's play cameras: none in no cell.
+  pipeline::MeasureConfig m;
+  m.scene.path = path;
+  m.pvs_path = c.output;
+  m.cameras.count = 300;
+  const pipeline::MeasureResult mr = pipeline::measure(m, quiet);
+  EXPECT_EQ(mr.error.cameras_uncovered, 0u);
+  EXPECT_EQ(mr.error.cameras, 300u);
+}
+
+TEST(Pipeline, MeasureCountsACameraInNoCellAsAFrameDrawingNothing) {
+  // A .pvs whose view box leaves out part of the map (what bakes wrote before the cover box):
+  // measure once stopped at the first such player eye; now it measures it, every pixel wrong.
+  const std::string path = test::oa_dm2_path(VIEWCELLS_DATA_DIR);
+  if (path.empty()) GTEST_SKIP() << "oa_dm2.bsp not fetched (scripts/fetch-maps.sh)";
+  pipeline::BakeConfig c;
+  c.scene.path = path;
+  c.sampling.samples = 20000;
+  c.sampling.show_progress = false;
+  c.subdivision.max_cells = 30;
+  c.subdivision.show_progress = false;
+  c.cells = 10;
+  c.agvs.max_samples = 20000;
+  c.agvs.show_progress = false;
+  c.output = test::temp_path("half.pvs");
+  pipeline::bake(c, quiet);
+  PvsFile f = read_pvs(c.output);
+  Box3& box = f.bsp.view_box;  // 4% off each side along x and y: eyes there have no cell
+  for (int a = 0; a < 2; ++a) {
+    const double cut = 0.04 * (box.hi[a] - box.lo[a]);
+    box.lo[a] += cut;
+    box.hi[a] -= cut;
+  }
+  const std::string half = test::temp_path("half-box.pvs");
+  write_pvs(half, f);
+  pipeline::MeasureConfig m;
+  m.scene.path = path;
+  m.pvs_path = half;
+  m.cameras.count = 200;
+  const pipeline::MeasureResult r = pipeline::measure(m, quiet);
+  EXPECT_GT(r.error.cameras_uncovered, 0u);
+  EXPECT_LT(r.error.cameras_uncovered, 100u);
+  EXPECT_GE(r.error.cameras_wrong, r.error.cameras_uncovered) << "an eye in no cell sees the map";
+  EXPECT_GT(r.error.worst_pixels, 1000.0);
+  EXPECT_LE(r.error.p99_pixels, r.error.worst_pixels);
+}
+
+TEST(Pipeline, BakeTimeBoundsTheWholeBake) {
+  // A merge asked to reach a pixel error it never reaches ran on past --time: now each of its
+  // AGVS runs stops at a quarter of it, and the PVSs' AGVS at what is left.
+  pipeline::BakeConfig c = small_bake(test::temp_path("timed.pvs"));
+  c.cells = 5;
+  c.agvs.max_samples = 0;
+  c.merge_agvs = AgvsConfig{};
+  c.merge_agvs->pixel_error = 1e-300;
+  c.merge_agvs->show_progress = false;
+  c.max_seconds = 1.0;
+  const pipeline::BakeResult r = pipeline::bake(c, quiet);
+  EXPECT_LT(r.seconds, 3.0) << "a bound of 1 s (tests never assert tight times)";
+  EXPECT_EQ(r.agvs.stop_reason, "reached the time limit");
+  // A limit the hierarchy uses up is an error, not a file of unsampled PVSs.
+  c.max_seconds = 1e-3;
+  EXPECT_THROW(pipeline::bake(c, quiet), Error);
+  EXPECT_FALSE(std::filesystem::exists(test::temp_path("timed-none.pvs")));
 }
 
 TEST(Pipeline, BakeRefusesNoBudgetOrTwo) {

@@ -1540,7 +1540,11 @@ class Builder {
     // reduction can only fall.
     auto side_costs = [&](const Plane& plane, bool from_extremes) {
       const FilteredSide side(plane, points);
-      auto& [neg, pos] = side_pair_marks_.local();
+      // Plain references, not a structured binding: clang 14 (the fuzz and sanitizer builds)
+      // refuses bindings captured by the lambdas below.
+      std::pair<Marks, Marks>& sides = side_pair_marks_.local();
+      Marks& neg = sides.first;
+      Marks& pos = sides.second;
       neg.reset(r_.size());
       pos.reset(r_.size());
       double cl = 0, cr = 0;

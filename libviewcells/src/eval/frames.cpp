@@ -82,7 +82,8 @@ PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, st
     throw Error("the field of view must be between 0 and 180 degrees");
   if (cells.size() != cameras.size()) throw Error("measure_frames: one cell per camera");
   for (int32_t c : cells)
-    if (c < 0 || static_cast<uint32_t>(c) >= pvs.cell_count()) throw Error("measure_frames: a camera outside the cells");
+    if (c < -1 || (c >= 0 && static_cast<uint32_t>(c) >= pvs.cell_count()))
+      throw Error("measure_frames: a camera's cell is not one of the PVS's");
   const double f = std::tan(0.5 * config.fov_degrees * std::numbers::pi / 180.0);
   const double aspect = static_cast<double>(height) / width;
   const uint32_t n = static_cast<uint32_t>(cameras.size());
@@ -107,7 +108,8 @@ PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, st
       });
       objects.clear();
       for (const Hit& h : hits)
-        if (h.hit() && scene.objects[h.object].rendered && !pvs.contains(static_cast<uint32_t>(cells[k]), h.object))
+        if (h.hit() && scene.objects[h.object].rendered &&
+            (cells[k] < 0 || !pvs.contains(static_cast<uint32_t>(cells[k]), h.object)))
           objects.push_back(h.object);
       std::sort(objects.begin(), objects.end());
       for (size_t i = 0; i < objects.size();) {
@@ -126,6 +128,7 @@ PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, st
   for (uint32_t k = 0; k < n; ++k) {
     for (const WrongView& w : wrong_of[k]) per_camera[k] += w.pixels;
     out.cameras_wrong += per_camera[k] > 0;
+    out.cameras_uncovered += cells[k] < 0;
     out.wrong.insert(out.wrong.end(), wrong_of[k].begin(), wrong_of[k].end());
   }
   const uint64_t wrong = std::accumulate(per_camera.begin(), per_camera.end(), uint64_t{0});
@@ -136,6 +139,12 @@ PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, st
   double median = static_cast<double>(per_camera[n / 2]);
   if (n % 2 == 0) median = 0.5 * (median + static_cast<double>(*std::max_element(per_camera.begin(), per_camera.begin() + n / 2)));
   out.median_pixels = median / frame * config.resolution;
+  // Nearest rank: the smallest count that at least 99% of the cameras do not exceed.
+  const size_t rank = (99 * static_cast<size_t>(n) + 99) / 100 - 1;
+  std::nth_element(per_camera.begin(), per_camera.begin() + rank, per_camera.end());
+  out.p99_pixels = static_cast<double>(per_camera[rank]) / frame * config.resolution;
+  out.worst_pixels =
+      static_cast<double>(*std::max_element(per_camera.begin(), per_camera.end())) / frame * config.resolution;
   return out;
 }
 

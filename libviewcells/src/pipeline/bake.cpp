@@ -179,8 +179,9 @@ struct CutBytes {
 /// The .pvs of the view cells `set` with the PVSs `lists`: written, read back and compared
 /// (`check`), or only measured (the sizes a search tries).
 CutBytes write_cut(const std::string& path, const SubdivisionFile& file, const ViewCellSet& set,
-                   const std::vector<std::vector<uint32_t>>* lists, bool check) {
+                   const std::vector<std::vector<uint32_t>>* lists, bool check, const Box3& view_box) {
   PvsFile pf = pvs_file_for(file, set);
+  pf.bsp.view_box = view_box;
   pf.rule += "; PVS by agvs";
   if (lists) pf.pvs = compress_pvs(*file.history, set.cells, *lists);
   CutBytes b;
@@ -262,13 +263,19 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   const ViewCellSet set = first_cut(c, file, log);
   const PvsFile sampled = pvs_file_for(file, set);
   const CellLocator cells(sampled.bsp, sampled.leaf_cell, sampled.pvs.cell_count);
+  // The file's cells cover every point of a map's non-solid space (covered_view_box), and the
+  // cameras are located in them as an engine would.
+  const Box3 written_box = covered_view_box(loaded.map.get(), sampled.bsp.view_box);
+  PvsFile covered = sampled;
+  covered.bsp.view_box = written_box;
+  const CellLocator covered_cells(covered.bsp, covered.leaf_cell, covered.pvs.cell_count);
   std::optional<CameraSet> cams;
   if (c.measure_cameras) {
     Stopwatch sw;
     CameraConfig cc = c.cameras;
     cc.count = c.measure_cameras;
     cams = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), cc,
-                        [&cells](const Vec3& p) { return cells.cell_at(p); }, &cells, c.output);
+                        [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); }, &covered_cells);
     out.camera_rule = cams->rule;
     log("viewcells: bake: " + std::to_string(cams->cameras.size()) + " measuring cameras (" + cams->rule + ") in " +
         fmt(sw.seconds(), 2) + " s");
@@ -277,7 +284,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   out.agvs_cells = static_cast<uint32_t>(set.cells.size());
   ViewCellSet written = set;
   std::vector<std::vector<uint32_t>> written_lists = lists;
-  CutBytes bytes = write_cut(c.output, file, set, &lists, true);
+  CutBytes bytes = write_cut(c.output, file, set, &lists, true, written_box);
   const uint64_t used = bytes.budgeted(c.memory_of_lists);
   if (c.memory && used > c.memory) {
     // AGVS found more than the construction samples: the largest coarser cut that fits, with
@@ -287,14 +294,14 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     const size_t n = largest_fitting(h.min_cells(), set.cells.size() - 1, c.memory, [&](size_t count) {
       const ViewCellSet cut = extract_by_count(h, count);
       const auto coarse = coarsen(h, set.cells, lists, cut.cells);
-      return write_cut(c.output, file, cut, &coarse, false).budgeted(c.memory_of_lists);
+      return write_cut(c.output, file, cut, &coarse, false, written_box).budgeted(c.memory_of_lists);
     });
     if (n == 0)
       throw Error(c.output, 0, "not even " + std::to_string(h.min_cells()) + " view cell(s) fit in " +
                                    std::to_string(c.memory) + " bytes");
     written = extract_by_count(h, n);
     written_lists = coarsen(h, set.cells, lists, written.cells);
-    bytes = write_cut(c.output, file, written, &written_lists, true);
+    bytes = write_cut(c.output, file, written, &written_lists, true, written_box);
   }
   if (cams) {
     if (written.cells.size() == set.cells.size() && !out.measured_curve.empty()) {
@@ -303,7 +310,8 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
       // The cells written (coarser when the budget coarsened them): each camera's is found again.
       CameraSet in_written = *cams;
       if (written.cells.size() != set.cells.size()) {
-        const PvsFile wf = pvs_file_for(file, written);
+        PvsFile wf = pvs_file_for(file, written);
+        wf.bsp.view_box = written_box;
         const CellLocator located(wf.bsp, wf.leaf_cell, wf.pvs.cell_count);
         for (size_t i = 0; i < in_written.cameras.size(); ++i)
           in_written.cells[i] = located.cell_at(in_written.cameras[i].eye);

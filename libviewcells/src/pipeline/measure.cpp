@@ -47,6 +47,10 @@ void frame_costs(const Scene& scene, const GlobalPvs& pvs, const std::vector<int
     }
   std::vector<double> per_camera;
   for (int32_t c : cam_cells) {
+    if (c < 0) {  // in no view cell: the engine has nothing to draw (and every pixel is wrong)
+      per_camera.push_back(0);
+      continue;
+    }
     out.frame_cost += cell_cost[c];
     out.frame_triangles += cell_tris[c];
     out.frame_objects += cell_objects[c];
@@ -64,8 +68,7 @@ void frame_costs(const Scene& scene, const GlobalPvs& pvs, const std::vector<int
 }  // namespace
 
 CameraSet draw_cameras(const Scene& scene, const RayCaster& caster, const Q3Map* map, const CameraConfig& c,
-                       const std::function<int32_t(const Vec3&)>& cell_at, const CellLocator* locator,
-                       const std::string& what) {
+                       const std::function<int32_t(const Vec3&)>& cell_at, const CellLocator* locator) {
   if (c.count == 0) throw Error("measure: the number of cameras must be positive");
   const CameraPlacement placement =
       c.placement == CameraPlacement::kAuto ? (map ? CameraPlacement::kPlay : CameraPlacement::kViewBox) : c.placement;
@@ -80,11 +83,11 @@ CameraSet draw_cameras(const Scene& scene, const RayCaster& caster, const Q3Map*
     out.cameras = std::move(play.cameras);
     out.rule = play.rule;
     out.points_drawn = play.points_drawn;
+    // A player's eye in no view cell is kept, and measured as a failure (measure_frames: an
+    // engine gets no PVS there): the frame a player would see, not a reason to stop.
     for (const Camera& cam : out.cameras) {
       const int32_t cell = cell_at(cam.eye);
-      if (cell < 0)
-        throw Error(what, 0, "a player's eye at (" + fmt(cam.eye.x, 1) + ", " + fmt(cam.eye.y, 1) + ", " +
-                                 fmt(cam.eye.z, 1) + ") lies in no view cell");
+      if (cell < 0) ++out.uncovered;
       out.cells.push_back(cell);
     }
   } else if (map) {
@@ -159,8 +162,11 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
   out.pvs_entries = m.pvs.entries();
 
   Stopwatch sw;
-  const CameraSet cams = draw_cameras(scene, *loaded.caster, loaded.map.get(), c.cameras, m.cell_at, m.locator.get(),
-                                      c.pvs_path.empty() ? c.scene.path : c.pvs_path);
+  const CameraSet cams = draw_cameras(scene, *loaded.caster, loaded.map.get(), c.cameras, m.cell_at, m.locator.get());
+  if (cams.uncovered)
+    log("viewcells: warning: " + std::to_string(cams.uncovered) + " of " + std::to_string(cams.cameras.size()) +
+        " player eyes lie in no view cell of " + (c.pvs_path.empty() ? c.scene.path : c.pvs_path) +
+        ": an engine gets no PVS there; they are measured as frames drawing nothing");
   const std::vector<Camera>& cameras = cams.cameras;
   const std::vector<int32_t>& cells = cams.cells;
   out.camera_rule = cams.rule;
@@ -214,8 +220,12 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
   log("viewcells: " + out.measured + ": per frame " + fmt(out.frame_triangles, 4) + " triangles in " +
       fmt(out.frame_objects, 4) + " objects drawn (cost " + fmt(out.frame_cost, 4) + "), wrong pixels " +
       fmt(out.error.pixels, 3) + " per " + std::to_string(c.frame.resolution) + " (median " +
-      fmt(out.error.median_pixels, 3) + "; " + std::to_string(out.error.cameras_wrong) + " of " +
-      std::to_string(out.error.cameras) + " cameras wrong), " + fmt(sw.seconds(), 2) + " s");
+      fmt(out.error.median_pixels, 3) + ", 99th percentile " + fmt(out.error.p99_pixels, 1) + ", worst " +
+      fmt(out.error.worst_pixels, 1) + "; " + std::to_string(out.error.cameras_wrong) + " of " +
+      std::to_string(out.error.cameras) + " frames wrong" +
+      (out.error.cameras_uncovered ? ", " + std::to_string(out.error.cameras_uncovered) + " in no view cell" : "") +
+      ") at " + std::to_string(c.frame.width) + "x" + std::to_string(c.frame.height) + ", " + fmt(sw.seconds(), 2) +
+      " s");
   return out;
 }
 

@@ -113,8 +113,7 @@ CameraSet measuring_cameras(const PvsConfig& c, const Scenes& s, const Q3Map* ma
   CameraConfig cc;
   cc.count = c.measure_cameras;
   cc.seed = c.agvs.seed + 17;
-  return draw_cameras(s.scene, *s.caster, map, cc, [&cells](const Vec3& p) { return cells.cell_at(p); }, &cells,
-                      c.hierarchy_path);
+  return draw_cameras(s.scene, *s.caster, map, cc, [&cells](const Vec3& p) { return cells.cell_at(p); }, &cells);
 }
 
 FrameConfig measuring_frame(const PvsConfig& c, const PvsResult& out) {
@@ -237,9 +236,14 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   std::shared_ptr<const Q3Map> map;
   if (is_q3_map(c.scene_path)) map = std::make_shared<const Q3Map>(read_q3bsp(c.scene_path));
   use_map_view_space(map, out.agvs);
+  // The file's cells cover every point of a map's non-solid space (covered_view_box): the
+  // cameras are located in them as an engine would.
+  PvsFile covered = pf;
+  covered.bsp.view_box = covered_view_box(map.get(), pf.bsp.view_box);
+  const CellLocator covered_cells(covered.bsp, covered.leaf_cell, covered.pvs.cell_count);
   std::optional<CameraSet> cams;
   if (c.measure_cameras) {
-    cams = measuring_cameras(c, scenes, map.get(), cells);
+    cams = measuring_cameras(c, scenes, map.get(), covered_cells);
     out.camera_rule = cams->rule;
   }
   std::optional<AgvsSolver> solver;
@@ -292,6 +296,7 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
         (c.filter.view_neighbours ? "view space, " + std::to_string(c.filter.view_neighbours) + " neighbours" : "") +
         "): mean PVS " + fmt(out.mean_pvs, 1) + " -> " + fmt(out.mean_written, 1) + " objects");
   pf.pvs = compress_pvs(h, set.cells, lists);
+  pf.bsp.view_box = covered.bsp.view_box;
   write_pvs_checked(c.output, pf, lists);
   out.pixel_error = solver->pixel_error();
   out.pixel_error_bound = solver->pixel_error_bound();

@@ -53,6 +53,12 @@ void use_map_view_space(const std::shared_ptr<const Q3Map>& map, AgvsConfig& con
   config.view_space = [map](const Vec3& p) { return q3_in_view_space(*map, p); };
 }
 
+Box3 covered_view_box(const Q3Map* map, const Box3& box) {
+  Box3 out = box;
+  if (map) out.extend(q3_cover_box(*map));
+  return out;
+}
+
 const PlaySpace& play_space(LoadedScene& s) {
   if (!s.map) throw Error("the play space needs a Quake 3 map");
   if (!s.play)

@@ -31,6 +31,49 @@ Box3 q3_view_box(const Q3Map& map) {
 
 namespace {
 
+/// The part of `poly` inside `box` (empty when none).
+ConvexPolyhedron clip_to_box(ConvexPolyhedron poly, const Box3& box) {
+  for (int k = 0; k < 3 && !poly.empty(); ++k)
+    for (int side = 0; side < 2 && !poly.empty(); ++side) {
+      const Plane plane = Plane::axis_aligned(k, side ? box.hi[k] : box.lo[k]);
+      if (auto parts = poly.split(plane, -1)) {
+        poly = side ? parts->first : parts->second;  // below hi, above lo
+      } else {
+        const double at = poly.centroid()[k];
+        if (side ? at > box.hi[k] : at < box.lo[k]) poly = ConvexPolyhedron();
+      }
+    }
+  return poly;
+}
+
+}  // namespace
+
+Box3 q3_cover_box(const Q3Map& map) {
+  const Box3 stored = q3_view_box(map);
+  Box3 around = stored;
+  for (int k = 0; k < 3; ++k) {
+    around.lo[k] -= 2;
+    around.hi[k] += 2;
+  }
+  const Subdivision s = q3_subdivision(map, around);
+  const size_t inner = map.nodes.size();
+  Box3 out = stored;
+  for (size_t l = 0; l < map.leaves.size(); ++l) {
+    const Q3Leaf& leaf = map.leaves[l];
+    if (leaf.cluster < 0 || leaf.bounds.empty() || s.cells[inner + l].empty()) continue;
+    Box3 rounded = leaf.bounds;
+    for (int k = 0; k < 3; ++k) {
+      rounded.lo[k] -= 1;
+      rounded.hi[k] += 1;
+    }
+    const ConvexPolyhedron part = clip_to_box(s.cells[inner + l], rounded);
+    if (!part.empty()) out.extend(part.bounds());
+  }
+  return out;
+}
+
+namespace {
+
 /// The Q3 plane as a Plane whose positive side is Q3's front (children[0]); `flipped` when it
 /// is an axial plane with a negative normal, which is kept exact as the opposite axis plane.
 Plane to_plane(const Q3Plane& q, bool& flipped) {

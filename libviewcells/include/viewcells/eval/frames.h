@@ -62,15 +62,21 @@ struct PixelErrorMeasure {
   double pixels = 0;         ///< mean wrong pixels per camera, scaled to `resolution`
   double share = 0;          ///< wrong pixels / all pixels
   double median_pixels = 0;  ///< median over the cameras of their wrong pixels, scaled to `resolution`
+  double p99_pixels = 0;     ///< 99th percentile over the cameras (nearest rank), scaled to `resolution`
+  double worst_pixels = 0;   ///< the worst camera's, scaled to `resolution`
   uint32_t cameras = 0;
   uint32_t cameras_wrong = 0;     ///< cameras with at least one wrong pixel
+  /// Cameras in no view cell (cell -1): an engine gets no PVS there and draws nothing, so every
+  /// pixel showing an object is wrong. A bake must leave none; counted among cameras_wrong
+  /// when they see anything.
+  uint32_t cameras_uncovered = 0;
   std::vector<WrongView> wrong;   ///< every (camera, object) with wrong pixels, by camera then object
 };
 
 /// Renders every camera (in parallel; the result does not depend on the thread count) and
 /// counts the pixels whose object (rendered objects only; see-through objects do not stop the
 /// camera's rays and are not counted) is missing from pvs's row `cells[k]` (each < the PVS's
-/// cell count).
+/// cell count, or -1: a camera in no cell, whose every object pixel is wrong).
 PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, std::span<const Camera> cameras,
                                  std::span<const int32_t> cells, const GlobalPvs& pvs, const FrameConfig& config);
 

@@ -56,6 +56,10 @@ void use_map_view_space(LoadedScene& loaded, SamplerConfig& config);
 
 /// On a Quake 3 map (`map` not null), AGVS draws its points in the map's non-solid space too.
 void use_map_view_space(const std::shared_ptr<const Q3Map>& map, AgvsConfig& config);
+/// The view box a written .pvs gives its cells: `box`, and on a Quake 3 map (`map` not null)
+/// every point of its non-solid space (q3_cover_box), so that an engine finds a cell wherever
+/// a player can stand. The BSP's cells at the rim reach out to it; nothing else changes.
+Box3 covered_view_box(const Q3Map* map, const Box3& box);
 /// The play space of a Quake 3 map (q3_play_space with its defaults), found the first time
 /// and kept in `loaded.play`. Error for other scenes.
 const PlaySpace& play_space(LoadedScene& loaded);

@@ -22,6 +22,12 @@ bool q3_in_view_space(const Q3Map& map, const Vec3& p);
 
 /// The bounding box of the non-solid leaves (Error when the map has none).
 Box3 q3_view_box(const Q3Map& map);
+/// The box a baked file's cells must cover: every point of a non-solid leaf that lies within
+/// that leaf's bounds as the file stores them, enlarged by one unit. The file rounds bounds to
+/// whole units, and q3map2 derives them from the leaf's portals, so a leaf may reach past them
+/// (by a third of a unit on q3dm6ish): q3_view_box, which unites the stored bounds, misses such
+/// slivers where a player can stand. Contains q3_view_box.
+Box3 q3_cover_box(const Q3Map& map);
 
 /// The map's BSP over `box` as a Subdivision: map node i is node i, map leaf l is node
 /// map.nodes.size() + l (so leaf_of_node() inverts it). Q3 planes become Planes (axial ones
