@@ -603,9 +603,11 @@ void build_grid(vc_pvs& f) {
       for (int x = 0; x < f.grid_n[0]; ++x) {
         const int i[3] = {x, y, z};
         double lo[3], hi[3];
+        // extent * (i / n), not extent * i / n: the product overflows for a span near 1e308
+        // (a fuzzed file: its grid cells became [inf, inf] and sent location the wrong way).
         for (int k = 0; k < 3; ++k) {
-          lo[k] = f.lo[k] + extent[k] * i[k] / f.grid_n[k] - margin[k];
-          hi[k] = f.lo[k] + extent[k] * (i[k] + 1) / f.grid_n[k] + margin[k];
+          lo[k] = f.lo[k] + extent[k] * (static_cast<double>(i[k]) / f.grid_n[k]) - margin[k];
+          hi[k] = f.lo[k] + extent[k] * (static_cast<double>(i[k] + 1) / f.grid_n[k]) + margin[k];
         }
         f.grid_start[at++] = deepest_node(f, lo, hi);
       }

@@ -197,7 +197,7 @@ void entry_runtime(const uint8_t* data, size_t size) {
       if (cell >= 0 && std::vector<uint32_t>(ids.begin(), ids.begin() + copied) != read->pvs.cell_pvs(cell))
         std::abort();
       vc_pvs_cell_bits(h, cell, row.data(), row.size());
-      vc_pvs_cell_sees(h, cell, static_cast<uint32_t>(raw[0]) % (objects + 1));
+      vc_pvs_cell_sees(h, cell, size > 2 ? data[2] : 0);
     }
     const int32_t some = static_cast<int32_t>(size > 1 ? data[size - 1] : 0) - 1;  // -1 and a few cells
     vc_pvs_cell_objects(h, some, nullptr);

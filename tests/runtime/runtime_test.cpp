@@ -424,7 +424,9 @@ std::string with_view_box(const std::string& path, int axis, double lo, double h
 
 TEST(Runtime, LocatesLikeTheToolkitInExtremeViewBoxes) {
   // Boxes a valid container can carry: a span of 1e-310 (its grid scale overflows), of 2e308
-  // (hi - lo overflows), far from the origin. The runtime once indexed its grid with
+  // (hi - lo overflows), far from the origin, of 5.4e307 (the fuzzer's box: extent x grid index
+  // overflowed; data/fuzz/regressions/pvs/runtime-disagrees-1, whose root plane is axial,
+  // reproduces that, these planes do not). The runtime once indexed its grid with
   // static_cast<int>(inf or NaN) here and crashed while `viewcells query` answered.
   const Level& l = level();
   const Box3& box = l.file.bsp.view_box;
@@ -435,7 +437,8 @@ TEST(Runtime, LocatesLikeTheToolkitInExtremeViewBoxes) {
   };
   size_t opened = 0, located = 0;
   for (const Case& c : {Case{0, 0, 1e-310}, Case{0, -1e308, 1e308}, Case{1, -huge, huge}, Case{2, 1e300, 1.5e300},
-                        Case{0, -5e-324, 5e-324}, Case{2, box.lo.z, 1e308}, Case{1, -1e308, box.hi.y}}) {
+                        Case{0, -5e-324, 5e-324}, Case{2, box.lo.z, 1e308}, Case{1, -1e308, box.hi.y},
+                        Case{0, -5.3751024732383243e+307, 59205627325.29705}}) {
     SCOPED_TRACE("axis " + std::to_string(c.axis) + " [" + std::to_string(c.lo) + ", " + std::to_string(c.hi) + "]");
     const std::string path = with_view_box(l.path, c.axis, c.lo, c.hi, "extreme_box.pvs");
     PvsFile f;
