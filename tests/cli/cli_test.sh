@@ -572,5 +572,67 @@ expect_error "needs a .pvs file" "$VC" measure office.obj
 expect_error "unknown camera placement" "$VC" measure office.obj bake1.pvs --cameras everywhere
 expect_error "--width" "$VC" measure office.obj bake1.pvs --width 100000
 
+# Hostile input (issue: the runtime never crashes an engine, every run is bounded): each case
+# a clear error and a non-zero exit before any work, or a bounded run; earlier files untouched.
+expect_error "above the ceiling of 4294967296" "$VC" measure office.obj bake1.pvs --count 10000000
+expect_error "above the ceiling" "$VC" measure office.obj bake1.pvs --count 2000 --width 2048 --height 2048
+expect_error "give a number from 1 to 179" "$VC" measure office.obj bake1.pvs --fov nan
+expect_error "must be a number from 0 to 1e12" "$VC" bake office.obj --cells 5 --cost-b 1e308 -o x.pvs
+expect_error "must be a number from 0 to 1e12" "$VC" measure office.obj bake1.pvs --cost-b 1e308
+expect_error "elementary cells of --max-cells" "$VC" bake office.obj --cells 5 --max-cells 2 -o x.pvs
+expect_error "above 0 bytes" "$VC" bake office.obj --memory 0 -o x.pvs
+expect_error "its directory nodir does not exist" "$VC" bake office.obj --cells 5 -o nodir/x.pvs
+expect_error "its directory nodir does not exist" "$VC" bake office.obj --cells 5 -o keep.pvs --report nodir/r.json
+cmp -s bake1.pvs keep.pvs && ok || bad "a bake refused for its report path replaced its output"
+expect_error "empty value" "$VC" bake office.obj --cells 5 -o ""
+expect_error "also given as an output file" "$VC" bake office.obj --cells 5 -o samedir --work samedir
+touch afile
+expect_error "exists and is not a directory" "$VC" bake office.obj --cells 5 -o x.pvs --work afile
+# 309-digit numbers are printed as 1.000e+308.
+"$VC" query bake1.pvs 1e308 0 0 >out.txt 2>err.txt
+grep -q "1.000e+308" err.txt && [ "$(wc -c <err.txt)" -lt 200 ] && ok || bad "query 1e308: $(cat err.txt)"
+# --time bounds the whole bake, also a merge that would never reach its pixel error.
+start=$(date +%s)
+expect_ok "$VC" bake office.obj --cells 5 --samples 5000 --merge-pixel-error 1e-300 --time 2 -o timed.pvs -q
+[ $(( $(date +%s) - start )) -lt 30 ] && ok || bad "bake --time 2 took $(( $(date +%s) - start )) s"
+# Ctrl-C stops a long measurement cleanly: exit 130, no report written.
+rm -f sigint.json
+"$VC" measure office.obj bake1.pvs --count 1000000 --width 32 --height 32 --report sigint.json -q 2>err.txt &
+pid=$!
+sleep 3
+kill -INT $pid
+wait $pid
+rc=$?
+[ $rc -eq 130 ] && grep -q "interrupted" err.txt && [ ! -e sigint.json ] && ok || bad "measure after SIGINT: exit $rc ($(cat err.txt))"
+# Another scene under a slice: an error, not a drawing of the wrong geometry.
+expect_error "is not the scene" "$VC" export office.vcells --slice-png other.png --scene rotated.obj
+expect_error "is not the scene" "$VC" extract office.vcells --count 4 --slice-png other.png --scene rotated.obj
+# glTF: a NaN vertex, lines only, the whole view space inside one closed solid.
+python3 - <<'PY'
+import base64, json, struct
+def gltf(path, verts, idx, mode=4):
+    vb = b''.join(struct.pack('<3f', *v) for v in verts)
+    ib = b''.join(struct.pack('<I', i) for i in idx)
+    fin = [v for v in verts if all(c == c and abs(c) != float('inf') for c in v)] or [(0, 0, 0)]
+    doc = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"name": "box", "mesh": 0}],
+           "meshes": [{"name": "box", "primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": mode}]}],
+           "accessors": [{"bufferView": 0, "componentType": 5126, "count": len(verts), "type": "VEC3",
+                          "min": [min(v[k] for v in fin) for k in range(3)], "max": [max(v[k] for v in fin) for k in range(3)]},
+                         {"bufferView": 1, "componentType": 5125, "count": len(idx), "type": "SCALAR"}],
+           "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": len(vb)},
+                           {"buffer": 0, "byteOffset": len(vb), "byteLength": len(ib)}],
+           "buffers": [{"byteLength": len(vb) + len(ib),
+                        "uri": "data:application/octet-stream;base64," + base64.b64encode(vb + ib).decode()}]}
+    open(path, 'w').write(json.dumps(doc))
+box = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0), (0, 0, 1), (1, 0, 1), (1, 1, 1), (0, 1, 1)]
+tris = [0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4, 1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7]
+gltf('solid.gltf', box, tris)
+gltf('nan.gltf', [(float('nan'), 0, 0)] + box[1:], tris)
+gltf('lines.gltf', box, tris, mode=1)
+PY
+expect_error "whose coordinates are not finite" "$VC" info nan.gltf
+expect_error "holds no triangles" "$VC" info lines.gltf
+expect_error "0 valid segments" "$VC" bake solid.gltf --cells 2 --samples 5000 -o x.pvs
+
 echo "cli: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]
