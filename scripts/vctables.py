@@ -1015,7 +1015,7 @@ def shipped(out, err, secs):
              "not in that PVS; errors are per 1024x1024 frame. q3map2: the map's own vis rows (visible clusters -> "
              "their leaves -> their surfaces), its storage the uncompressed rows (the leaf surface lists its renderer also "
              "needs not counted). Ours: `viewcells bake MAP --cells "
-             f"CLUSTERS --pixel-error {err} --time {secs}` (1M construction samples, AV-M cells at q3map2's cluster "
+             f"CLUSTERS --pixel-error {err} --agvs-time {secs}` (1M construction samples, AV-M cells at q3map2's cluster "
              "count, PVSs by AGVS until the estimated error is below the target or the time is up), its storage the "
              "visible sets as an engine's compact handle holds them (`vc_pvs_open_compact`: the hierarchy-compressed object "
              "lists as .pvs format 2 codes them, and 8 bytes a hierarchy node; the .pvs file adds point location, object "
@@ -1392,7 +1392,7 @@ def shipped_leaf(out, path, err, secs, play=None, *check):
     if every:
         intro = (f"Every map of the main table ({len(rows)}), baked with one setting in one run: the most cells whose "
                  f"compressed lists fit q3map2's rows and leaf surface lists, with `--play-space` (`viewcells bake MAP "
-                 f"--memory ROWS+LEAF_LISTS --memory-of lists --pixel-error {err} --time {secs} --play-space`; the play "
+                 f"--memory ROWS+LEAF_LISTS --memory-of lists --pixel-error {err} --agvs-time {secs} --play-space`; the play "
                  "space as in the table above), measured by the same 5,000 play cameras. The column \"at the cluster "
                  "count\" is the main table's bake, without `--play-space` and at q3map2's cluster count.\n")
     elif check:
@@ -1404,7 +1404,7 @@ def shipped_leaf(out, path, err, secs, play=None, *check):
     elif play:
         intro = (f"The {len(rows)} maps that still miss the goal after the bakes above, baked once more within q3map2's "
                  f"rows and leaf surface lists with `--play-space`: `viewcells bake MAP --memory ROWS+LEAF_LISTS "
-                 f"--memory-of lists --pixel-error {err} --time {secs} --play-space`. The cells are weighed by their "
+                 f"--memory-of lists --pixel-error {err} --agvs-time {secs} --play-space`. The cells are weighed by their "
                  "volume in the play space (the non-solid leaves reachable from the spawn points that hold a point at "
                  "most 112 units above a walkable floor with free space up to it: where a player's eye can be, "
                  "jumping included) instead of all non-solid space, in the division (200,000 points uniform in those "
@@ -1413,7 +1413,7 @@ def shipped_leaf(out, path, err, secs, play=None, *check):
     else:
         intro = (f"The {len(rows)} maps of the table above that miss the goal against q3map2's rows and leaf surface "
                  f"lists, baked again: `viewcells bake MAP --memory ROWS+LEAF_LISTS --memory-of lists --pixel-error {err} "
-                 f"--time {secs}` (the most cells whose compressed lists fit those bytes; fewer cells than the clusters "
+                 f"--agvs-time {secs}` (the most cells whose compressed lists fit those bytes; fewer cells than the clusters "
                  "where the lists at the cluster count exceed them, more where they leave room), measured by the same "
                  "5,000 play cameras (q3map2's side measured again: the same cost per frame on every map, checked). "
                  "The table above was made before maps-shipped.sh made this bake itself; its other bakes are as they "

@@ -324,6 +324,17 @@ TEST(LevelView, CellsFillTheViewBoxAndCarryTheirPvs) {
     EXPECT_EQ(v.scene.first_index[o + 1] - v.scene.first_index[o], 3 * b.scene.objects[o].triangle_count);
   // A different scene is refused.
   EXPECT_THROW(make_level_view(f, generate_scene({GeneratorKind::kOffice, 2, 1}), CostModel{}), Error);
+  // A view box beyond float's range (a valid file may carry one): glTF and the page store
+  // floats, so it is an error, not a .glb whose accessor bounds are null.
+  PvsFile far = f;
+  far.bsp.view_box.lo.x = -1e308;
+  far.bsp.view_box.hi.x = 1e308;
+  try {
+    make_level_view(far, b.scene, CostModel{});
+    FAIL() << "a view box of 1e308 was drawn";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("not finite in float"), std::string::npos) << e.what();
+  }
 }
 
 TEST(LevelView, GltfRoundTripsThroughAssimpWithTheCellsPvsInExtras) {
