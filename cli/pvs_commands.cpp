@@ -291,7 +291,7 @@ void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
 
 struct MeasureArgs {
   std::string scene, pvs, objects = "auto", cameras = "auto", report;
-  uint32_t count = 5000, width = 64, height = 48;
+  uint32_t count = 1000, width = 1024, height = 768;
   double fov = 90, cost_a = CostModel{}.a, cost_b = CostModel{}.b, max_pitch = 30;
   uint64_t seed = 1;
   bool fast = false;
@@ -338,7 +338,11 @@ void add_measure_command(CLI::App& app, const Common& common, Commands& commands
                  "view space, looking anywhere) or auto (play on a map)")
       ->capture_default_str();
   ms->add_option("--count", a->count, "Number of cameras")->capture_default_str()->check(whole(1, 10'000'000));
-  ms->add_option("--width", a->width, "Frame width in pixels")->capture_default_str()->check(whole(1, 2048));
+  ms->add_option("--width", a->width,
+                 "Frame width in pixels (what players see; wrong pixels are reported per 1024x1024 frame whatever "
+                 "the size). Cameras x width x height may not exceed 2^32 rays")
+      ->capture_default_str()
+      ->check(whole(1, 2048));
   ms->add_option("--height", a->height, "Frame height in pixels")->capture_default_str()->check(whole(1, 2048));
   ms->add_option("--fov", a->fov, "Horizontal field of view in degrees")->capture_default_str()->check(in_range(1.0, 179.0));
   ms->add_option("--max-pitch", a->max_pitch, "Play cameras: largest pitch up or down, in degrees")

@@ -47,7 +47,7 @@ for name in "${names[@]}"; do
   map="data/maps/bsp/$name.bsp"
   d="$out/$name"
   mkdir -p "$d"
-  [ -f "$d/q3map2.json" ] || "$vc" measure "$map" --report "$d/q3map2.json" -q 2> "$d/err"
+  [ -f "$d/q3map2.json" ] || "$vc" measure "$map" --count 5000 --width 64 --height 48 --report "$d/q3map2.json" -q 2> "$d/err"
   budget=$(python3 scripts/vctables.py shipped-budget "$d")
   echo "shipped-leaf: [$i/${#names[@]}] $name: within $budget bytes"
   shipped_fit "$map" "$d" "$budget" "$bake" "q3map2's rows and leaf surface lists" "${flags[@]}"

@@ -59,7 +59,7 @@ for map in "${maps[@]}"; do
   d="$out/$name"
   if [ "${SHIPPED_RECODE:-0}" = 1 ] && [ -f "$d/ours.pvs" ]; then
     "$vc" recode "$d/ours.pvs" -o "$d/recoded.pvs" -q 2>> "$d/err" && mv "$d/recoded.pvs" "$d/ours.pvs"
-    "$vc" measure "$map" "$d/ours.pvs" --report "$d/ours.json" -q 2>> "$d/err"
+    "$vc" measure "$map" "$d/ours.pvs" --count 5000 --width 64 --height 48 --report "$d/ours.json" -q 2>> "$d/err"
     rm -f "$d"/fit*.pvs "$d"/fit*.json
     echo "shipped: [$i/${#maps[@]}] $name: recoded, lists $(python3 scripts/vctables.py get "$d/ours.json" pvs_bytes) bytes"
     fits "$map" "$d"
@@ -78,12 +78,12 @@ for map in "${maps[@]}"; do
     echo "shipped: [$i/${#maps[@]}] $name: no visibility data, skipped"
     continue
   fi
-  if "$vc" measure "$map" --report "$d/q3map2.json" -q 2> "$d/err" &&
+  if "$vc" measure "$map" --count 5000 --width 64 --height 48 --report "$d/q3map2.json" -q 2> "$d/err" &&
      start=$(date +%s.%N) &&
      "$vc" bake "$map" --cells "$clusters" --pixel-error "$err" --agvs-time "$secs" --seed 1 --no-play-space -o "$d/ours.pvs" \
        --report "$d/bake.json" -q 2>> "$d/err" &&
      python3 scripts/vctables.py elapsed "$start" > "$d/bake_wall_seconds" &&
-     "$vc" measure "$map" "$d/ours.pvs" --report "$d/ours.json" -q 2>> "$d/err"; then
+     "$vc" measure "$map" "$d/ours.pvs" --count 5000 --width 64 --height 48 --report "$d/ours.json" -q 2>> "$d/err"; then
     echo "shipped: [$i/${#maps[@]}] $name: $clusters clusters, bake $(cat "$d/bake_wall_seconds") s"
     fits "$map" "$d"
   else

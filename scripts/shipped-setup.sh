@@ -12,7 +12,7 @@ shipped_fit() {
   [ -f "$d/$name.json" ] && return 0
   if "$vc" bake "$map" --memory "$budget" --memory-of lists --pixel-error "$err" --agvs-time "$secs" --seed 1 "$@" \
        -o "$d/$name.pvs" --report "$d/$name-bake.json" -q 2>> "$d/err" &&
-     "$vc" measure "$map" "$d/$name.pvs" --report "$d/$name.json" -q 2>> "$d/err"; then
+     "$vc" measure "$map" "$d/$name.pvs" --count 5000 --width 64 --height 48 --report "$d/$name.json" -q 2>> "$d/err"; then
     echo "shipped: $(basename "$d"): lists fit $what ($budget bytes) at $(python3 scripts/vctables.py get "$d/$name.json" cells) cells, ours / q3map2 $(python3 scripts/vctables.py shipped-ratio "$d" "$name")"
   else
     echo "shipped: $(basename "$d"): no cut fits $what ($budget bytes): $(tail -1 "$d/err")"

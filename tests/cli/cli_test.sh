@@ -411,8 +411,17 @@ assert 'non-solid' in s['view_space'], s['view_space']
   expect_ok "$VC" build "$MAPS/oa_dm2.bsp" --samples 50000 --max-cells 100 -o dm2.vcells --report dm2.json -q
   [ "$(json_get dm2.json "['settings']['view_box_source']")" = "the map's non-solid leaves" ] && ok || bad "build on a map: view box"
   # measure: the map's own PVS (q3map2's vis rows) and a baked one, by the same play cameras.
-  expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" --count 300 --report q3m.json -q
+  expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" --count 300 --width 64 --height 48 --report q3m.json -q
   [ "$(json_get q3m.json "['cells']")" = "1041" ] && ok || bad "measure on oa_dm2: $(json_get q3m.json "['cells']") clusters"
+  # By default at 1024x768, what players see, cast as coherent packets; the report gives both rates.
+  expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" --count 20 --report q3big.json -q
+  python3 -c "
+import json; r = json.load(open('q3big.json')); c = r['cameras']
+assert (c['width'], c['height'], c['count']) == (1024, 768, 20), c
+p = c['primary_rays_per_second']; assert p['coherent'] > 0 and p['incoherent'] > 0 and p['rays_timed'] > 0, p
+e = r['pixel_error']; assert 0 <= e['median_pixels'] <= e['p99_pixels'] <= e['worst_pixels'], e
+assert e['frames_with_wrong_pixels_share'] == e['cameras_with_wrong_pixels'] / 20, e
+" && ok || bad "measure at its default resolution: report"
   expect_ok "$VC" bake "$MAPS/oa_dm2.bsp" --cells 40 --samples 50000 --max-cells 100 --merge-pvs samples \
     --agvs-samples 100000 -o dm2.pvs --report dm2bake.json -q
   [ "$(json_get dm2bake.json "['effects']['restricted_view_space']['enabled']")" = "True" ] && ok || bad "bake on a map: AGVS not in the view space"
@@ -428,7 +437,7 @@ assert 'non-solid' in s['view_space'], s['view_space']
   [ "$(json_get dm2mbake.json "['settings']['play_space']")" = "False" ] &&
     json_get dm2mbake.json "['effects']['restricted_view_space']['reason']" | grep -q "non-solid space" && ok ||
     bad "bake --no-play-space on a map: still the play space"
-  expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" dm2m.pvs --count 300 --report dm2mm.json -q
+  expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" dm2m.pvs --count 300 --width 64 --height 48 --report dm2mm.json -q
   python3 -c "
 import json
 b, m = json.load(open('dm2mbake.json')), json.load(open('dm2mm.json'))
@@ -438,7 +447,7 @@ assert b['agvs']['stop_reason'].startswith('measured pixel error'), b['agvs']['s
 assert b['measured_curve'][-1]['measured_pixels'] == e['pixels'], b['measured_curve']
 assert abs(m['pixel_error']['pixels'] - e['pixels']) <= 1e-9 * max(1, e['pixels']), (m['pixel_error'], e)
 " && ok || bad "bake --measured-error on oa_dm2: the report and measure disagree"
-  expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" dm2.pvs --count 300 --report ourm.json -q
+  expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" dm2.pvs --count 300 --width 64 --height 48 --report ourm.json -q
   [ "$(json_get ourm.json "['cells']")" = "40" ] && ok || bad "measure of a baked map: cells"
   [ "$(json_get ourm.json "['cameras']['placement']")" = "$(json_get q3m.json "['cameras']['placement']")" ] &&
     [ "$(json_get ourm.json "['cameras']['points_drawn']")" = "$(json_get q3m.json "['cameras']['points_drawn']")" ] &&

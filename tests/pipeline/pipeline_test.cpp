@@ -284,6 +284,7 @@ TEST(Pipeline, BakedMapGivesEveryPointOfItsNonSolidSpaceACell) {
   m.scene.path = path;
   m.pvs_path = c.output;
   m.cameras.count = 300;
+  m.frame = {64, 48, 90.0, 1024 * 1024};
   const pipeline::MeasureResult mr = pipeline::measure(m, quiet);
   EXPECT_EQ(mr.error.cameras_uncovered, 0u);
   EXPECT_EQ(mr.error.cameras, 300u);
@@ -318,6 +319,7 @@ TEST(Pipeline, MeasureCountsACameraInNoCellAsAFrameDrawingNothing) {
   m.scene.path = path;
   m.pvs_path = half;
   m.cameras.count = 200;
+  m.frame = {64, 48, 90.0, 1024 * 1024};
   const pipeline::MeasureResult r = pipeline::measure(m, quiet);
   EXPECT_GT(r.error.cameras_uncovered, 0u);
   EXPECT_LT(r.error.cameras_uncovered, 100u);

@@ -74,6 +74,60 @@ void check_frame_budget(uint64_t cameras, uint32_t width, uint32_t height) {
                 std::to_string(kMaxFrameRays) + " (2^32) a measurement may cast: fewer cameras or pixels");
 }
 
+void frame_rays(const Camera& cam, const FrameConfig& config, std::vector<Ray>& rays) {
+  const uint32_t width = config.width, height = config.height;
+  const double f = std::tan(0.5 * config.fov_degrees * std::numbers::pi / 180.0);
+  const double aspect = static_cast<double>(height) / width;
+  rays.resize(size_t(width) * height);
+  constexpr uint32_t kTile = 4;
+  size_t at = 0;
+  for (uint32_t ty = 0; ty < height; ty += kTile)
+    for (uint32_t tx = 0; tx < width; tx += kTile)
+      for (uint32_t y = ty; y < std::min(ty + kTile, height); ++y)
+        for (uint32_t x = tx; x < std::min(tx + kTile, width); ++x) {
+          const double sx = (2 * (x + 0.5) / width - 1) * f, sy = (2 * (y + 0.5) / height - 1) * f * aspect;
+          rays[at++] = Ray{cam.eye, normalize(cam.forward + cam.right * sx + cam.up * sy)};
+        }
+}
+
+namespace {
+
+/// The frame's hits, in slices of 4096 rays over all threads (a large frame uses every core).
+void cast_frame(const RayCaster& caster, const std::vector<Ray>& rays, std::vector<Hit>& hits, bool coherent) {
+  hits.resize(rays.size());
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    const std::span<const Ray> in(rays.data() + r.begin(), r.size());
+    const std::span<Hit> out(hits.data() + r.begin(), r.size());
+    if (coherent) caster.intersect_coherent(in, out);
+    else caster.intersect(in, out);
+  });
+}
+
+}  // namespace
+
+FrameRayRates frame_ray_rates(const RayCaster& caster, std::span<const Camera> cameras, const FrameConfig& config,
+                              uint64_t max_rays) {
+  FrameRayRates out;
+  std::vector<std::vector<Ray>> frames;
+  for (const Camera& cam : cameras) {
+    if (out.rays >= max_rays) break;
+    frames.emplace_back();
+    frame_rays(cam, config, frames.back());
+    out.rays += frames.back().size();
+  }
+  std::vector<Hit> hits;
+  double seconds[2] = {0, 0};
+  for (int round = 0; round < 2; ++round)  // twice each, alternating; the second round counts
+    for (int coherent = 1; coherent >= 0; --coherent) {
+      Stopwatch sw;
+      for (const auto& rays : frames) cast_frame(caster, rays, hits, coherent);
+      if (round == 1) seconds[coherent] = sw.seconds();
+    }
+  out.coherent_per_second = out.rays / std::max(seconds[1], 1e-9);
+  out.incoherent_per_second = out.rays / std::max(seconds[0], 1e-9);
+  return out;
+}
+
 PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, std::span<const Camera> cameras,
                                  std::span<const int32_t> cells, const GlobalPvs& pvs, const FrameConfig& config) {
   const uint32_t width = config.width, height = config.height;
@@ -84,39 +138,28 @@ PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, st
   for (int32_t c : cells)
     if (c < -1 || (c >= 0 && static_cast<uint32_t>(c) >= pvs.cell_count()))
       throw Error("measure_frames: a camera's cell is not one of the PVS's");
-  const double f = std::tan(0.5 * config.fov_degrees * std::numbers::pi / 180.0);
-  const double aspect = static_cast<double>(height) / width;
   const uint32_t n = static_cast<uint32_t>(cameras.size());
   std::vector<std::vector<WrongView>> wrong_of(n);
   Progress progress("frames", n);
   tbb::parallel_for(tbb::blocked_range<uint32_t>(0, n, 1), [&](const tbb::blocked_range<uint32_t>& range) {
-    std::vector<Ray> rays(size_t(width) * height);
-    std::vector<Hit> hits(rays.size());
-    std::vector<uint32_t> objects;
+    std::vector<Ray> rays;
+    std::vector<Hit> hits;
+    std::vector<uint32_t> objects, count(scene.objects.size(), 0);
     for (uint32_t k = range.begin(); k < range.end(); ++k) {
       throw_if_interrupted("measuring frames");
-      const Camera& cam = cameras[k];
-      for (uint32_t y = 0; y < height; ++y)
-        for (uint32_t x = 0; x < width; ++x) {
-          const double sx = (2 * (x + 0.5) / width - 1) * f, sy = (2 * (y + 0.5) / height - 1) * f * aspect;
-          rays[size_t(y) * width + x] = Ray{cam.eye, normalize(cam.forward + cam.right * sx + cam.up * sy)};
-        }
-      // Large images: in slices, so that one camera also uses every core.
-      tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-        caster.intersect(std::span<const Ray>(rays.data() + r.begin(), r.size()),
-                         std::span<Hit>(hits.data() + r.begin(), r.size()));
-      });
+      frame_rays(cameras[k], config, rays);
+      cast_frame(caster, rays, hits, config.coherent);
+      // Counted per object (a frame of 786K pixels is not sorted): the objects met, then
+      // their counts in id order.
       objects.clear();
       for (const Hit& h : hits)
         if (h.hit() && scene.objects[h.object].rendered &&
-            (cells[k] < 0 || !pvs.contains(static_cast<uint32_t>(cells[k]), h.object)))
+            (cells[k] < 0 || !pvs.contains(static_cast<uint32_t>(cells[k]), h.object)) && count[h.object]++ == 0)
           objects.push_back(h.object);
       std::sort(objects.begin(), objects.end());
-      for (size_t i = 0; i < objects.size();) {
-        size_t j = i;
-        while (j < objects.size() && objects[j] == objects[i]) ++j;
-        wrong_of[k].push_back({k, objects[i], static_cast<uint32_t>(j - i)});
-        i = j;
+      for (uint32_t o : objects) {
+        wrong_of[k].push_back({k, o, count[o]});
+        count[o] = 0;
       }
       progress.advance();
     }

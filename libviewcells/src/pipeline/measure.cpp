@@ -174,7 +174,13 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
   log("viewcells: " + std::to_string(cameras.size()) + " cameras (" + out.camera_rule + ") in " + fmt(sw.seconds(), 2) +
       " s");
 
-  // The frames.
+  // The frames: first the rate of their rays cast coherently and not, on the same frames.
+  out.ray_rates = frame_ray_rates(*loaded.caster, cameras, c.frame);
+  log("viewcells: primary rays at " + std::to_string(c.frame.width) + "x" + std::to_string(c.frame.height) + ": " +
+      fmt(out.ray_rates.coherent_per_second / 1e6, 1) + " M/s in coherent packets, " +
+      fmt(out.ray_rates.incoherent_per_second / 1e6, 1) + " M/s incoherent (" +
+      fmt(out.ray_rates.coherent_per_second / out.ray_rates.incoherent_per_second, 2) + "x, the same " +
+      std::to_string(out.ray_rates.rays) + " rays)");
   sw.restart();
   GlobalPvs pvs = std::move(m.pvs);
   out.error = measure_frames(scene, *loaded.caster, cameras, cells, pvs, c.frame);

@@ -155,6 +155,50 @@ class EmbreeCaster final : public RayCaster {
     }
   }
 
+  void intersect_coherent(std::span<const Ray> rays, std::span<Hit> hits) const override {
+    constexpr unsigned K = 16;
+    alignas(64) RTCRayHit16 packet;
+    alignas(64) int valid[K];
+    RTCRayHit native[K];
+    for (size_t start = 0; start < rays.size(); start += K) {
+      const unsigned n = static_cast<unsigned>(std::min<size_t>(K, rays.size() - start));
+      for (unsigned i = 0; i < n; ++i)
+        to_native(rays[start + i].origin, rays[start + i].dir, rays[start + i].tnear, rays[start + i].tfar, native[i]);
+      for (unsigned i = 0; i < K; ++i) {
+        const RTCRay& r = native[i < n ? i : 0].ray;  // idle lanes copy a valid ray, and are masked off
+        valid[i] = i < n ? -1 : 0;
+        packet.ray.org_x[i] = r.org_x;
+        packet.ray.org_y[i] = r.org_y;
+        packet.ray.org_z[i] = r.org_z;
+        packet.ray.dir_x[i] = r.dir_x;
+        packet.ray.dir_y[i] = r.dir_y;
+        packet.ray.dir_z[i] = r.dir_z;
+        packet.ray.tnear[i] = r.tnear;
+        packet.ray.tfar[i] = r.tfar;
+        packet.ray.time[i] = 0.0f;
+        packet.ray.mask[i] = 0xffffffffu;
+        packet.ray.id[i] = i;
+        packet.ray.flags[i] = 0;
+        packet.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+        packet.hit.primID[i] = RTC_INVALID_GEOMETRY_ID;
+        packet.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+      }
+      RTCIntersectContext context;
+      rtcInitIntersectContext(&context);
+      context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+      rtcIntersect16(valid, rtc_scene_, &context, &packet);
+      for (unsigned i = 0; i < n; ++i) {
+        native[i].ray.tfar = packet.ray.tfar[i];
+        native[i].hit.geomID = packet.hit.geomID[i];
+        native[i].hit.primID = packet.hit.primID[i];
+        native[i].hit.Ng_x = packet.hit.Ng_x[i];
+        native[i].hit.Ng_y = packet.hit.Ng_y[i];
+        native[i].hit.Ng_z = packet.hit.Ng_z[i];
+      }
+      from_native(native, n, hits.data() + start);
+    }
+  }
+
   double time_raw(std::span<const Ray> rays) const override {
     std::vector<RTCRayHit> native(rays.size());
     for (size_t i = 0; i < rays.size(); ++i) to_native(rays[i].origin, rays[i].dir, rays[i].tnear, rays[i].tfar, native[i]);

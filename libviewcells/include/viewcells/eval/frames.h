@@ -49,7 +49,25 @@ struct FrameConfig {
   uint32_t width = 32, height = 32;
   double fov_degrees = 90;            ///< horizontal
   uint32_t resolution = 1024 * 1024;  ///< wrong pixels are reported per frame of this many pixels
+  /// Cast each frame's rays as coherent packets of 4x4 pixels (RayCaster::intersect_coherent);
+  /// false: as incoherent rays (for the A/B of their rates).
+  bool coherent = true;
 };
+
+/// A frame's primary rays, 4x4 pixel tile after tile (rows of tiles, pixels in a tile row by
+/// row; tiles clipped at the right and bottom edges): neighbours next to each other, so that
+/// packets of 16 are coherent. `rays` is resized to width x height.
+void frame_rays(const Camera& camera, const FrameConfig& config, std::vector<Ray>& rays);
+
+/// Primary rays a second cast coherently and incoherently over the same frames, measured one
+/// after the other in the same run (Embree's packets against its stream of single rays).
+struct FrameRayRates {
+  uint64_t rays = 0;
+  double coherent_per_second = 0, incoherent_per_second = 0;
+};
+/// Casts the frames of the first cameras (about `max_rays` rays) both ways, on all threads.
+FrameRayRates frame_ray_rates(const RayCaster& caster, std::span<const Camera> cameras, const FrameConfig& config,
+                              uint64_t max_rays = 4'000'000);
 
 /// An object shown at a camera although the camera's cell's PVS lacks it.
 struct WrongView {

@@ -51,7 +51,7 @@ struct MeasureConfig {
   SceneSource scene;
   std::string pvs_path;  ///< the .pvs to measure; empty: the map's own PVS (a Quake 3 map's vis rows)
   CameraConfig cameras;
-  FrameConfig frame{64, 48, 90.0, 1024 * 1024};
+  FrameConfig frame{1024, 768, 90.0, 1024 * 1024};  ///< what players see (wrong pixels reported per 1024x1024)
   CostModel model;  ///< r(o) of the frame cost (the pixel term is not used)
 };
 
@@ -89,6 +89,9 @@ struct MeasureResult {
   /// For a .pvs: "missed" (what sampling did not find).
   std::map<std::string, uint64_t> wrong_by_cause;
   std::vector<WrongObject> worst;  ///< up to 10, most wrong pixels first
+  /// Primary rays a second, coherent packets against incoherent single rays, on the same
+  /// frames in this run (frame_ray_rates).
+  FrameRayRates ray_rates;
   double seconds = 0;
   int threads = 1;
 };
