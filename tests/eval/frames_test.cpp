@@ -15,6 +15,7 @@
 #include "viewcells/io/scene_io.h"
 #include "viewcells/q3/play.h"
 #include "viewcells/q3/view_space.h"
+#include "viewcells/scene/generators.h"
 
 namespace viewcells {
 namespace {
@@ -26,7 +27,9 @@ TEST(Frames, WrongPixelsAreThoseOfObjectsMissingFromThePvs) {
   std::vector<int32_t> cam_cells;
   const std::vector<Camera> cams = view_box_cameras(*caster, cells, 60, 5, true, cam_cells);
   ASSERT_EQ(cams.size(), 60u);
-  const FrameConfig frame{24, 16, 90.0, 1024 * 1024};
+  // Incoherent single rays here, the kernel of the count by hand below (packets may differ in
+  // the last bits: checked against this in the next test).
+  const FrameConfig frame{24, 16, 90.0, 1024 * 1024, false};
   // Every object in every PVS: nothing is wrong.
   std::vector<std::vector<uint32_t>> all(cells.cell_count());
   for (auto& l : all)
@@ -65,6 +68,58 @@ TEST(Frames, WrongPixelsAreThoseOfObjectsMissingFromThePvs) {
   const PixelErrorMeasure serial = measure_frames(scene, *caster, cams, cam_cells, GlobalPvs::from_lists(scene.object_count(), all), frame);
   EXPECT_EQ(serial.share, m.share);
   EXPECT_EQ(serial.median_pixels, m.median_pixels);
+}
+
+TEST(Frames, CoherentPacketsSeeWhatSingleRaysSeeAndEveryPixelOnce) {
+  const Scene scene = generate_scene({GeneratorKind::kRotatedOffice, 1, 3});
+  const auto caster = make_embree_caster(scene);
+  const CellLocator cells = test::kd_cells(scene, 8);
+  std::vector<int32_t> cam_cells;
+  const std::vector<Camera> cams = view_box_cameras(*caster, cells, 40, 9, false, cam_cells);
+  // 4x4 tiles clipped at the edges (37 x 23 is no multiple of 4): every pixel's ray once.
+  const FrameConfig odd{37, 23, 75.0, 1024 * 1024};
+  std::vector<Ray> tiled;
+  frame_rays(cams[0], odd, tiled);
+  ASSERT_EQ(tiled.size(), 37u * 23u);
+  const double f = std::tan(0.5 * 75.0 * std::numbers::pi / 180.0);
+  std::vector<int> met(tiled.size(), 0);
+  for (const Ray& r : tiled) {
+    // The pixel a ray goes through, from its direction in the camera's frame.
+    const double along = dot(r.dir, cams[0].forward);
+    const double sx = dot(r.dir, cams[0].right) / along, sy = dot(r.dir, cams[0].up) / along;
+    const long x = std::lround(((sx / f) + 1) * 37 / 2 - 0.5), y = std::lround(((sy / (f * 23 / 37)) + 1) * 23 / 2 - 0.5);
+    ASSERT_TRUE(x >= 0 && x < 37 && y >= 0 && y < 23);
+    ++met[static_cast<size_t>(y) * 37 + static_cast<size_t>(x)];
+  }
+  for (int m : met) ASSERT_EQ(m, 1);
+  // Packets and single rays: the same objects wrong, pixel counts within the kernels' last bits.
+  std::vector<std::vector<uint32_t>> half(cells.cell_count());
+  for (auto& l : half)
+    for (uint32_t o = 0; o < scene.object_count(); o += 2) l.push_back(o);
+  const GlobalPvs pvs = GlobalPvs::from_lists(scene.object_count(), half);
+  FrameConfig frame{64, 48, 90.0, 1024 * 1024, true};
+  const PixelErrorMeasure packets = measure_frames(scene, *caster, cams, cam_cells, pvs, frame);
+  frame.coherent = false;
+  const PixelErrorMeasure singles = measure_frames(scene, *caster, cams, cam_cells, pvs, frame);
+  ASSERT_GT(singles.share, 0.0);
+  EXPECT_NEAR(packets.share, singles.share, 1e-3 * singles.share);
+  EXPECT_EQ(packets.cameras_wrong, singles.cameras_wrong);
+  EXPECT_LE(packets.median_pixels, packets.p99_pixels);
+  EXPECT_LE(packets.p99_pixels, packets.worst_pixels);
+  // A camera in no cell: every pixel showing an object is wrong.
+  std::vector<int32_t> none(cams.size(), -1);
+  const PixelErrorMeasure lost = measure_frames(scene, *caster, cams, none, pvs, frame);
+  EXPECT_EQ(lost.cameras_uncovered, cams.size());
+  std::vector<std::vector<uint32_t>> nothing(cells.cell_count());
+  const PixelErrorMeasure empty =
+      measure_frames(scene, *caster, cams, cam_cells, GlobalPvs::from_lists(scene.object_count(), nothing), frame);
+  EXPECT_EQ(lost.share, empty.share);
+  EXPECT_EQ(empty.cameras_uncovered, 0u);
+  // The rates of both ways, timed on the same frames.
+  const FrameRayRates rates = frame_ray_rates(*caster, cams, frame, 100000);
+  EXPECT_GE(rates.rays, 100000u);
+  EXPECT_GT(rates.coherent_per_second, 0);
+  EXPECT_GT(rates.incoherent_per_second, 0);
 }
 
 TEST(Frames, PlayerCameraIsLevel) {
