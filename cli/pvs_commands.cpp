@@ -1,4 +1,5 @@
 // pvs, bake: potentially visible sets by adaptive global visibility sampling.
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -194,7 +195,18 @@ struct BakeArgs {
   double measured_error = 0;
   uint32_t measure_cameras = 0;
   double seconds = 0;  ///< --time: the whole bake
+  std::string holes, measure_size;
 };
+
+/// "1%" or "1" (percent) -> 0.01.
+double parse_percent(const std::string& text, const std::string& option) {
+  std::string number = text;
+  if (!number.empty() && number.back() == '%') number.pop_back();
+  const std::vector<double> v = parse_numbers(number, option);
+  if (v.size() != 1 || !(v[0] > 0 && v[0] <= 100))
+    throw Error(option + " needs a percentage above 0 and at most 100, e.g. 1% (got '" + text + "')");
+  return v[0] / 100;
+}
 
 int run_bake(BakeArgs a, const Common& c) {
   check_files({a.sampling.scene}, {a.output, a.report}, {a.work});
@@ -210,12 +222,30 @@ int run_bake(BakeArgs a, const Common& c) {
   if (!a.memory.empty() && config.memory == 0) throw Error("--memory must be above 0 bytes (got '" + a.memory + "')");
   if (a.memory_of != "file" && a.memory_of != "lists") throw Error("--memory-of is file or lists, not '" + a.memory_of + "'");
   config.memory_of_lists = a.memory_of == "lists";
+  config.holes = a.holes.empty() ? 0.0 : parse_percent(a.holes, "--holes");
   if (!a.agvs.samples && !(a.agvs.seconds > 0) && !(a.agvs.pixel_error > 0) && !(a.measured_error > 0) &&
-      !(a.seconds > 0))
+      !(a.seconds > 0) && !(config.holes > 0))
     a.agvs.pixel_error = 10;
   config.max_seconds = a.seconds;
   config.measured_error = a.measured_error;
-  config.measure_cameras = a.measure_cameras ? a.measure_cameras : a.measured_error > 0 ? 5000 : 0;
+  // Holes are what a player sees at the resolution played: 1,000 frames of 1024x768 by
+  // default; a mean error alone keeps 5,000 frames of 64x48 (its estimator's cost).
+  const bool by_holes = config.holes > 0;
+  config.measure_cameras =
+      a.measure_cameras ? a.measure_cameras : by_holes ? 1000 : a.measured_error > 0 ? 5000 : 0;
+  if (!a.measure_size.empty()) {
+    const size_t x = a.measure_size.find('x');
+    const std::vector<double> wh =
+        x == std::string::npos ? std::vector<double>{} : parse_numbers(a.measure_size.substr(0, x) + "," + a.measure_size.substr(x + 1), "--measure-size");
+    if (wh.size() != 2 || wh[0] < 1 || wh[1] < 1 || wh[0] > 2048 || wh[1] > 2048 || wh[0] != std::floor(wh[0]) ||
+        wh[1] != std::floor(wh[1]))
+      throw Error("--measure-size needs WIDTHxHEIGHT, each from 1 to 2048 (got '" + a.measure_size + "')");
+    config.frame.width = static_cast<uint32_t>(wh[0]);
+    config.frame.height = static_cast<uint32_t>(wh[1]);
+  } else if (by_holes) {
+    config.frame.width = 1024;
+    config.frame.height = 768;
+  }
   config.agvs = a.agvs.config(c);
   config.agvs.seed = a.sampling.seed;
   config.output = a.output;
@@ -270,6 +300,14 @@ void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
                  "cameras), instead of trusting the estimate: measured after one batch and at every doubling of the "
                  "samples (a run may sample up to twice what it needed; --time and the other limits still apply)")
       ->check(non_negative());
+  bk->add_option("--holes", a->holes,
+                 "Stop AGVS once at most this percentage of the measuring cameras' frames shows any wrong pixel "
+                 "(e.g. 1%): the holes a player sees. Measured after one batch and at every doubling of the samples "
+                 "(by default 1,000 cameras of 1024x768, placed as `viewcells measure` places them), each "
+                 "measurement logged with an estimate of the time left; with --measured-error both must hold; "
+                 "--time still bounds the bake");
+  bk->add_option("--measure-size", a->measure_size,
+                 "Frames of the measuring cameras, WIDTHxHEIGHT (default 1024x768 with --holes, else 64x48)");
   bk->add_option("--measure-cameras", a->measure_cameras,
                  "Cameras that measure the PVSs, placed and counted as `viewcells measure` does (on a Quake 3 map "
                  "player eyes above floors reachable from the spawn points, else random points of the view box; "

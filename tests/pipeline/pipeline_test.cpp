@@ -347,6 +347,44 @@ TEST(Pipeline, BakeTimeBoundsTheWholeBake) {
   EXPECT_FALSE(std::filesystem::exists(test::temp_path("timed-none.pvs")));
 }
 
+TEST(Pipeline, BakeMeetsAHoleTargetThatIndependentCamerasConfirm) {
+  // The target: at most 5% of frames with any wrong pixel. First a bake stopped early (one AGVS
+  // batch) misses it, so the check below can fail; then a bake that stops on it meets it, and
+  // cameras of another seed (never the bake's) confirm it within their sampling error.
+  auto holes_of = [](const std::string& pvs, uint64_t seed) {
+    pipeline::MeasureConfig m;
+    m.scene.path = office();
+    m.pvs_path = pvs;
+    m.cameras.count = 400;
+    m.cameras.seed = seed;
+    m.frame = {128, 96, 90.0, 1024 * 1024};
+    const pipeline::MeasureResult r = pipeline::measure(m, quiet);
+    return static_cast<double>(r.error.cameras_wrong) / r.error.cameras;
+  };
+  const double target = 0.05, slack = 3 * std::sqrt(target * (1 - target) / 400);
+  const std::string early = test::temp_path("holes-early.pvs"), met = test::temp_path("holes-met.pvs");
+  pipeline::BakeConfig c = small_bake(early);
+  c.cells = 60;
+  c.agvs.max_samples = 1000;
+  c.agvs.batch_size = 1000;
+  pipeline::bake(c, quiet);
+  EXPECT_GT(holes_of(early, 2), target + slack) << "a bake of one batch should miss the target";
+  c = small_bake(met);
+  c.cells = 60;
+  c.agvs.max_samples = 0;
+  c.agvs.batch_size = 1000;
+  c.holes = target;
+  c.measure_cameras = 200;
+  c.frame = {128, 96, 90.0, 1024 * 1024};
+  const pipeline::BakeResult r = pipeline::bake(c, quiet);
+  ASSERT_TRUE(r.measured_stop) << r.agvs.stop_reason;
+  ASSERT_FALSE(r.measured_curve.empty());
+  const PixelErrorMeasure& last = r.measured_curve.back().measured;
+  EXPECT_LE(static_cast<double>(last.cameras_wrong) / last.cameras, target);
+  EXPECT_EQ(r.measured_curve.back().eta_seconds, 0.0);
+  EXPECT_LE(holes_of(met, 2), target + slack) << "independent cameras find more holes than the bake measured";
+}
+
 TEST(Pipeline, BakeRefusesNoBudgetOrTwo) {
   pipeline::BakeConfig c = small_bake(test::temp_path("none.pvs"));
   EXPECT_THROW(pipeline::bake(c, quiet), Error);

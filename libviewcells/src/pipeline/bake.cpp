@@ -114,16 +114,17 @@ std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, LoadedScene& 
   // batches, saves, and goes on, which changes nothing of its samples (a resumed state
   // continues exactly), so a bake cut off mid-way continues from the last checkpoint.
   const AgvsConfig& a = c.agvs;
-  if (cams && c.measured_error > 0) {
+  const MeasuredTarget target{c.measured_error, c.holes};
+  if (cams && target.any()) {
     // Measured at every doubling of the samples; the state is saved before each measurement.
     const SolverMeasuring m{*loaded.scene, *loaded.caster, *cams, c.frame};
-    out.measured_stop = run_to_measured_error(solver, a, c.measured_error, m, out.measured_curve, log, [&] {
+    out.measured_stop = run_to_measured_error(solver, a, target, m, out.measured_curve, log, [&] {
       if (state.empty()) return;
       const UnbatchedWrites now;
       solver.save(state, identity);
     });
   }
-  while (!(cams && c.measured_error > 0)) {
+  while (!(cams && target.any())) {
     const double until = solver.stats().seconds + c.checkpoint_seconds;
     const bool sliced = !state.empty() && c.checkpoint_seconds > 0 && (!(a.max_seconds > 0) || until < a.max_seconds);
     solver.set_limits(a.max_samples, sliced ? until : a.max_seconds, a.pixel_error);
@@ -137,8 +138,10 @@ std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, LoadedScene& 
   }
   out.agvs = solver.stats();
   if (out.measured_stop)
-    out.agvs.stop_reason = "measured pixel error at most " + fmt(c.measured_error, 3) + " (mean of " +
-                           std::to_string(cams->cameras.size()) + " cameras)";
+    out.agvs.stop_reason = c.holes > 0 ? "measured: " + target.describe() + " (" +
+                                             std::to_string(cams->cameras.size()) + " cameras)"
+                                       : "measured pixel error at most " + fmt(c.measured_error, 3) + " (mean of " +
+                                             std::to_string(cams->cameras.size()) + " cameras)";
   out.pixel_error = solver.pixel_error();
   out.pixel_error_bound = solver.pixel_error_bound();
   std::vector<std::vector<uint32_t>> lists(cells.cell_count());
@@ -221,10 +224,12 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     throw Error("the measured pixel error must be a finite number >= 0");
   if (c.measured_error > 0 && !c.measure_cameras)
     throw Error("a measured pixel error needs measuring cameras");
+  if (!(c.holes >= 0 && c.holes <= 1)) throw Error("the share of frames with holes must be from 0 to 1");
+  if (c.holes > 0 && !c.measure_cameras) throw Error("a share of frames with holes needs measuring cameras");
   if (c.measure_cameras) check_frame_budget(c.measure_cameras, c.frame.width, c.frame.height);
   if (!(c.max_seconds >= 0) || !std::isfinite(c.max_seconds)) throw Error("the bake's time limit must be finite and >= 0");
   if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0) && !(c.measured_error > 0) &&
-      !(c.max_seconds > 0))
+      !(c.holes > 0) && !(c.max_seconds > 0))
     throw Error("give when the PVSs are good enough: a pixel error (estimated or measured), a time or a number of "
                 "AGVS samples");
   if (c.cells && c.subdivision.max_cells && c.cells > c.subdivision.max_cells)

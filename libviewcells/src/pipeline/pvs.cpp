@@ -181,8 +181,51 @@ MeasuredPoint measure_solver(const SolverMeasuring& m, const AgvsSolver& solver,
   return p;
 }
 
-bool run_to_measured_error(AgvsSolver& solver, const AgvsConfig& a, double target, const SolverMeasuring& m,
-                           std::vector<MeasuredPoint>& curve, const Log& log, const std::function<void()>& after_run) {
+bool MeasuredTarget::met(const PixelErrorMeasure& m) const {
+  const double share = m.cameras ? static_cast<double>(m.cameras_wrong) / m.cameras : 1.0;
+  return any() && (!(mean > 0) || m.pixels <= mean) && (!(holes > 0) || share <= holes);
+}
+
+std::string MeasuredTarget::describe() const {
+  std::string s;
+  if (holes > 0) s = "at most " + fmt(100 * holes, 2) + "% of frames with a wrong pixel";
+  if (mean > 0) s += (s.empty() ? "" : " and ") + std::string("a mean of at most ") + fmt(mean, 3) + " wrong pixels";
+  return s;
+}
+
+namespace {
+
+/// Seconds of sampling until `value` (falling as a power of the time through the last two
+/// measurements) reaches `target`: 0 when it has, NaN when two points do not tell.
+double seconds_to(double t0, double v0, double t1, double v1, double target) {
+  if (v1 <= target) return 0;
+  if (!(t0 > 0 && t1 > t0 && v0 > 0 && v1 > 0 && v1 < v0)) return std::nan("");
+  const double slope = std::log(v1 / v0) / std::log(t1 / t0);  // < 0
+  return t1 * std::pow(target / v1, 1 / slope) - t1;
+}
+
+/// The time left for `target` from the curve's last two points: the longest over its parts.
+double eta(const std::vector<MeasuredPoint>& curve, const MeasuredTarget& target) {
+  if (curve.size() < 2) return std::nan("");
+  const MeasuredPoint& a = curve[curve.size() - 2];
+  const MeasuredPoint& b = curve.back();
+  const auto share = [](const PixelErrorMeasure& m) {
+    return m.cameras ? static_cast<double>(m.cameras_wrong) / m.cameras : 1.0;
+  };
+  const double mean = target.mean > 0
+                          ? seconds_to(a.seconds, a.measured.pixels, b.seconds, b.measured.pixels, target.mean)
+                          : 0.0;
+  const double holes = target.holes > 0
+                           ? seconds_to(a.seconds, share(a.measured), b.seconds, share(b.measured), target.holes)
+                           : 0.0;
+  return std::isnan(mean) || std::isnan(holes) ? std::nan("") : std::max(mean, holes);
+}
+
+}  // namespace
+
+bool run_to_measured_error(AgvsSolver& solver, const AgvsConfig& a, const MeasuredTarget& target,
+                           const SolverMeasuring& m, std::vector<MeasuredPoint>& curve, const Log& log,
+                           const std::function<void()>& after_run) {
   uint64_t next = std::max<uint64_t>(solver.stats().samples + 1, a.batch_size);
   while (true) {
     const uint64_t until = a.max_samples ? std::min(next, a.max_samples) : next;
@@ -191,7 +234,18 @@ bool run_to_measured_error(AgvsSolver& solver, const AgvsConfig& a, double targe
     if (after_run) after_run();
     const AgvsStats& st = solver.stats();
     curve.push_back(measure_solver(m, solver, log));
-    if (curve.back().measured.pixels <= target) return true;
+    MeasuredPoint& now = curve.back();
+    if (target.met(now.measured)) {
+      now.eta_seconds = 0;
+      return true;
+    }
+    now.eta_seconds = eta(curve, target);
+    log("viewcells: " + fmt(100.0 * now.measured.cameras_wrong / now.measured.cameras, 2) +
+        "% of frames with a wrong pixel, mean " + fmt(now.measured.pixels, 3) + " (target: " + target.describe() +
+        "); " +
+        (std::isnan(now.eta_seconds) ? std::string("time left not known yet")
+                                     : "about " + fmt(now.eta_seconds, now.eta_seconds < 10 ? 2 : 0) +
+                                           " s of sampling left at this rate (measuring not counted)"));
     // Another limit: the samples, the time, or the estimator's error (the solver's own stop).
     const double estimated = solver.pixel_error(), bound = solver.pixel_error_bound();
     if (st.samples < until || (a.max_samples && st.samples >= a.max_samples) ||
@@ -261,7 +315,8 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   }
   bool measured_stop = false;
   if (cams && c.measured_error > 0) {
-    measured_stop = run_to_measured_error(*solver, c.agvs, c.measured_error, measuring(c, scenes, *cams, out),
+    measured_stop = run_to_measured_error(*solver, c.agvs, MeasuredTarget{c.measured_error, 0},
+                                          measuring(c, scenes, *cams, out),
                                           out.measured_curve, log);
   } else {
     if (cams && !c.measure_at.empty()) measured_run(c, scenes, *cams, *solver, out, log);

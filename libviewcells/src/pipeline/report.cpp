@@ -358,7 +358,12 @@ json measured_curve(const std::vector<MeasuredPoint>& curve) {
     out.push_back({{"samples", p.samples}, {"rays", p.rays}, {"seconds", p.seconds}, {"mean_pvs", p.mean_pvs},
                    {"estimated_pixel_error", number_or_null(p.estimated)}, {"measured_pixels", p.measured.pixels},
                    {"measured_median_pixels", p.measured.median_pixels},
-                   {"cameras_with_wrong_pixels", p.measured.cameras_wrong}});
+                   {"measured_p99_pixels", p.measured.p99_pixels},
+                   {"measured_worst_pixels", p.measured.worst_pixels},
+                   {"cameras_with_wrong_pixels", p.measured.cameras_wrong},
+                   {"frames_with_wrong_pixels_share",
+                    p.measured.cameras ? static_cast<double>(p.measured.cameras_wrong) / p.measured.cameras : 0.0},
+                   {"eta_seconds", number_or_null(p.eta_seconds)}});
   return out;
 }
 
@@ -585,6 +590,9 @@ std::string report_json(const BakeResult& r) {
                  {"play_space", c.subdivision.play_space},
                  {"pixel_error", c.agvs.pixel_error},
                  {"measured_error", c.measured_error},
+                 {"holes", c.holes},
+                 {"measure_cameras", c.measure_cameras},
+                 {"measure_frame", {{"width", c.frame.width}, {"height", c.frame.height}}},
                  {"max_seconds", c.agvs.max_seconds},
                  {"max_samples", c.agvs.max_samples},
                  {"agvs_batch_size", c.agvs.batch_size},

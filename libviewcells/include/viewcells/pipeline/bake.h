@@ -44,6 +44,9 @@ struct BakeConfig {
   /// the other limits still apply). Coarsening for a memory budget only unites PVSs, so the
   /// file written is measured again and never shows more. 0: not used.
   double measured_error = 0;
+  /// With measure_cameras: also (or instead) stop once at most this share of the cameras' frames
+  /// (0 to 1) shows any wrong pixel: the holes a player sees. 0: not used.
+  double holes = 0;
   std::string output;              ///< .pvs
   std::string work_dir;            ///< empty: nothing kept between runs
   double checkpoint_seconds = 60;  ///< with a work directory: AGVS state saved this often (0: at the end)

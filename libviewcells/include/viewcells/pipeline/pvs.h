@@ -52,6 +52,21 @@ struct MeasuredPoint {
   double mean_pvs = 0;
   double estimated = 0;        ///< the estimator's pixel error then (NaN: none)
   PixelErrorMeasure measured;  ///< `wrong` left empty
+  /// Seconds of sampling still needed for the target, from a power law through this and the
+  /// previous measurement (NaN: not known yet, or the error did not fall; 0: met).
+  double eta_seconds = 0;
+};
+
+/// What measured frames must show for AGVS to stop; 0 leaves a part out, and every part given
+/// must hold: the mean wrong pixels per frame (scaled to the frame's resolution, 1024 x 1024),
+/// and the share of frames with any wrong pixel (0 to 1: the holes a player sees).
+struct MeasuredTarget {
+  double mean = 0;
+  double holes = 0;
+  bool any() const { return mean > 0 || holes > 0; }
+  bool met(const PixelErrorMeasure& m) const;
+  /// E.g. "at most 1.00% of frames with a wrong pixel and a mean of at most 1.000 wrong pixels".
+  std::string describe() const;
 };
 
 /// What measures a solver's PVSs part-way through a run: the scene it samples, its caster,
@@ -67,13 +82,13 @@ struct SolverMeasuring {
 MeasuredPoint measure_solver(const SolverMeasuring& m, const AgvsSolver& solver, const Log& log);
 
 /// The stopping rule by measured error: the solver run to one batch, then to every doubling
-/// of its samples, and measured each time (appended to `curve`), until the cameras' mean
-/// wrong pixels (the paper's pixel error, which the estimator estimates) are at most
-/// `target`, or one of `limits`' own limits (samples, seconds, estimated error) stops it
-/// first. `after_run`, when given, is called after each run, before measuring (a checkpoint).
-/// Returns whether the measured error stopped it.
-bool run_to_measured_error(AgvsSolver& solver, const AgvsConfig& limits, double target, const SolverMeasuring& m,
-                           std::vector<MeasuredPoint>& curve, const Log& log,
+/// of its samples, and measured each time (appended to `curve`, logged with an estimate of the
+/// time left), until the cameras meet `target` (the mean wrong pixels, the paper's pixel error
+/// that the estimator estimates, and/or the share of frames with holes), or one of `limits`'
+/// own limits (samples, seconds, estimated error) stops it first. `after_run`, when given, is
+/// called after each run, before measuring (a checkpoint). Returns whether the target stopped it.
+bool run_to_measured_error(AgvsSolver& solver, const AgvsConfig& limits, const MeasuredTarget& target,
+                           const SolverMeasuring& m, std::vector<MeasuredPoint>& curve, const Log& log,
                            const std::function<void()>& after_run = {});
 
 struct PvsResult {
