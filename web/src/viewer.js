@@ -177,9 +177,100 @@ cellGeometry.setAttribute('position', new THREE.BufferAttribute(cells.positions,
 cellGeometry.setIndex(new THREE.BufferAttribute(cells.indices, 1));
 const cellColours = new Float32Array(cells.positions.length);
 cellGeometry.setAttribute('color', new THREE.BufferAttribute(cellColours, 3));
+// The cutaway: everything above a horizontal plane is clipped away (roofs, ceilings, the upper
+// storeys), and the cells' cross-sections at that height are drawn opaque in their colours,
+// with the scene's own cross-section in dark lines: slice.png in 3D. The plane starts at the
+// middle of the view box's height (as the PNG slice) and the panel's slider moves it.
+const cut = new THREE.Plane(new THREE.Vector3(0, 0, -1), 0);
+const clipping = [cut];
+sceneMaterial.clippingPlanes = clipping;
+// Cells pushed behind coplanar surfaces (polygon offset): no stripes where a cell's face meets a
+// wall, a floor or the roof.
 const cellMesh = new THREE.Mesh(cellGeometry, new THREE.MeshBasicMaterial({
-  vertexColors: true, transparent: true, opacity: 0.22, depthWrite: false, side: THREE.DoubleSide }));
+  vertexColors: true, transparent: true, opacity: 0.22, depthWrite: false, side: THREE.DoubleSide,
+  clippingPlanes: clipping, polygonOffset: true, polygonOffsetFactor: 2, polygonOffsetUnits: 2 }));
 cellMesh.renderOrder = 1;
+
+// Each cell's leaves: their vertices are consecutive and apart from the next leaf's, so a
+// triangle whose lowest vertex lies beyond every vertex seen so far starts a leaf.
+const cellLeaves = [];
+for (let c = 0; c < cells.count; ++c) {
+  const leaves = [];
+  let seen = -1;
+  for (let i = cells.firstIndex[c]; i < cells.firstIndex[c + 1]; i += 3) {
+    const a = cells.indices[i], b = cells.indices[i + 1], d = cells.indices[i + 2];
+    if (Math.min(a, b, d) > seen) leaves.push([]);
+    leaves[leaves.length - 1].push(i);
+    seen = Math.max(seen, a, b, d);
+  }
+  cellLeaves.push(leaves);
+}
+// The convex polygon where the plane z = h crosses a convex leaf (its triangles' edges that
+// straddle the plane, hull of the crossings), as a fan of triangles.
+function hull2(points) {
+  const p = points.slice().sort((u, v) => u[0] - v[0] || u[1] - v[1]);
+  const cross = (o, a, b) => (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0]);
+  const lower = [], upper = [];
+  for (const q of p) { while (lower.length >= 2 && cross(lower[lower.length - 2], lower[lower.length - 1], q) <= 0) lower.pop(); lower.push(q); }
+  for (const q of p.reverse()) { while (upper.length >= 2 && cross(upper[upper.length - 2], upper[upper.length - 1], q) <= 0) upper.pop(); upper.push(q); }
+  return lower.slice(0, -1).concat(upper.slice(0, -1));
+}
+function crossings(positions, indices, triangles, h, out) {
+  for (const i of triangles)
+    for (let e = 0; e < 3; ++e) {
+      const a = indices[i + e], b = indices[i + (e + 1) % 3];
+      const za = positions[3 * a + 2], zb = positions[3 * b + 2];
+      if ((za < h) === (zb < h)) continue;
+      const t = (h - za) / (zb - za);
+      out.push([positions[3 * a] + t * (positions[3 * b] - positions[3 * a]),
+                positions[3 * a + 1] + t * (positions[3 * b + 1] - positions[3 * a + 1])]);
+    }
+  return out;
+}
+const sectionMaterial = new THREE.MeshBasicMaterial({ vertexColors: true, side: THREE.DoubleSide });
+const sectionMesh = new THREE.Mesh(new THREE.BufferGeometry(), sectionMaterial);
+const sceneSection = new THREE.LineSegments(new THREE.BufferGeometry(), new THREE.LineBasicMaterial({ color: 0x101010 }));
+sectionMesh.renderOrder = 3;
+sceneSection.renderOrder = 4;
+let sectionCells = [];  // the cells the plane crosses
+function buildSections(h) {
+  cut.constant = h;
+  const pos = [], col = [];
+  sectionCells = [];
+  for (let c = 0; c < cells.count; ++c) {
+    let crossed = false;
+    for (const leaf of cellLeaves[c]) {
+      const ring = hull2(crossings(cells.positions, cells.indices, leaf, h, []));
+      if (ring.length < 3) continue;
+      crossed = true;
+      for (let k = 1; k + 1 < ring.length; ++k)
+        for (const q of [ring[0], ring[k], ring[k + 1]]) {
+          pos.push(q[0], q[1], h);
+          col.push(cellColours[3 * cells.firstVertex[c]], cellColours[3 * cells.firstVertex[c] + 1],
+                   cellColours[3 * cells.firstVertex[c] + 2]);
+        }
+    }
+    if (crossed) sectionCells.push(c);
+  }
+  const g = new THREE.BufferGeometry();
+  g.setAttribute('position', new THREE.BufferAttribute(new Float32Array(pos), 3));
+  g.setAttribute('color', new THREE.BufferAttribute(new Float32Array(col), 3));
+  sectionMesh.geometry.dispose();
+  sectionMesh.geometry = g;
+  // The scene's walls where the plane cuts them, lifted a hair so that they lie on the sections.
+  const lines = [];
+  const lift = 1e-4 * Math.max(1, Math.abs(h));
+  for (let o = 0; o < objects.count; ++o) {
+    const tris = [];
+    for (let i = objects.firstIndex[o]; i < objects.firstIndex[o + 1]; i += 3) tris.push(i);
+    const pts = crossings(scenePositions, sceneIndices, tris, h, []);
+    for (let k = 0; k + 1 < pts.length; k += 2) lines.push(pts[k][0], pts[k][1], h + lift, pts[k + 1][0], pts[k + 1][1], h + lift);
+  }
+  const lg = new THREE.BufferGeometry();
+  lg.setAttribute('position', new THREE.BufferAttribute(new Float32Array(lines), 3));
+  sceneSection.geometry.dispose();
+  sceneSection.geometry = lg;
+}
 
 function cellValue(c, mode) { return mode === 'pvs' ? cells.pvs[c].length : cells.cost[c]; }
 function paintCells(mode) {
@@ -191,6 +282,7 @@ function paintCells(mode) {
     for (let v = cells.firstVertex[c]; v < cells.firstVertex[c + 1]; ++v) cellColours.set(rgb, 3 * v);
   }
   cellGeometry.attributes.color.needsUpdate = true;
+  if (cutaway.checked) buildSections(Number(cutSlider.value));
   document.getElementById('range').textContent = mode === 'pvs'
     ? `PVS size: 0 to ${max} objects`
     : `r(PVS) = sum of max(${D.cost_model.a}, ${D.cost_model.b} × triangles): 0 to ${Math.round(max)}`;
@@ -207,15 +299,18 @@ function showSelectedCell(c) {
   g.setAttribute('position', new THREE.BufferAttribute(cells.positions.slice(3 * v0, 3 * v1), 3));
   g.setIndex(Array.from(cells.indices.subarray(i0, i1), (i) => i - v0));
   const fill = new THREE.Mesh(g, new THREE.MeshBasicMaterial({
-    color: 0xffffff, transparent: true, opacity: 0.25, depthWrite: false, side: THREE.DoubleSide }));
+    color: 0xffffff, transparent: true, opacity: 0.25, depthWrite: false, side: THREE.DoubleSide,
+    clippingPlanes: clipping }));
   fill.renderOrder = 2;
   selectedGroup.add(fill);
-  selectedGroup.add(new THREE.LineSegments(new THREE.EdgesGeometry(g), new THREE.LineBasicMaterial({ color: 0xffffff })));
+  selectedGroup.add(new THREE.LineSegments(new THREE.EdgesGeometry(g),
+                                           new THREE.LineBasicMaterial({ color: 0xffffff, clippingPlanes: clipping })));
 }
 
 // --- view ----------------------------------------------------------------------------------
 const container = document.getElementById('view');
 const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
+renderer.localClippingEnabled = true;
 // The resolution is the panel's choice (#scale in the address): drawing half or a quarter of
 // the pixels is what keeps software WebGL (no GPU) moving on a large level.
 const pixelRatio = () => (window.devicePixelRatio || 1) * Number(document.getElementById('scale').value);
@@ -227,7 +322,30 @@ scene.background = new THREE.Color(0x15171c);
 scene.add(new THREE.HemisphereLight(0xffffff, 0x404050, 1.6));
 const sun = new THREE.DirectionalLight(0xffffff, 1.4);
 sun.position.set(0.4, -0.6, 1);
-scene.add(sun, sceneGroup, cellMesh, selectedGroup);
+scene.add(sun, sceneGroup, cellMesh, selectedGroup, sectionMesh, sceneSection);
+
+// The cut's controls: on by default at the middle of the view box's height; #cut=Z or #cut=off.
+const cutaway = document.getElementById('cutaway'), cutSlider = document.getElementById('cut');
+cutSlider.min = box[2];
+cutSlider.max = box[5];
+cutSlider.step = (box[5] - box[2]) / 200;
+{
+  const asked = new URLSearchParams(location.hash.slice(1)).get('cut');
+  cutaway.checked = asked !== 'off';
+  const z = Number(asked);
+  cutSlider.value = asked !== null && asked !== 'off' && Number.isFinite(z) ? z : (box[2] + box[5]) / 2;
+}
+function applyCut() {
+  const on = cutaway.checked;
+  cutSlider.disabled = !on;
+  document.getElementById('cutz').textContent = on ? `z = ${Number(cutSlider.value).toFixed(2)}` : 'off';
+  clipping.length = 0;
+  if (on) clipping.push(cut);
+  sectionMesh.visible = sceneSection.visible = on;
+  if (on) buildSections(Number(cutSlider.value));
+  for (const m of [sceneMaterial, cellMesh.material]) m.needsUpdate = true;
+  dirty = true;
+}
 
 const size = new THREE.Vector3(), centre = new THREE.Vector3();
 sceneBounds.getSize(size); sceneBounds.getCenter(centre);
@@ -240,9 +358,11 @@ const controls = new OrbitControls(camera, renderer.domElement);
 // The start view: #camera=x,y,z&target=x,y,z in the address, else from above one corner.
 const hash = new URLSearchParams(location.hash.slice(1));
 const vec = (s) => { const v = (s || '').split(',').map(Number); return v.length === 3 && v.every(Number.isFinite) ? v : null; };
-const target = vec(hash.get('target')) || centre.toArray();
+// From above one corner, looking down at the cut (or at the middle without it).
+const lookAt = [(box[0] + box[3]) / 2, (box[1] + box[4]) / 2, cutaway.checked ? Number(cutSlider.value) : centre.z];
+const target = vec(hash.get('target')) || lookAt;
 const eye = vec(hash.get('camera')) ||
-    [centre.x - 0.55 * size.x, centre.y - 0.85 * size.y, centre.z + 0.6 * size.z + 0.45 * Math.max(size.x, size.y)];
+    [lookAt[0] - 0.3 * size.x, lookAt[1] - 0.55 * size.y, lookAt[2] + 0.9 * Math.max(size.x, size.y)];
 camera.position.fromArray(eye);
 controls.target.fromArray(target);
 controls.update();
@@ -393,6 +513,9 @@ document.getElementById('scale').addEventListener('change', () => {
 if (hash.get('follow') === '1') follow.checked = state.follow = true;
 paintScene(null);
 paintCells(document.getElementById('colour').value);
+cutaway.addEventListener('change', applyCut);
+cutSlider.addEventListener('input', applyCut);
+applyCut();
 window.viewcells = {
   get ready() { return state.ready; },
   get selected() { return state.selected; },
@@ -401,6 +524,15 @@ window.viewcells = {
   get drawn() { return drawn; },
   get sceneTrianglesDrawn() { return sceneTrianglesDrawn(); },
   get chunks() { return chunks.length; },
+  // The cutaway: its height (null when off), the cells its plane crosses, and each cell's
+  // colour as the page draws it (8-bit sRGB), for tests.
+  get cut() { return cutaway.checked ? Number(cutSlider.value) : null; },
+  get sectionCells() { return sectionCells.slice(); },
+  cellColour: (c) => {
+    const v = 3 * cells.firstVertex[c];
+    const col = new THREE.Color(cellColours[v], cellColours[v + 1], cellColours[v + 2]).convertLinearToSRGB();
+    return [col.r, col.g, col.b].map((x) => Math.round(255 * x));
+  },
   camera, controls,
 };
 requestAnimationFrame((t) => { frame(t); state.ready = true; });

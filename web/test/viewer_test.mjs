@@ -27,8 +27,70 @@ const [x0, y0, z0, x1, y1] = info.view_box;
 const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2, eyeZ = z0 + 1.6;
 const hash = `camera=${cx - 2},${cy},${eyeZ}&target=${cx + 1},${cy},${z0 + 0.2}`;
 
+// The distinct cell colours a screenshot shows: pixels within 3 of a cell's colour as the page
+// draws it (8-bit sRGB; the cells' cross-sections are drawn opaque, unlit), outside the panel
+// (whose legend holds every colour of the scale).
+async function cellColoursShown(page, png) {
+  return page.evaluate(async (data) => {
+    const v = window.viewcells;
+    const count = v.sectionCells.length ? Math.max(...v.sectionCells) + 1 : 0;
+    const wanted = new Map();
+    for (let c = 0; c < 4096; ++c) {
+      try { const [r, g, b] = v.cellColour(c); wanted.set((r << 16) | (g << 8) | b, true); } catch (e) { break; }
+    }
+    const img = new Image();
+    img.src = 'data:image/png;base64,' + data;
+    await img.decode();
+    const cv = document.createElement('canvas');
+    cv.width = img.width; cv.height = img.height;
+    const g = cv.getContext('2d');
+    g.drawImage(img, 0, 0);
+    const d = g.getImageData(0, 0, cv.width, cv.height).data;
+    const keys = [...wanted.keys()];
+    const shown = new Set(), near = new Map();
+    const hud = document.getElementById('hud').getBoundingClientRect();
+    const ratio = cv.width / window.innerWidth;
+    for (let i = 0; i < d.length; i += 4) {
+      const x = (i / 4) % cv.width / ratio, y = Math.floor(i / 4 / cv.width) / ratio;
+      if (x >= hud.left && x <= hud.right && y >= hud.top && y <= hud.bottom) continue;
+      const key = (d[i] << 16) | (d[i + 1] << 8) | d[i + 2];
+      let hit = near.get(key);
+      if (hit === undefined) {
+        hit = -1;
+        for (const k of keys)
+          if (Math.abs((k >> 16) - d[i]) + Math.abs(((k >> 8) & 255) - d[i + 1]) + Math.abs((k & 255) - d[i + 2]) <= 3) { hit = k; break; }
+        near.set(key, hit);
+      }
+      if (hit >= 0) shown.add(hit);
+    }
+    return { shown: shown.size, distinct: keys.length, crossed: v.sectionCells.length, count };
+  }, png.toString('base64'));
+}
+
 const browser = await launch();
 try {
+  // First sight, before any click: the cutaway at mid-height shows the cells' cross-sections in
+  // their colours. At least a quarter of the cells' colours must show; with the cut off (the
+  // view as it was: the roof, translucent cells behind it) far fewer do.
+  const cellCount = info.cells.count;
+  for (const [name, h] of [['default', ''], ['no-cut', 'cut=off']]) {
+    const { page, errors } = await openSite(browser, join(work, 'site', 'index.html'), h);
+    await page.waitForTimeout(300);
+    const shotPath = join(work, `viewer-${name}.png`);
+    const png = await page.screenshot({ path: shotPath });
+    const seen = await cellColoursShown(page, png);
+    console.log(`${name} view (${shotPath}): ${seen.shown} cell colours shown of ${seen.distinct} distinct among ` +
+                `${cellCount} cells (the cut crosses ${seen.crossed})`);
+    if (name === 'default') {
+      if (!(await page.evaluate(() => window.viewcells.cut !== null))) fail('the cutaway is not on by default');
+      if (seen.shown < Math.ceil(cellCount / 4)) fail(`the first view shows ${seen.shown} cell colours, fewer than a quarter of ${cellCount} cells`);
+    } else if (seen.shown >= Math.ceil(cellCount / 4)) {
+      fail(`without the cut the check should fail (the roof hides the cells), yet ${seen.shown} colours show: it cannot tell`);
+    }
+    if (errors.length) fail(`the ${name} view logged errors: ` + errors.join('; '));
+    await page.close();
+  }
+
   const { page, errors } = await openSite(browser, join(work, 'site', 'index.html'), hash);
   const box = await page.locator('canvas').boundingBox();
   await page.mouse.click(box.x + box.width / 2, box.y + box.height / 2);
