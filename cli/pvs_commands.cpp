@@ -1,9 +1,11 @@
 // pvs, bake: potentially visible sets by adaptive global visibility sampling.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
 
+#include "commands.h"
 #include "options.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
@@ -208,9 +210,9 @@ double parse_percent(const std::string& text, const std::string& option) {
   return v[0] / 100;
 }
 
-int run_bake(BakeArgs a, const Common& c) {
-  check_files({a.sampling.scene}, {a.output, a.report}, {a.work});
-  ThreadLimit threads(c.threads);
+/// The bake the options ask for, with the command line's defaults (also what bindings that
+/// bake from code run: bake_config_from_args).
+pipeline::BakeConfig bake_config(BakeArgs a, const Common& c) {
   pipeline::BakeConfig config;
   config.model = a.cells.model();
   config.subdivision = a.cells.subdivision(c, a.sampling);
@@ -251,12 +253,20 @@ int run_bake(BakeArgs a, const Common& c) {
   config.output = a.output;
   config.work_dir = a.work;
   config.checkpoint_seconds = a.checkpoint;
+  return config;
+}
+
+int run_bake(const BakeArgs& a, const Common& c) {
+  check_files({a.sampling.scene}, {a.output, a.report}, {a.work});
+  ThreadLimit threads(c.threads);
+  const pipeline::BakeConfig config = bake_config(a, c);
   const pipeline::BakeResult result = pipeline::bake(config, c.logger());
   write_report_to(a.report, result, c);
   return 0;
 }
 
-void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
+/// Adds `bake`; returns its parsed options (filled by the parse).
+std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
   auto a = std::make_shared<BakeArgs>();
   a->cells.max_cells = 0;
   a->cells.play_space_by_default = true;
@@ -323,6 +333,7 @@ void add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
                           throw Error("bake needs a budget: --cells N or --memory BYTES");
                         return run_bake(*a, common);
                       }});
+  return a;
 }
 
 }  // namespace
@@ -392,6 +403,25 @@ void add_measure_command(CLI::App& app, const Common& common, Commands& commands
   ms->add_flag("--fast", a->fast, "Embree without robust mode");
   ms->add_option("--report", a->report, "JSON report (default: printed)");
   commands.push_back({ms, [a, &common] { return run_measure(*a, common); }});
+}
+
+pipeline::BakeConfig bake_config_from_args(const std::vector<std::string>& args, bool quiet) {
+  CLI::App app{"viewcells"};
+  Common common;
+  common.quiet = quiet;
+  Commands commands;
+  const std::shared_ptr<BakeArgs> a = add_bake_command(app, common, commands);
+  std::vector<std::string> reversed = {"bake"};
+  reversed.insert(reversed.end(), args.begin(), args.end());
+  std::reverse(reversed.begin(), reversed.end());  // CLI11 takes a vector last argument first
+  try {
+    app.parse(reversed);
+  } catch (const CLI::ParseError& e) {
+    throw Error(std::string("bake: ") + e.what());
+  }
+  check_no_empty_values(*commands.front().app);
+  if (a->view_cells == 0 && a->memory.empty()) throw Error("bake needs a budget: cells or memory");
+  return bake_config(*a, common);
 }
 
 void add_pvs_commands(CLI::App& app, const Common& common, Commands& commands) {

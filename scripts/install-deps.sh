@@ -25,6 +25,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev   # tests and micro-benchmarks
   gnuplot-nox                                  # plots of comparisons and studies (scripts/plot-*.sh)
   valgrind               # instruction counts of an A/B benchmark (scripts/bench-ab-instructions.sh)
+  python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest   # the Python module (python/) and its tests
 )
 
 # scripts/fuzz.sh also needs clang with libFuzzer's runtime.

@@ -6,7 +6,9 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 # With MPI, so that the suite also runs sampling and AGVS on several ranks (tests/mpi/).
-bash scripts/build.sh build RelWithDebInfo -DVIEWCELLS_BUILD_TESTS=ON -DVIEWCELLS_MPI=ON
+# With the Python module, built for the system Python 3 (pytest runs it: tests/python/).
+bash scripts/build.sh build RelWithDebInfo -DVIEWCELLS_BUILD_TESTS=ON -DVIEWCELLS_MPI=ON -DVIEWCELLS_PYTHON=ON \
+  -DPython3_EXECUTABLE=/usr/bin/python3 -DPYBIND11_FINDPYTHON=ON
 # Real Quake 3 levels from Debian's archive (oa_dm2 is tested); the tests fail without them.
 bash scripts/fetch-maps.sh
 export VIEWCELLS_REQUIRE_MAPS=1

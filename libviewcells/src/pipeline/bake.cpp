@@ -27,7 +27,9 @@ std::string hierarchy_key(const BakeConfig& c, uint32_t max_cells) {
   const SubdivisionConfig& d = c.subdivision;
   std::ostringstream k;
   k.precision(17);
-  k << "viewcells bake hierarchy v3\nscene " << c.scene.path << " grouping " << to_string(c.scene.grouping)
+  k << "viewcells bake hierarchy v3\nscene " << c.scene.path
+    << (c.scene.scene ? " in memory " + std::to_string(c.scene.scene->fingerprint()) : std::string()) << " grouping "
+    << to_string(c.scene.grouping)
     << " robust " << c.scene.robust << "\nsamples " << s.samples << " segments " << s.target_segments << " seed "
     << s.seed << " recasts " << s.max_recasts << " empty " << static_cast<int>(s.empty_space) << "\nview box "
     << s.view_box.lo.x << ' ' << s.view_box.lo.y << ' ' << s.view_box.lo.z << ' ' << s.view_box.hi.x << ' '

@@ -24,8 +24,13 @@ LoadedScene load_scene_for_rays(const SceneSource& source, const Log& log) {
   LoadedScene out;
   out.source = source;
   Stopwatch sw;
-  out.scene = std::make_unique<const Scene>(load_scene(source.path, source.grouping));
-  if (is_q3_map(source.path)) out.map = std::make_shared<const Q3Map>(read_q3bsp(source.path));
+  if (source.scene) {
+    if (source.scene->triangles.empty()) throw Error(source.path, 0, "the scene has no triangles");
+    out.scene = std::make_unique<const Scene>(*source.scene);
+  } else {
+    out.scene = std::make_unique<const Scene>(load_scene(source.path, source.grouping));
+    if (is_q3_map(source.path)) out.map = std::make_shared<const Q3Map>(read_q3bsp(source.path));
+  }
   out.load_seconds = sw.seconds();
   log("viewcells: " + source.path + ": " + std::to_string(out.scene->object_count()) + " objects, " +
       std::to_string(out.scene->triangle_count()) + " triangles, loaded in " + fmt(out.load_seconds, 2) + " s");

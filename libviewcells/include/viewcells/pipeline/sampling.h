@@ -25,9 +25,12 @@ using Log = std::function<void(const std::string&)>;
 
 /// A scene file and how to read it.
 struct SceneSource {
-  std::string path;
+  std::string path;  ///< the scene file; with `scene`, only a name for logs and reports
   ObjectGrouping grouping = ObjectGrouping::kAuto;
   bool robust = true;  ///< Embree's robust mode (off: faster, rays may slip through edges)
+  /// A scene made in memory (an editor's meshes, Python's arrays): used instead of reading
+  /// `path`, with its own objects (`grouping` does not apply). Shared, never modified.
+  std::shared_ptr<const Scene> scene;
 };
 
 /// True for a Quake 3 map (.bsp).

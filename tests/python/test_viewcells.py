@@ -1,0 +1,107 @@
+"""The Python module `viewcells` (python/): a scene from numpy arrays or a file, baked with the
+command line's options and defaults, read back as arrays. Run by ctest (tests/CMakeLists.txt)
+with the system Python 3 and PYTHONPATH at the built module; VIEWCELLS_CLI names the executable."""
+import json
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import viewcells
+
+CLI = os.environ["VIEWCELLS_CLI"]
+
+
+def run(*args, cwd):
+    return subprocess.run([CLI, "-q", *args], cwd=cwd, check=True, capture_output=True, text=True).stdout
+
+
+def read_obj(path):
+    """The OBJ the generator writes, as arrays: vertices, triangles, each triangle's group, names."""
+    vertices, triangles, groups, names = [], [], [], []
+    for line in open(path):
+        t = line.split()
+        if not t:
+            continue
+        if t[0] == "v":
+            vertices.append([float(x) for x in t[1:4]])
+        elif t[0] in ("o", "g"):
+            names.append(t[1])
+        elif t[0] == "f":
+            idx = [int(x.split("/")[0]) - 1 for x in t[1:]]
+            for k in range(1, len(idx) - 1):  # a fan, as the OBJ reader triangulates
+                triangles.append([idx[0], idx[k], idx[k + 1]])
+                groups.append(len(names) - 1)
+    return np.array(vertices), np.array(triangles), np.array(groups), names
+
+
+@pytest.fixture(scope="module")
+def office(tmp_path_factory):
+    d = tmp_path_factory.mktemp("office")
+    run("generate", "office", "--size", "1", "-o", "office.obj", cwd=d)
+    return d
+
+
+SETTINGS = dict(cells=12, samples=20000, max_cells=60, agvs_samples=50000)
+
+
+def test_arrays_file_and_command_line_bake_the_same_file(office):
+    run("bake", "office.obj", "--cells", "12", "--samples", "20000", "--max-cells", "60", "--agvs-samples", "50000",
+        "-o", "cli.pvs", cwd=office)
+    from_file = viewcells.bake(str(office / "office.obj"), str(office / "file.pvs"), **SETTINGS)
+    v, t, g, names = read_obj(office / "office.obj")
+    scene = viewcells.Scene(v, t, objects=g, names=names, name="office.obj")
+    assert scene.fingerprint == viewcells.Scene.load(str(office / "office.obj")).fingerprint
+    from_arrays = viewcells.bake(scene, str(office / "arrays.pvs"), **SETTINGS)
+    cli = (office / "cli.pvs").read_bytes()
+    assert (office / "file.pvs").read_bytes() == cli
+    assert (office / "arrays.pvs").read_bytes() == cli
+    assert from_arrays.cell_count == from_file.cell_count == 12
+    assert from_arrays.report["cells"] == 12 and from_arrays.report["budget"]["cells"] == 12
+
+
+def test_results_agree_with_query(office):
+    baked = viewcells.bake(str(office / "office.obj"), str(office / "q.pvs"), **SETTINGS)
+    bounds = baked.cell_bounds
+    assert bounds.shape == (baked.cell_count, 2, 3)
+    assert np.all(bounds[:, 0, :] < bounds[:, 1, :])
+    rng = np.random.default_rng(3)
+    lo, hi = bounds[:, 0, :].min(axis=0), bounds[:, 1, :].max(axis=0)
+    for p in rng.uniform(lo, hi, size=(20, 3)):
+        cell = baked.query(tuple(p))
+        q = json.loads(run("query", "q.pvs", *map(repr, p), "--json", cwd=office))
+        assert cell == q["cell"]
+        assert list(baked.pvs(cell)) == [o["id"] for o in q["pvs"]]
+        assert np.all(bounds[cell, 0] <= p) and np.all(p <= bounds[cell, 1])
+    assert baked.query((1e9, 0, 0)) == -1
+    assert len(baked.object_names) == baked.object_count == 24
+
+
+def test_progress_and_see_through_and_errors(office, tmp_path):
+    lines = []
+    # Two boxes and a glass pane between them: the pane is seen, but hides nothing.
+    box = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
+    faces = np.array([[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5],
+                      [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]])
+    pane = np.array([[2, -1, -1], [2, 2, -1], [2, 2, 2], [2, -1, 2]], float)
+    v = np.vstack([box, box + [4, 0, 0], pane])
+    t = np.vstack([faces, faces + 8, [[16, 17, 18], [16, 18, 19]]])
+    objects = np.array([0] * 12 + [1] * 12 + [2] * 2)
+    scene = viewcells.Scene(v, t, objects=objects, names=["left", "right", "glass"], see_through=[False, False, True])
+    baked = viewcells.bake(scene, str(tmp_path / "glass.pvs"), cells=2, samples=20000, agvs_samples=20000,
+                           view_box="-1,-2,-1,6,3,2", progress=lines.append)
+    assert any("bake:" in line for line in lines), lines[:5]
+    seen = set()
+    for c in range(baked.cell_count):
+        seen.update(baked.pvs(c).tolist())
+    assert seen == {0, 1, 2}, "both boxes seen through the glass"
+    with pytest.raises(viewcells.Error, match="max-cells"):
+        viewcells.bake(scene, str(tmp_path / "x.pvs"), cells=5, max_cells=2)
+    with pytest.raises(viewcells.Error, match="NaN or infinite"):
+        viewcells.Scene(np.array([[np.nan, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2]]))
+    with pytest.raises(viewcells.Error, match="out of range"):
+        viewcells.Scene(box, np.array([[0, 1, 99]]))
+    with pytest.raises(viewcells.Error, match="unrecognized|not expected|--no-such"):
+        viewcells.bake(scene, str(tmp_path / "x.pvs"), cells=2, no_such_option=3)
+    assert not (tmp_path / "x.pvs").exists()
