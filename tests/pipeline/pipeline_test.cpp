@@ -221,6 +221,22 @@ TEST(Pipeline, BakeByCellsWritesThatManyAndContinuesFromItsWorkDirectory) {
   EXPECT_FALSE(pipeline::bake(c, quiet).hierarchy_reused);
 }
 
+/// A small bake of the map at `path` into the temporary file `name` (20,000 AGVS samples).
+pipeline::BakeConfig small_map_bake(const std::string& path, uint64_t samples, uint32_t max_cells, uint32_t cells,
+                                    const std::string& name) {
+  pipeline::BakeConfig c;
+  c.scene.path = path;
+  c.sampling.samples = samples;
+  c.sampling.show_progress = false;
+  c.subdivision.max_cells = max_cells;
+  c.subdivision.show_progress = false;
+  c.cells = cells;
+  c.agvs.max_samples = 20000;
+  c.agvs.show_progress = false;
+  c.output = test::temp_path(name);
+  return c;
+}
+
 TEST(Pipeline, BakedMapGivesEveryPointOfItsNonSolidSpaceACell) {
   // q3map2 rounds leaf bounds to whole units and derives them from portals: some non-solid
   // leaves reach past the union of the stored bounds (the bake's view box), and a player (or a
@@ -228,17 +244,8 @@ TEST(Pipeline, BakedMapGivesEveryPointOfItsNonSolidSpaceACell) {
   // q3_cover_box, and the runtime, the toolkit and measure's play cameras all find one.
   const std::string path = test::oa_dm2_path(VIEWCELLS_DATA_DIR);
   if (path.empty()) GTEST_SKIP() << "oa_dm2.bsp not fetched (scripts/fetch-maps.sh)";
-  pipeline::BakeConfig c;
-  c.scene.path = path;
-  c.sampling.samples = 30000;
-  c.sampling.show_progress = false;
-  c.subdivision.max_cells = 60;
-  c.subdivision.show_progress = false;
+  pipeline::BakeConfig c = small_map_bake(path, 30000, 60, 20, "covered.pvs");
   c.subdivision.play_space = true;
-  c.cells = 20;
-  c.agvs.max_samples = 20000;
-  c.agvs.show_progress = false;
-  c.output = test::temp_path("covered.pvs");
   pipeline::bake(c, quiet);
   const Q3Map map = read_q3bsp(path);
   const Box3 stored = q3_view_box(map), cover = q3_cover_box(map);
@@ -295,16 +302,7 @@ TEST(Pipeline, MeasureCountsACameraInNoCellAsAFrameDrawingNothing) {
   // measure once stopped at the first such player eye; now it measures it, every pixel wrong.
   const std::string path = test::oa_dm2_path(VIEWCELLS_DATA_DIR);
   if (path.empty()) GTEST_SKIP() << "oa_dm2.bsp not fetched (scripts/fetch-maps.sh)";
-  pipeline::BakeConfig c;
-  c.scene.path = path;
-  c.sampling.samples = 20000;
-  c.sampling.show_progress = false;
-  c.subdivision.max_cells = 30;
-  c.subdivision.show_progress = false;
-  c.cells = 10;
-  c.agvs.max_samples = 20000;
-  c.agvs.show_progress = false;
-  c.output = test::temp_path("half.pvs");
+  const pipeline::BakeConfig c = small_map_bake(path, 20000, 30, 10, "half.pvs");
   pipeline::bake(c, quiet);
   PvsFile f = read_pvs(c.output);
   Box3& box = f.bsp.view_box;  // 4% off each side along x and y: eyes there have no cell

@@ -27,16 +27,16 @@ const [x0, y0, z0, x1, y1] = info.view_box;
 const cx = (x0 + x1) / 2, cy = (y0 + y1) / 2, eyeZ = z0 + 1.6;
 const hash = `camera=${cx - 2},${cy},${eyeZ}&target=${cx + 1},${cy},${z0 + 0.2}`;
 
-// The distinct cell colours a screenshot shows: pixels within 3 of a cell's colour as the page
-// draws it (8-bit sRGB; the cells' cross-sections are drawn opaque, unlit), outside the panel
-// (whose legend holds every colour of the scale).
-async function cellColoursShown(page, png) {
+// What a screenshot shows: its distinct colours, its share of background, and the distinct
+// cell colours in it (pixels within 3 of a cell's colour as the page draws it: 8-bit sRGB, the
+// cells' cross-sections opaque and unlit), outside the panel (whose legend holds every colour
+// of the scale).
+async function screenshotStats(page, png) {
   return page.evaluate(async (data) => {
     const v = window.viewcells;
-    const count = v.sectionCells.length ? Math.max(...v.sectionCells) + 1 : 0;
-    const wanted = new Map();
+    const keys = [];
     for (let c = 0; c < 4096; ++c) {
-      try { const [r, g, b] = v.cellColour(c); wanted.set((r << 16) | (g << 8) | b, true); } catch (e) { break; }
+      try { const [r, g, b] = v.cellColour(c); keys.push((r << 16) | (g << 8) | b); } catch (e) { break; }
     }
     const img = new Image();
     img.src = 'data:image/png;base64,' + data;
@@ -46,24 +46,26 @@ async function cellColoursShown(page, png) {
     const g = cv.getContext('2d');
     g.drawImage(img, 0, 0);
     const d = g.getImageData(0, 0, cv.width, cv.height).data;
-    const keys = [...wanted.keys()];
-    const shown = new Set(), near = new Map();
+    const colours = new Set(), shown = new Set(), near = new Map();
+    let background = 0;
     const hud = document.getElementById('hud').getBoundingClientRect();
     const ratio = cv.width / window.innerWidth;
     for (let i = 0; i < d.length; i += 4) {
+      const key = (d[i] << 16) | (d[i + 1] << 8) | d[i + 2];
+      colours.add(key);
+      if (Math.abs(d[i] - 0x15) + Math.abs(d[i + 1] - 0x17) + Math.abs(d[i + 2] - 0x1c) < 6) ++background;
       const x = (i / 4) % cv.width / ratio, y = Math.floor(i / 4 / cv.width) / ratio;
       if (x >= hud.left && x <= hud.right && y >= hud.top && y <= hud.bottom) continue;
-      const key = (d[i] << 16) | (d[i + 1] << 8) | d[i + 2];
       let hit = near.get(key);
       if (hit === undefined) {
-        hit = -1;
-        for (const k of keys)
-          if (Math.abs((k >> 16) - d[i]) + Math.abs(((k >> 8) & 255) - d[i + 1]) + Math.abs((k & 255) - d[i + 2]) <= 3) { hit = k; break; }
+        hit = keys.find((k) => Math.abs((k >> 16) - d[i]) + Math.abs(((k >> 8) & 255) - d[i + 1]) +
+                               Math.abs((k & 255) - d[i + 2]) <= 3);
         near.set(key, hit);
       }
-      if (hit >= 0) shown.add(hit);
+      if (hit !== undefined) shown.add(hit);
     }
-    return { shown: shown.size, distinct: keys.length, crossed: v.sectionCells.length, count };
+    return { colours: colours.size, background: background / (d.length / 4), shown: shown.size,
+             distinct: new Set(keys).size, crossed: v.sectionCells.length };
   }, png.toString('base64'));
 }
 
@@ -78,7 +80,7 @@ try {
     await page.waitForTimeout(300);
     const shotPath = join(work, `viewer-${name}.png`);
     const png = await page.screenshot({ path: shotPath });
-    const seen = await cellColoursShown(page, png);
+    const seen = await screenshotStats(page, png);
     console.log(`${name} view (${shotPath}): ${seen.shown} cell colours shown of ${seen.distinct} distinct among ` +
                 `${cellCount} cells (the cut crosses ${seen.crossed})`);
     if (name === 'default') {
@@ -132,23 +134,7 @@ try {
   const shot = join(work, 'viewer.png');
   await page.screenshot({ path: shot });
   // Not blank: many colours, and most pixels differ from the background.
-  const stats = await page.evaluate(async (png) => {
-    const img = new Image();
-    img.src = 'data:image/png;base64,' + png;
-    await img.decode();
-    const c = document.createElement('canvas');
-    c.width = img.width; c.height = img.height;
-    const g = c.getContext('2d');
-    g.drawImage(img, 0, 0);
-    const d = g.getImageData(0, 0, c.width, c.height).data;
-    const colours = new Set();
-    let background = 0;
-    for (let i = 0; i < d.length; i += 4) {
-      colours.add((d[i] << 16) | (d[i + 1] << 8) | d[i + 2]);
-      if (Math.abs(d[i] - 0x15) + Math.abs(d[i + 1] - 0x17) + Math.abs(d[i + 2] - 0x1c) < 6) ++background;
-    }
-    return { colours: colours.size, background: background / (d.length / 4) };
-  }, readFileSync(shot).toString('base64'));
+  const stats = await screenshotStats(page, readFileSync(shot));
   console.log(`screenshot ${shot}: ${stats.colours} colours, ${(100 * stats.background).toFixed(1)}% background`);
   if (stats.colours < 50) fail(`the screenshot has only ${stats.colours} colours`);
   if (stats.background > 0.9) fail('the screenshot is mostly background');
