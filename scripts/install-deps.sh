@@ -26,6 +26,7 @@ packages=(
   gnuplot-nox                                  # plots of comparisons and studies (scripts/plot-*.sh)
   valgrind               # instruction counts of an A/B benchmark (scripts/bench-ab-instructions.sh)
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest   # the Python module (python/) and its tests
+  blender                # the module inside Blender 3.4, headless (tests/blender/)
 )
 
 # scripts/fuzz.sh also needs clang with libFuzzer's runtime.
