@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <iostream>
 #include <memory>
+#include <tuple>
 
 #include "commands.h"
 #include "options.h"
@@ -197,8 +198,20 @@ struct BakeArgs {
   double measured_error = 0;
   uint32_t measure_cameras = 0;
   double seconds = 0;  ///< --time: the whole bake
-  std::string holes, measure_size;
+  std::string holes, measure_size, frame_size = "256x192";
+  uint32_t frame_samples = 0;
 };
+
+/// "WIDTHxHEIGHT", each from 1 to 2048, of option `option`.
+std::pair<uint32_t, uint32_t> parse_size(const std::string& text, const std::string& option) {
+  const size_t x = text.find('x');
+  const std::vector<double> wh =
+      x == std::string::npos ? std::vector<double>{} : parse_numbers(text.substr(0, x) + "," + text.substr(x + 1), option);
+  if (wh.size() != 2 || wh[0] < 1 || wh[1] < 1 || wh[0] > 2048 || wh[1] > 2048 || wh[0] != std::floor(wh[0]) ||
+      wh[1] != std::floor(wh[1]))
+    throw Error(option + " needs WIDTHxHEIGHT, each from 1 to 2048 (got '" + text + "')");
+  return {static_cast<uint32_t>(wh[0]), static_cast<uint32_t>(wh[1])};
+}
 
 /// "1%" or "1" (percent) -> 0.01.
 double parse_percent(const std::string& text, const std::string& option) {
@@ -236,18 +249,13 @@ pipeline::BakeConfig bake_config(BakeArgs a, const Common& c) {
   config.measure_cameras =
       a.measure_cameras ? a.measure_cameras : by_holes ? 1000 : a.measured_error > 0 ? 5000 : 0;
   if (!a.measure_size.empty()) {
-    const size_t x = a.measure_size.find('x');
-    const std::vector<double> wh =
-        x == std::string::npos ? std::vector<double>{} : parse_numbers(a.measure_size.substr(0, x) + "," + a.measure_size.substr(x + 1), "--measure-size");
-    if (wh.size() != 2 || wh[0] < 1 || wh[1] < 1 || wh[0] > 2048 || wh[1] > 2048 || wh[0] != std::floor(wh[0]) ||
-        wh[1] != std::floor(wh[1]))
-      throw Error("--measure-size needs WIDTHxHEIGHT, each from 1 to 2048 (got '" + a.measure_size + "')");
-    config.frame.width = static_cast<uint32_t>(wh[0]);
-    config.frame.height = static_cast<uint32_t>(wh[1]);
+    std::tie(config.frame.width, config.frame.height) = parse_size(a.measure_size, "--measure-size");
   } else if (by_holes) {
     config.frame.width = 1024;
     config.frame.height = 768;
   }
+  config.frame_samples = a.frame_samples;
+  std::tie(config.sample_frame.width, config.sample_frame.height) = parse_size(a.frame_size, "--frame-size");
   config.agvs = a.agvs.config(c);
   config.agvs.seed = a.sampling.seed;
   config.output = a.output;
@@ -316,6 +324,12 @@ std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, 
                  "(by default 1,000 cameras of 1024x768, placed as `viewcells measure` places them), each "
                  "measurement logged with an estimate of the time left; with --measured-error both must hold; "
                  "--time still bounds the bake");
+  bk->add_option("--frame-samples", a->frame_samples,
+                 "After AGVS, frames as a sampler: this many cameras per view cell on average, placed as measuring "
+                 "cameras are (on a Quake 3 map player eyes, pitch within 30 degrees) but from a seed of their own, "
+                 "render --frame-size frames, and every object a frame shows joins its cell's PVS (0: none)")
+      ->check(whole(0, 100000));
+  bk->add_option("--frame-size", a->frame_size, "Frames of --frame-samples, WIDTHxHEIGHT")->capture_default_str();
   bk->add_option("--measure-size", a->measure_size,
                  "Frames of the measuring cameras, WIDTHxHEIGHT (default 1024x768 with --holes, else 64x48)");
   bk->add_option("--measure-cameras", a->measure_cameras,

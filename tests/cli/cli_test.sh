@@ -564,6 +564,14 @@ expect_ok "$VC" bake office.obj --memory 3000 --samples 20000 --max-cells 300 --
 expect_ok "$VC" measure office.obj meml.pvs --count 20 --width 8 --height 8 --report memlm.json -q
 [ "$(json_get memlm.json "['pvs_bytes']")" = "$(json_get meml.json "['list_bytes']")" ] && ok || bad "measure's pvs_bytes differ from bake's list_bytes"
 expect_error "file or lists" "$VC" bake office.obj --memory 3000 --memory-of everything -o x.pvs
+# Frames as a sampler: the report says how many frames added how many entries.
+expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --max-cells 60 --agvs-samples 20000 --frame-samples 8 \
+  --frame-size 64x48 -o framed.pvs --report framed.json -q
+python3 -c "
+import json; e = json.load(open('framed.json'))['effects']['frame_samples']
+assert e['enabled'] and '96 frames of 64x48' in e['reason'], e
+" && ok || bad "bake --frame-samples: report"
+expect_error "WIDTHxHEIGHT" "$VC" bake office.obj --cells 12 --frame-samples 8 --frame-size 64 -o x.pvs
 cp bake1.pvs keep.pvs
 expect_error "too small" "$VC" bake office.obj --memory 50 --samples 20000 --max-cells 300 --agvs-samples 50000 \
   -o keep.pvs -q

@@ -122,6 +122,42 @@ TEST(Frames, CoherentPacketsSeeWhatSingleRaysSeeAndEveryPixelOnce) {
   EXPECT_GT(rates.incoherent_per_second, 0);
 }
 
+TEST(Frames, FrameSamplesAddWhatTheirFramesShowToTheirCells) {
+  // From empty PVSs, the frames of some cameras fill their cells' lists: measured by the same
+  // cameras and frames nothing is wrong, and other cameras still find holes (a sampler's own
+  // cameras cannot measure it).
+  const Scene scene = generate_scene({GeneratorKind::kOffice, 1, 1});
+  const auto caster = make_embree_caster(scene);
+  const CellLocator cells = test::kd_cells(scene, 16);
+  std::vector<int32_t> cam_cells, other_cells;
+  const std::vector<Camera> cams = view_box_cameras(*caster, cells, 40, 21, true, cam_cells);
+  const std::vector<Camera> others = view_box_cameras(*caster, cells, 200, 22, true, other_cells);
+  std::vector<std::vector<uint32_t>> lists(cells.cell_count());
+  const FrameConfig frame{48, 36, 90.0, 1024 * 1024};
+  std::vector<int32_t> with_none = cam_cells;
+  with_none.push_back(-1);  // a camera in no cell adds nothing
+  std::vector<Camera> with_extra = cams;
+  with_extra.push_back(cams[0]);
+  const uint64_t added = add_frame_samples(*caster, with_extra, with_none, frame, lists);
+  uint64_t entries = 0;
+  for (const auto& l : lists) {
+    entries += l.size();
+    EXPECT_TRUE(std::is_sorted(l.begin(), l.end()));
+    EXPECT_TRUE(std::adjacent_find(l.begin(), l.end()) == l.end());
+  }
+  EXPECT_EQ(added, entries);
+  ASSERT_GT(added, 0u);
+  const GlobalPvs pvs = GlobalPvs::from_lists(scene.object_count(), lists);
+  EXPECT_EQ(measure_frames(scene, *caster, cams, cam_cells, pvs, frame).cameras_wrong, 0u);
+  EXPECT_GT(measure_frames(scene, *caster, others, other_cells, pvs, frame).cameras_wrong, 0u);
+  // Adding the same frames again adds nothing; the result does not depend on the threads.
+  EXPECT_EQ(add_frame_samples(*caster, cams, cam_cells, frame, lists), 0u);
+  std::vector<std::vector<uint32_t>> serial(cells.cell_count());
+  ThreadLimit one(1);
+  add_frame_samples(*caster, cams, cam_cells, frame, serial);
+  EXPECT_EQ(serial, lists);
+}
+
 TEST(Frames, PlayerCameraIsLevel) {
   const Camera c = camera_looking({1, 2, 3}, 0.7, 0.2);
   EXPECT_NEAR(length(c.forward), 1, 1e-12);

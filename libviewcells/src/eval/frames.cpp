@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <iterator>
 #include <numeric>
 
 #include "agvs/halton.h"
@@ -126,6 +127,43 @@ FrameRayRates frame_ray_rates(const RayCaster& caster, std::span<const Camera> c
   out.coherent_per_second = out.rays / std::max(seconds[1], 1e-9);
   out.incoherent_per_second = out.rays / std::max(seconds[0], 1e-9);
   return out;
+}
+
+uint64_t add_frame_samples(const RayCaster& caster, std::span<const Camera> cameras, std::span<const int32_t> cells,
+                           const FrameConfig& config, std::vector<std::vector<uint32_t>>& lists) {
+  check_frame_budget(cameras.size(), config.width, config.height);
+  if (cells.size() != cameras.size()) throw Error("add_frame_samples: one cell per camera");
+  const size_t n = cameras.size();
+  std::vector<std::vector<uint32_t>> seen(n);  // per camera: the objects it shows, sorted
+  Progress progress("frame samples", n);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 1), [&](const tbb::blocked_range<size_t>& range) {
+    std::vector<Ray> rays;
+    std::vector<Hit> hits;
+    for (size_t k = range.begin(); k < range.end(); ++k) {
+      throw_if_interrupted("frame samples");
+      if (cells[k] < 0) continue;
+      frame_rays(cameras[k], config, rays);
+      cast_frame(caster, rays, hits, true);
+      for (const Hit& h : hits)
+        if (h.hit()) seen[k].push_back(h.object);
+      std::sort(seen[k].begin(), seen[k].end());
+      seen[k].erase(std::unique(seen[k].begin(), seen[k].end()), seen[k].end());
+      progress.advance();
+    }
+  });
+  progress.finish();
+  // Serially, camera by camera: the lists do not depend on the threads.
+  uint64_t added = 0;
+  std::vector<uint32_t> merged;
+  for (size_t k = 0; k < n; ++k) {
+    if (cells[k] < 0 || seen[k].empty()) continue;
+    std::vector<uint32_t>& list = lists.at(static_cast<size_t>(cells[k]));
+    merged.clear();
+    std::set_union(list.begin(), list.end(), seen[k].begin(), seen[k].end(), std::back_inserter(merged));
+    added += merged.size() - list.size();
+    list.swap(merged);
+  }
+  return added;
 }
 
 PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, std::span<const Camera> cameras,

@@ -229,6 +229,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   if (!(c.holes >= 0 && c.holes <= 1)) throw Error("the share of frames with holes must be from 0 to 1");
   if (c.holes > 0 && !c.measure_cameras) throw Error("a share of frames with holes needs measuring cameras");
   if (c.measure_cameras) check_frame_budget(c.measure_cameras, c.frame.width, c.frame.height);
+  if (c.frame_samples) check_frame_budget(c.frame_samples, c.sample_frame.width, c.sample_frame.height);
   if (!(c.max_seconds >= 0) || !std::isfinite(c.max_seconds)) throw Error("the bake's time limit must be finite and >= 0");
   if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0) && !(c.measured_error > 0) &&
       !(c.holes > 0) && !(c.max_seconds > 0))
@@ -287,7 +288,24 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     log("viewcells: bake: " + std::to_string(cams->cameras.size()) + " measuring cameras (" + cams->rule + ") in " +
         fmt(sw.seconds(), 2) + " s");
   }
-  const std::vector<std::vector<uint32_t>> lists = sample_pvs(run, loaded, sampled, cells, cams, out, log);
+  std::vector<std::vector<uint32_t>> lists = sample_pvs(run, loaded, sampled, cells, cams, out, log);
+  if (c.frame_samples) {
+    // Frames where viewers are, from a seed of their own (the measuring cameras' is c.cameras.seed).
+    Stopwatch sw;
+    CameraConfig sc = c.cameras;
+    sc.count = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{c.frame_samples} * set.cells.size(), 10'000'000));
+    sc.seed = c.cameras.seed + 0x5a3'0001;
+    const CameraSet samplers = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), sc,
+                                            [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
+                                            &covered_cells);
+    out.frame_sample_cameras = samplers.cameras.size();
+    out.frame_sample_entries = add_frame_samples(*loaded.caster, samplers.cameras, samplers.cells, c.sample_frame, lists);
+    out.frame_sample_seconds = sw.seconds();
+    log("viewcells: bake: " + std::to_string(out.frame_sample_cameras) + " sampling frames of " +
+        std::to_string(c.sample_frame.width) + "x" + std::to_string(c.sample_frame.height) + " (" + samplers.rule +
+        ") added " + std::to_string(out.frame_sample_entries) + " PVS entries in " + fmt(out.frame_sample_seconds, 1) +
+        " s");
+  }
   out.agvs_cells = static_cast<uint32_t>(set.cells.size());
   ViewCellSet written = set;
   std::vector<std::vector<uint32_t>> written_lists = lists;
@@ -311,7 +329,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     bytes = write_cut(c.output, file, written, &written_lists, true, written_box);
   }
   if (cams) {
-    if (written.cells.size() == set.cells.size() && !out.measured_curve.empty()) {
+    if (written.cells.size() == set.cells.size() && !out.measured_curve.empty() && !c.frame_samples) {
       out.measured = out.measured_curve.back().measured;  // the PVSs written, measured last
     } else {
       // The cells written (coarser when the budget coarsened them): each camera's is found again.

@@ -614,7 +614,15 @@ std::string report_json(const BakeResult& r) {
                                                            "are the unions of their parts"
                                                      : "the file fits the budget as sampled")},
                  {"empty_space_detection", effect(st.empty_space.enabled, st.empty_space.reason)},
-                 {"restricted_view_space", agvs_view_space(r.agvs_in_view_space, c.subdivision.play_space)}}},
+                 {"restricted_view_space", agvs_view_space(r.agvs_in_view_space, c.subdivision.play_space)},
+                 {"frame_samples",
+                  effect(c.frame_samples > 0,
+                         c.frame_samples > 0
+                             ? std::to_string(r.frame_sample_cameras) + " frames of " + std::to_string(c.sample_frame.width) +
+                                   "x" + std::to_string(c.sample_frame.height) + " from cameras of their own seed added " +
+                                   std::to_string(r.frame_sample_entries) + " PVS entries in " +
+                                   fmt(r.frame_sample_seconds, 2) + " s (--frame-samples)"
+                             : "not asked for (--frame-samples)")}}},
                {"scene_fingerprint", r.scene_fingerprint},
                {"objects", r.object_count},
                {"cells", r.cells},

@@ -98,6 +98,13 @@ struct PixelErrorMeasure {
 PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, std::span<const Camera> cameras,
                                  std::span<const int32_t> cells, const GlobalPvs& pvs, const FrameConfig& config);
 
+/// Frames as a sampler (what Unreal's precomputed visibility does): renders each camera's frame
+/// (coherent packets) and adds every object it shows to the PVS `lists[cells[k]]` of the
+/// camera's cell (cells -1 are skipped); lists stay sorted. Returns the entries added. The
+/// cameras must not be those that measure: a sampler's own cameras would hide its holes.
+uint64_t add_frame_samples(const RayCaster& caster, std::span<const Camera> cameras, std::span<const int32_t> cells,
+                           const FrameConfig& config, std::vector<std::vector<uint32_t>>& lists);
+
 /// The measured pixel error of a solution (paper section 4.5, the estimator's definition):
 /// cameras at uniform random points of the view box, randomly oriented, `width` x `height`
 /// pixels over a `fov_degrees` horizontal field of view, rendered by ray casting. A pixel is

@@ -47,6 +47,12 @@ struct BakeConfig {
   /// With measure_cameras: also (or instead) stop once at most this share of the cameras' frames
   /// (0 to 1) shows any wrong pixel: the holes a player sees. 0: not used.
   double holes = 0;
+  /// Frames as a sampler, after AGVS: this many cameras per view cell on average, placed as the
+  /// measuring cameras are but from their own seed (never the measuring cameras: on a map,
+  /// player eyes), each rendering `sample_frame`; every object a frame shows joins its cell's
+  /// PVS. 0: none. Bounded by kMaxFrameRays, not by max_seconds.
+  uint32_t frame_samples = 0;
+  FrameConfig sample_frame{256, 192, 90.0, 1024 * 1024};
   std::string output;              ///< .pvs
   std::string work_dir;            ///< empty: nothing kept between runs
   double checkpoint_seconds = 60;  ///< with a work directory: AGVS state saved this often (0: at the end)
@@ -72,6 +78,9 @@ struct BakeResult {
   std::vector<MeasuredPoint> measured_curve;  ///< with measured_error: every measurement of the run
   bool measured_stop = false;                 ///< the measured error stopped AGVS
   bool agvs_resumed = false;
+  // Frames as a sampler (frame_samples): cameras drawn, entries they added, seconds.
+  uint64_t frame_sample_cameras = 0, frame_sample_entries = 0;
+  double frame_sample_seconds = 0;
   bool agvs_in_view_space = false;  ///< a Quake 3 map: AGVS drew its points in the non-solid space
   uint64_t pvs_entries = 0, file_bytes = 0;
   uint64_t list_bytes = 0;  ///< the visible sets of the file written as a compact handle holds them
