@@ -269,6 +269,8 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   out.scene_fingerprint = file.scene_fingerprint;
   out.object_count = file.object_count;
   const ViewCellSet set = first_cut(c, file, log);
+  const uint64_t sampling_frames = std::min<uint64_t>(uint64_t{c.frame_samples} * set.cells.size(), 10'000'000);
+  if (sampling_frames) check_frame_budget(sampling_frames, c.sample_frame.width, c.sample_frame.height);  // before AGVS
   const PvsFile sampled = pvs_file_for(file, set);
   const CellLocator cells(sampled.bsp, sampled.leaf_cell, sampled.pvs.cell_count);
   // The file's cells cover every point of a map's non-solid space (covered_view_box), and the
@@ -293,7 +295,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     // Frames where viewers are, from a seed of their own (the measuring cameras' is c.cameras.seed).
     Stopwatch sw;
     CameraConfig sc = c.cameras;
-    sc.count = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{c.frame_samples} * set.cells.size(), 10'000'000));
+    sc.count = static_cast<uint32_t>(sampling_frames);
     sc.seed = c.cameras.seed + 0x5a3'0001;
     const CameraSet samplers = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), sc,
                                             [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
