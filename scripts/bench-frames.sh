@@ -27,7 +27,7 @@ frames, commit, rest = sys.argv[1], sys.argv[2], sys.argv[3:]
 print(f"{datetime.date.today()}, commit {commit}, 2 threads. Each scene baked with 100 view cells (200,000 construction samples, "
       f"1M AGVS samples), then `viewcells measure SCENE PVS --count {frames}` (1024x768, 90 degrees; on a map player eyes, "
       "elsewhere random points of the view box). Rays a second: the first frames' rays (about 4.7M) cast both ways, "
-      "alternating, the second round timed.\n")
+      "frame by frame, twice each way alternating, the second round timed.\n")
 print("| scene | coherent packets (M rays/s) | incoherent (M rays/s) | ratio | whole measurement (s) | frames with a wrong pixel | mean wrong pixels | 99th percentile | worst |")
 print("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
 for name, path in zip(rest[::2], rest[1::2]):

@@ -65,7 +65,8 @@ struct FrameRayRates {
   uint64_t rays = 0;
   double coherent_per_second = 0, incoherent_per_second = 0;
 };
-/// Casts the frames of the first cameras (about `max_rays` rays) both ways, on all threads.
+/// Casts the frames of the first cameras (about `max_rays` rays) both ways, on all threads,
+/// frame by frame (each twice each way, alternating; the second round timed).
 FrameRayRates frame_ray_rates(const RayCaster& caster, std::span<const Camera> cameras, const FrameConfig& config,
                               uint64_t max_rays = 4'000'000);
 
