@@ -199,7 +199,7 @@ struct BakeArgs {
   uint32_t measure_cameras = 0;
   double seconds = 0;  ///< --time: the whole bake
   std::string holes, measure_size, frame_size = "256x192";
-  uint32_t frame_samples = 0;
+  uint32_t frame_samples = 0, frame_rounds = 1;
 };
 
 /// "WIDTHxHEIGHT", each from 1 to 2048, of option `option`.
@@ -255,6 +255,7 @@ pipeline::BakeConfig bake_config(BakeArgs a, const Common& c) {
     config.frame.height = 768;
   }
   config.frame_samples = a.frame_samples;
+  config.frame_rounds = a.frame_rounds;
   std::tie(config.sample_frame.width, config.sample_frame.height) = parse_size(a.frame_size, "--frame-size");
   config.agvs = a.agvs.config(c);
   config.agvs.seed = a.sampling.seed;
@@ -330,6 +331,11 @@ std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, 
                  "render --frame-size frames, and every object a frame shows joins its cell's PVS (0: none)")
       ->check(whole(0, 100000));
   bk->add_option("--frame-size", a->frame_size, "Frames of --frame-samples, WIDTHxHEIGHT")->capture_default_str();
+  bk->add_option("--frame-rounds", a->frame_rounds,
+                 "Rounds of --frame-samples: after the first, only the cells whose frames still added an object get "
+                 "about as many frames again")
+      ->capture_default_str()
+      ->check(whole(1, 64));
   bk->add_option("--measure-size", a->measure_size,
                  "Frames of the measuring cameras, WIDTHxHEIGHT (default 1024x768 with --holes, else 64x48)");
   bk->add_option("--measure-cameras", a->measure_cameras,

@@ -572,6 +572,10 @@ import json; e = json.load(open('framed.json'))['effects']['frame_samples']
 assert e['enabled'] and '96 frames of 64x48' in e['reason'], e
 " && ok || bad "bake --frame-samples: report"
 expect_error "WIDTHxHEIGHT" "$VC" bake office.obj --cells 12 --frame-samples 8 --frame-size 64 -o x.pvs
+# Rounds: after the first, frames only where the last ones still found something.
+"$VC" bake office.obj --cells 12 --samples 20000 --max-cells 60 --agvs-samples 20000 --frame-samples 8 \
+  --frame-size 64x48 --frame-rounds 3 -o framed3.pvs 2>err.txt && grep -q "frame round 2" err.txt && ok ||
+  bad "bake --frame-rounds 3: $(grep 'frame round' err.txt)"
 cp bake1.pvs keep.pvs
 expect_error "too small" "$VC" bake office.obj --memory 50 --samples 20000 --max-cells 300 --agvs-samples 50000 \
   -o keep.pvs -q

@@ -270,7 +270,8 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   out.object_count = file.object_count;
   const ViewCellSet set = first_cut(c, file, log);
   const uint64_t sampling_frames = std::min<uint64_t>(uint64_t{c.frame_samples} * set.cells.size(), 10'000'000);
-  if (sampling_frames) check_frame_budget(sampling_frames, c.sample_frame.width, c.sample_frame.height);  // before AGVS
+  if (sampling_frames)  // before AGVS
+    check_frame_budget(sampling_frames * std::max(c.frame_rounds, 1u), c.sample_frame.width, c.sample_frame.height);
   const PvsFile sampled = pvs_file_for(file, set);
   const CellLocator cells(sampled.bsp, sampled.leaf_cell, sampled.pvs.cell_count);
   // The file's cells cover every point of a map's non-solid space (covered_view_box), and the
@@ -293,18 +294,41 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   std::vector<std::vector<uint32_t>> lists = sample_pvs(run, loaded, sampled, cells, cams, out, log);
   if (c.frame_samples) {
     // Frames where viewers are, from a seed of their own (the measuring cameras' is c.cameras.seed).
+    // After the first round, only the cells whose frames still added something get more: about
+    // as many frames again, drawn from the same distribution and kept where they land in those.
     Stopwatch sw;
-    CameraConfig sc = c.cameras;
-    sc.count = static_cast<uint32_t>(sampling_frames);
-    sc.seed = c.cameras.seed + 0x5a3'0001;
-    const CameraSet samplers = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), sc,
-                                            [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
-                                            &covered_cells);
-    out.frame_sample_cameras = samplers.cameras.size();
-    out.frame_sample_entries = add_frame_samples(*loaded.caster, samplers.cameras, samplers.cells, c.sample_frame, lists);
+    std::vector<uint8_t> active(lists.size(), 1);
+    std::string rule;
+    for (uint32_t round = 0; round < c.frame_rounds; ++round) {
+      const size_t n_active = static_cast<size_t>(std::count(active.begin(), active.end(), 1));
+      if (n_active == 0) break;
+      CameraConfig sc = c.cameras;
+      sc.count = static_cast<uint32_t>(std::min<uint64_t>(sampling_frames * lists.size() / n_active, 10'000'000));
+      sc.seed = c.cameras.seed + 0x5a3'0001 + round;
+      const CameraSet drawn = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), sc,
+                                           [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
+                                           &covered_cells);
+      rule = drawn.rule;
+      std::vector<Camera> kept;
+      std::vector<int32_t> kept_cells;
+      for (size_t i = 0; i < drawn.cameras.size() && kept.size() < sampling_frames; ++i)
+        if (drawn.cells[i] >= 0 && active[static_cast<size_t>(drawn.cells[i])]) {
+          kept.push_back(drawn.cameras[i]);
+          kept_cells.push_back(drawn.cells[i]);
+        }
+      std::vector<size_t> before(lists.size());
+      for (size_t i = 0; i < lists.size(); ++i) before[i] = lists[i].size();
+      const uint64_t added = add_frame_samples(*loaded.caster, kept, kept_cells, c.sample_frame, lists);
+      for (size_t i = 0; i < lists.size(); ++i) active[i] = active[i] && lists[i].size() > before[i];
+      out.frame_sample_cameras += kept.size();
+      out.frame_sample_entries += added;
+      if (c.frame_rounds > 1)
+        log("viewcells: bake: frame round " + std::to_string(round + 1) + ": " + std::to_string(kept.size()) +
+            " frames in " + std::to_string(n_active) + " cells added " + std::to_string(added) + " entries");
+    }
     out.frame_sample_seconds = sw.seconds();
     log("viewcells: bake: " + std::to_string(out.frame_sample_cameras) + " sampling frames of " +
-        std::to_string(c.sample_frame.width) + "x" + std::to_string(c.sample_frame.height) + " (" + samplers.rule +
+        std::to_string(c.sample_frame.width) + "x" + std::to_string(c.sample_frame.height) + " (" + rule +
         ") added " + std::to_string(out.frame_sample_entries) + " PVS entries in " + fmt(out.frame_sample_seconds, 1) +
         " s");
   }

@@ -53,6 +53,9 @@ struct BakeConfig {
   /// PVS. 0: none. Bounded by kMaxFrameRays, not by max_seconds.
   uint32_t frame_samples = 0;
   FrameConfig sample_frame{256, 192, 90.0, 1024 * 1024};
+  /// Rounds of frame samples: after the first, only the cells whose last frames added an entry
+  /// get about as many frames again (drawn from the same distribution, kept in those cells).
+  uint32_t frame_rounds = 1;
   std::string output;              ///< .pvs
   std::string work_dir;            ///< empty: nothing kept between runs
   double checkpoint_seconds = 60;  ///< with a work directory: AGVS state saved this often (0: at the end)
