@@ -335,9 +335,9 @@ TEST(Pipeline, BakeTimeBoundsTheWholeBake) {
   c.merge_agvs = AgvsConfig{};
   c.merge_agvs->pixel_error = 1e-300;
   c.merge_agvs->show_progress = false;
-  c.max_seconds = 1.0;
+  c.max_seconds = 4.0;  // room for the hierarchy on a loaded or sanitized machine
   const pipeline::BakeResult r = pipeline::bake(c, quiet);
-  EXPECT_LT(r.seconds, 3.0) << "a bound of 1 s (tests never assert tight times)";
+  EXPECT_LT(r.seconds, 12.0) << "a bound of 4 s (tests never assert tight times)";
   EXPECT_EQ(r.agvs.stop_reason, "reached the time limit");
   // A limit the hierarchy uses up is an error, not a file of unsampled PVSs.
   c.max_seconds = 1e-3;
