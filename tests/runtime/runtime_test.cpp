@@ -425,8 +425,8 @@ std::string with_view_box(const std::string& path, int axis, double lo, double h
 TEST(Runtime, LocatesLikeTheToolkitInExtremeViewBoxes) {
   // Boxes a valid container can carry: a span of 1e-310 (its grid scale overflows), of 2e308
   // (hi - lo overflows), far from the origin, of 5.4e307 (the fuzzer's box: extent x grid index
-  // overflowed; data/fuzz/regressions/pvs/runtime-disagrees-1, whose root plane is axial,
-  // reproduces that, these planes do not). The runtime once indexed its grid with
+  // overflowed; data/fuzz/regressions/pvs/runtime-disagrees-grid-overflow, whose root plane is
+  // axial, reproduces that, these planes do not). The runtime once indexed its grid with
   // static_cast<int>(inf or NaN) here and crashed while `viewcells query` answered.
   const Level& l = level();
   const Box3& box = l.file.bsp.view_box;
