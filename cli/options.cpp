@@ -86,6 +86,16 @@ CLI::Validator in_range(double lo, double hi) {
                       "NUMBER in [" + short_number(lo) + ", " + short_number(hi) + "]");
 }
 
+std::pair<uint32_t, uint32_t> parse_size(const std::string& text, const std::string& option, uint32_t max) {
+  long w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%ld%c%ld%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X') || w < 1 ||
+      h < 1 || w > max || h > max)
+    throw Error(option + " needs WIDTHxHEIGHT, each from 1 to " + std::to_string(max) + ", e.g. 1024x768 (got '" +
+                text + "')");
+  return {static_cast<uint32_t>(w), static_cast<uint32_t>(h)};
+}
+
 std::vector<double> parse_numbers(const std::string& text, const std::string& option) {
   std::vector<double> v;
   std::stringstream ss(text);
@@ -224,12 +234,9 @@ void add_sampling_options(CLI::App* cmd, SamplingOptions& a) {
 namespace {
 
 void parse_screen(const std::string& text, CostModel& model) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X'))
-    throw Error("--screen needs WIDTHxHEIGHT, e.g. 1024x768 (got '" + text + "')");
-  model.screen_width = w;
-  model.screen_height = h;
+  const auto [w, h] = parse_size(text, "--screen", 65536);
+  model.screen_width = static_cast<int>(w);
+  model.screen_height = static_cast<int>(h);
 }
 
 HeightBandDensity parse_density_band(const std::string& text) {

@@ -62,6 +62,8 @@ CLI::Validator non_negative();
 /// A finite number from lo to hi (NaN is refused, and the message says the range enforced).
 CLI::Validator in_range(double lo, double hi);
 
+/// "WIDTHxHEIGHT" of option `option`, each a whole number from 1 to `max`; Error otherwise.
+std::pair<uint32_t, uint32_t> parse_size(const std::string& text, const std::string& option, uint32_t max);
 /// Comma-separated numbers of option `option`; throws Error naming the option.
 std::vector<double> parse_numbers(const std::string& text, const std::string& option);
 Box3 parse_box(const std::string& text);

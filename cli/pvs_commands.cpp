@@ -1,6 +1,5 @@
 // pvs, bake: potentially visible sets by adaptive global visibility sampling.
 #include <algorithm>
-#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <memory>
@@ -202,17 +201,6 @@ struct BakeArgs {
   uint32_t frame_samples = 0, frame_rounds = 1;
 };
 
-/// "WIDTHxHEIGHT", each from 1 to 2048, of option `option`.
-std::pair<uint32_t, uint32_t> parse_size(const std::string& text, const std::string& option) {
-  const size_t x = text.find('x');
-  const std::vector<double> wh =
-      x == std::string::npos ? std::vector<double>{} : parse_numbers(text.substr(0, x) + "," + text.substr(x + 1), option);
-  if (wh.size() != 2 || wh[0] < 1 || wh[1] < 1 || wh[0] > 2048 || wh[1] > 2048 || wh[0] != std::floor(wh[0]) ||
-      wh[1] != std::floor(wh[1]))
-    throw Error(option + " needs WIDTHxHEIGHT, each from 1 to 2048 (got '" + text + "')");
-  return {static_cast<uint32_t>(wh[0]), static_cast<uint32_t>(wh[1])};
-}
-
 /// "1%" or "1" (percent) -> 0.01.
 double parse_percent(const std::string& text, const std::string& option) {
   std::string number = text;
@@ -249,14 +237,14 @@ pipeline::BakeConfig bake_config(BakeArgs a, const Common& c) {
   config.measure_cameras =
       a.measure_cameras ? a.measure_cameras : by_holes ? 1000 : a.measured_error > 0 ? 5000 : 0;
   if (!a.measure_size.empty()) {
-    std::tie(config.frame.width, config.frame.height) = parse_size(a.measure_size, "--measure-size");
+    std::tie(config.frame.width, config.frame.height) = parse_size(a.measure_size, "--measure-size", 2048);
   } else if (by_holes) {
     config.frame.width = 1024;
     config.frame.height = 768;
   }
   config.frame_samples = a.frame_samples;
   config.frame_rounds = a.frame_rounds;
-  std::tie(config.sample_frame.width, config.sample_frame.height) = parse_size(a.frame_size, "--frame-size");
+  std::tie(config.sample_frame.width, config.sample_frame.height) = parse_size(a.frame_size, "--frame-size", 2048);
   config.agvs = a.agvs.config(c);
   config.agvs.seed = a.sampling.seed;
   config.output = a.output;

@@ -528,6 +528,7 @@ window.viewcells = {
   // colour as the page draws it (8-bit sRGB), for tests.
   get cut() { return cutaway.checked ? Number(cutSlider.value) : null; },
   get sectionCells() { return sectionCells.slice(); },
+  get cellCount() { return cells.count; },
   cellColour: (c) => {
     const v = 3 * cells.firstVertex[c];
     const col = new THREE.Color(cellColours[v], cellColours[v + 1], cellColours[v + 2]).convertLinearToSRGB();

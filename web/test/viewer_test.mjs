@@ -35,8 +35,9 @@ async function screenshotStats(page, png) {
   return page.evaluate(async (data) => {
     const v = window.viewcells;
     const keys = [];
-    for (let c = 0; c < 4096; ++c) {
-      try { const [r, g, b] = v.cellColour(c); keys.push((r << 16) | (g << 8) | b); } catch (e) { break; }
+    for (let c = 0; c < v.cellCount; ++c) {
+      const [r, g, b] = v.cellColour(c);
+      keys.push((r << 16) | (g << 8) | b);
     }
     const img = new Image();
     img.src = 'data:image/png;base64,' + data;

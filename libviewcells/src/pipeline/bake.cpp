@@ -277,9 +277,9 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   // The file's cells cover every point of a map's non-solid space (covered_view_box), and the
   // cameras are located in them as an engine would.
   const Box3 written_box = covered_view_box(loaded.map.get(), sampled.bsp.view_box);
-  PvsFile covered = sampled;
-  covered.bsp.view_box = written_box;
-  const CellLocator covered_cells(covered.bsp, covered.leaf_cell, covered.pvs.cell_count);
+  Subdivision covered_bsp = sampled.bsp;
+  covered_bsp.view_box = written_box;
+  const CellLocator covered_cells(std::move(covered_bsp), sampled.leaf_cell, sampled.pvs.cell_count);
   std::optional<CameraSet> cams;
   if (c.measure_cameras) {
     Stopwatch sw;

@@ -85,11 +85,7 @@ CameraSet draw_cameras(const Scene& scene, const RayCaster& caster, const Q3Map*
     out.points_drawn = play.points_drawn;
     // A player's eye in no view cell is kept, and measured as a failure (measure_frames: an
     // engine gets no PVS there): the frame a player would see, not a reason to stop.
-    for (const Camera& cam : out.cameras) {
-      const int32_t cell = cell_at(cam.eye);
-      if (cell < 0) ++out.uncovered;
-      out.cells.push_back(cell);
-    }
+    for (const Camera& cam : out.cameras) out.cells.push_back(cell_at(cam.eye));
   } else if (map) {
     // Uniform random points of the map's non-solid space (solid space sees nothing a player could).
     Rng rng(c.seed, 93);
@@ -163,8 +159,9 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
 
   Stopwatch sw;
   const CameraSet cams = draw_cameras(scene, *loaded.caster, loaded.map.get(), c.cameras, m.cell_at, m.locator.get());
-  if (cams.uncovered)
-    log("viewcells: warning: " + std::to_string(cams.uncovered) + " of " + std::to_string(cams.cameras.size()) +
+  const auto uncovered = std::count(cams.cells.begin(), cams.cells.end(), -1);
+  if (uncovered)
+    log("viewcells: warning: " + std::to_string(uncovered) + " of " + std::to_string(cams.cameras.size()) +
         " player eyes lie in no view cell of " + (c.pvs_path.empty() ? c.scene.path : c.pvs_path) +
         ": an engine gets no PVS there; they are measured as frames drawing nothing");
   const std::vector<Camera>& cameras = cams.cameras;

@@ -182,8 +182,7 @@ MeasuredPoint measure_solver(const SolverMeasuring& m, const AgvsSolver& solver,
 }
 
 bool MeasuredTarget::met(const PixelErrorMeasure& m) const {
-  const double share = m.cameras ? static_cast<double>(m.cameras_wrong) / m.cameras : 1.0;
-  return any() && (!(mean > 0) || m.pixels <= mean) && (!(holes > 0) || share <= holes);
+  return any() && (!(mean > 0) || m.pixels <= mean) && (!(holes > 0) || m.wrong_frame_share() <= holes);
 }
 
 std::string MeasuredTarget::describe() const {
@@ -209,14 +208,12 @@ double eta(const std::vector<MeasuredPoint>& curve, const MeasuredTarget& target
   if (curve.size() < 2) return std::nan("");
   const MeasuredPoint& a = curve[curve.size() - 2];
   const MeasuredPoint& b = curve.back();
-  const auto share = [](const PixelErrorMeasure& m) {
-    return m.cameras ? static_cast<double>(m.cameras_wrong) / m.cameras : 1.0;
-  };
   const double mean = target.mean > 0
                           ? seconds_to(a.seconds, a.measured.pixels, b.seconds, b.measured.pixels, target.mean)
                           : 0.0;
   const double holes = target.holes > 0
-                           ? seconds_to(a.seconds, share(a.measured), b.seconds, share(b.measured), target.holes)
+                           ? seconds_to(a.seconds, a.measured.wrong_frame_share(), b.seconds, b.measured.wrong_frame_share(),
+                                      target.holes)
                            : 0.0;
   return std::isnan(mean) || std::isnan(holes) ? std::nan("") : std::max(mean, holes);
 }
@@ -240,7 +237,7 @@ bool run_to_measured_error(AgvsSolver& solver, const AgvsConfig& a, const Measur
       return true;
     }
     now.eta_seconds = eta(curve, target);
-    log("viewcells: " + fmt(100.0 * now.measured.cameras_wrong / now.measured.cameras, 2) +
+    log("viewcells: " + fmt(100.0 * now.measured.wrong_frame_share(), 2) +
         "% of frames with a wrong pixel, mean " + fmt(now.measured.pixels, 3) + " (target: " + target.describe() +
         "); " +
         (std::isnan(now.eta_seconds) ? std::string("time left not known yet")
@@ -292,9 +289,10 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   use_map_view_space(map, out.agvs);
   // The file's cells cover every point of a map's non-solid space (covered_view_box): the
   // cameras are located in them as an engine would.
-  PvsFile covered = pf;
-  covered.bsp.view_box = covered_view_box(map.get(), pf.bsp.view_box);
-  const CellLocator covered_cells(covered.bsp, covered.leaf_cell, covered.pvs.cell_count);
+  const Box3 written_box = covered_view_box(map.get(), pf.bsp.view_box);
+  Subdivision covered_bsp = pf.bsp;
+  covered_bsp.view_box = written_box;
+  const CellLocator covered_cells(std::move(covered_bsp), pf.leaf_cell, pf.pvs.cell_count);
   std::optional<CameraSet> cams;
   if (c.measure_cameras) {
     cams = measuring_cameras(c, scenes, map.get(), covered_cells);
@@ -351,7 +349,7 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
         (c.filter.view_neighbours ? "view space, " + std::to_string(c.filter.view_neighbours) + " neighbours" : "") +
         "): mean PVS " + fmt(out.mean_pvs, 1) + " -> " + fmt(out.mean_written, 1) + " objects");
   pf.pvs = compress_pvs(h, set.cells, lists);
-  pf.bsp.view_box = covered.bsp.view_box;
+  pf.bsp.view_box = written_box;
   write_pvs_checked(c.output, pf, lists);
   out.pixel_error = solver->pixel_error();
   out.pixel_error_bound = solver->pixel_error_bound();

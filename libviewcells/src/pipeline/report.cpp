@@ -362,7 +362,7 @@ json measured_curve(const std::vector<MeasuredPoint>& curve) {
                    {"measured_worst_pixels", p.measured.worst_pixels},
                    {"cameras_with_wrong_pixels", p.measured.cameras_wrong},
                    {"frames_with_wrong_pixels_share",
-                    p.measured.cameras ? static_cast<double>(p.measured.cameras_wrong) / p.measured.cameras : 0.0},
+                    p.measured.wrong_frame_share()},
                    {"eta_seconds", number_or_null(p.eta_seconds)}});
   return out;
 }
@@ -713,7 +713,7 @@ std::string report_json(const MeasureResult& r) {
                        {"resolution", c.frame.resolution},
                        {"cameras_with_wrong_pixels", r.error.cameras_wrong},
                        {"frames_with_wrong_pixels_share",
-                        r.error.cameras ? static_cast<double>(r.error.cameras_wrong) / r.error.cameras : 0.0},
+                        r.error.wrong_frame_share()},
                        {"p99_pixels", r.error.p99_pixels},
                        {"worst_pixels", r.error.worst_pixels},
                        {"cameras_in_no_cell", r.error.cameras_uncovered},

@@ -90,6 +90,9 @@ struct PixelErrorMeasure {
   /// when they see anything.
   uint32_t cameras_uncovered = 0;
   std::vector<WrongView> wrong;   ///< every (camera, object) with wrong pixels, by camera then object
+
+  /// The share of frames with any wrong pixel (the holes a player sees), 0 to 1.
+  double wrong_frame_share() const { return cameras ? static_cast<double>(cameras_wrong) / cameras : 0.0; }
 };
 
 /// Renders every camera (in parallel; the result does not depend on the thread count) and

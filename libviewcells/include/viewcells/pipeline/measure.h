@@ -37,12 +37,11 @@ struct CameraSet {
   std::vector<int32_t> cells;
   std::string rule;  ///< how they were placed, in words
   uint64_t points_drawn = 0;
-  uint32_t uncovered = 0;  ///< play cameras in no view cell (cell -1), measured as failures
 };
 
 /// Draws the cameras (serially: reproducible). `map`: the scene's Quake 3 map or null;
-/// `cell_at`: the view cell of a point (-1: none; a play camera in none keeps cell -1 and is
-/// counted in `uncovered`); `locator`: the view cells, needed for view-box cameras on scenes
+/// `cell_at`: the view cell of a point (-1: none; a play camera in none keeps cell -1, which
+/// measure_frames counts as a failure); `locator`: the view cells, needed for view-box cameras on scenes
 /// that are not maps.
 CameraSet draw_cameras(const Scene& scene, const RayCaster& caster, const Q3Map* map, const CameraConfig& config,
                        const std::function<int32_t(const Vec3&)>& cell_at, const CellLocator* locator);
