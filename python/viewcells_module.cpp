@@ -16,7 +16,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <iterator>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -27,6 +30,7 @@
 #include "viewcells/pipeline/bake.h"
 #include "viewcells/pipeline/report.h"
 #include "viewcells/pvs/pvs.h"
+#include "viewcells/vis/level_view.h"
 #include "viewcells/scene/scene.h"
 
 namespace py = pybind11;
@@ -101,21 +105,38 @@ void add_option(std::vector<std::string>& args, const std::string& key, const py
   args.push_back(py::str(value));
 }
 
-/// What a bake wrote, read back: the view cells (their point location, bounds and PVSs), the
-/// report as a dict.
+/// A .pvs file read back: the view cells (their point location, bounds, convex pieces and
+/// PVSs), the merge history above them (coarser cuts), the report of the bake that wrote it as
+/// a dict, and, when the scene is known, the cells as meshes with their render costs.
 struct Baked {
   std::string path;
   PvsFile file;
   std::unique_ptr<CellLocator> cells;
   py::dict report;
+  std::shared_ptr<const Scene> scene;  ///< null until known
+  std::optional<pipeline::SceneSource> scene_file;  ///< read when `scene` is first needed
+  CostModel model;
+  std::vector<std::vector<int32_t>> leaves_of;         ///< per view cell, its BSP leaves (lazily)
+  std::vector<ConvexPolyhedron> leaf_poly;             ///< per BSP node (leaves filled, lazily)
+  std::optional<LevelView> level;                      ///< with a scene (lazily)
 
+  Baked(std::string p, std::shared_ptr<const Scene> s, const CostModel& m)
+      : path(std::move(p)), file(read_pvs(path)), scene(std::move(s)), model(m) {
+    cells = std::make_unique<CellLocator>(file.bsp, file.leaf_cell, file.pvs.cell_count);
+    if (scene && scene->fingerprint() != file.scene_fingerprint)
+      throw Error(scene->source, 0, "is not the scene " + path + " was baked from (fingerprints differ)");
+  }
+
+  uint32_t cell_index(int64_t cell) const {
+    if (cell < 0 || cell >= file.pvs.cell_count) throw Error(path, 0, "no view cell " + std::to_string(cell));
+    return static_cast<uint32_t>(cell);
+  }
   int32_t query(const std::array<double, 3>& p) const {
     const Vec3 q{p[0], p[1], p[2]};
     return cells->cell_at(q);
   }
   py::array_t<uint32_t> pvs(int64_t cell) const {
-    if (cell < 0 || cell >= file.pvs.cell_count) throw Error(path, 0, "no view cell " + std::to_string(cell));
-    const std::vector<uint32_t> ids = file.pvs.cell_pvs(static_cast<uint32_t>(cell));
+    const std::vector<uint32_t> ids = file.pvs.cell_pvs(cell_index(cell));
     return py::array_t<uint32_t>(static_cast<py::ssize_t>(ids.size()), ids.data());
   }
   py::array_t<double> bounds() const {
@@ -130,6 +151,111 @@ struct Baked {
     }
     return out;
   }
+
+  /// A view cell is the union of BSP leaves, each convex: its pieces as (vertices (V, 3), faces:
+  /// vertex lists counter-clockwise seen from outside), found by clipping the view box down the
+  /// tree as the viewers do (a .pvs keeps the tree, not the split order).
+  py::list polyhedra(int64_t cell) {
+    const uint32_t c = cell_index(cell);
+    if (leaves_of.empty()) {
+      leaves_of.resize(file.pvs.cell_count);
+      leaf_poly.resize(file.bsp.nodes.size());
+      clip_to_leaves(file.bsp, ConvexPolyhedron::box(file.bsp.view_box, 0),
+                     [&](int32_t leaf, const ConvexPolyhedron& part) {
+                       const int32_t in = file.leaf_cell[leaf];
+                       if (in < 0 || static_cast<uint32_t>(in) >= file.pvs.cell_count) return;
+                       leaf_poly[leaf] = part;
+                       leaves_of[in].push_back(leaf);
+                     });
+    }
+    py::list out;
+    for (int32_t leaf : leaves_of[c]) {
+      const ConvexPolyhedron& poly = leaf_poly[leaf];
+      py::array_t<double> v({static_cast<py::ssize_t>(poly.vertices().size()), py::ssize_t{3}});
+      auto w = v.mutable_unchecked<2>();
+      for (size_t i = 0; i < poly.vertices().size(); ++i)
+        for (int k = 0; k < 3; ++k) w(i, k) = poly.vertices()[i][k];
+      py::list faces;
+      for (const PolyFace& f : poly.faces()) faces.append(py::cast(f.vertices));
+      out.append(py::make_tuple(v, faces));
+    }
+    return out;
+  }
+
+  /// The coarser view cells of the merge history above the file's: `count` groups (1 to the
+  /// cell count), cut where the history has exactly that many. Returns each cell's group and
+  /// each group's PVS (the union of its cells', which the hierarchy node keeps whole).
+  py::tuple cut(int64_t count) const {
+    const uint32_t n = file.pvs.cell_count;
+    const PvsHierarchy& h = file.pvs;
+    size_t roots = 0;
+    for (size_t i = 0; i < h.node_count(); ++i) roots += h.parent[i] < 0;
+    if (count < static_cast<int64_t>(roots) || count > n)
+      throw Error(path, 0, "the merge history above the " + std::to_string(n) + " view cells cuts from " +
+                               std::to_string(roots) + " to " + std::to_string(n) + " cells, not " +
+                               std::to_string(count));
+    // The merges happened in node order (a parent after its children), each joining two: the
+    // cut of `count` groups is what the first n - count merges made, every node among the first
+    // n + (n - count) whose parent is not among them.
+    const size_t kept = 2 * static_cast<size_t>(n) - static_cast<size_t>(count);
+    std::vector<int32_t> group_of_node(kept, -1);
+    std::vector<int32_t> groups;
+    for (size_t i = 0; i < kept; ++i)
+      if (h.parent[i] < 0 || static_cast<size_t>(h.parent[i]) >= kept) {
+        group_of_node[i] = static_cast<int32_t>(groups.size());
+        groups.push_back(static_cast<int32_t>(i));
+      }
+    for (size_t i = kept; i-- > 0;)  // parents come after children: go down from the top
+      if (group_of_node[i] < 0) group_of_node[i] = group_of_node[h.parent[i]];
+    py::array_t<int32_t> cell_group(static_cast<py::ssize_t>(n));
+    auto g = cell_group.mutable_unchecked<1>();
+    std::vector<std::vector<uint32_t>> lists(groups.size());
+    for (uint32_t c = 0; c < n; ++c) {
+      g(c) = group_of_node[c];
+      std::vector<uint32_t> merged;
+      const std::vector<uint32_t> mine = h.cell_pvs(c);
+      auto& into = lists[g(c)];
+      std::set_union(into.begin(), into.end(), mine.begin(), mine.end(), std::back_inserter(merged));
+      into.swap(merged);
+    }
+    py::list pvs;
+    for (const auto& l : lists) pvs.append(py::array_t<uint32_t>(static_cast<py::ssize_t>(l.size()), l.data()));
+    return py::make_tuple(cell_group, pvs);
+  }
+
+  const LevelView& level_view() {
+    if (!scene && scene_file) {
+      scene = std::shared_ptr<const Scene>(pipeline::load_scene_for_rays(*scene_file, [](const std::string&) {}).scene.release());
+      if (scene->fingerprint() != file.scene_fingerprint)
+        throw Error(scene->source, 0, "is not the scene " + path + " was baked from (fingerprints differ)");
+    }
+    if (!scene)
+      throw Error(path, 0, "needs the scene it was baked from: viewcells.read(path, scene) or a bake of a Scene");
+    if (!level) level = make_level_view(file, *scene, model);
+    return *level;
+  }
+  /// Per view cell, its leaves as one mesh (each leaf shrunk a little towards its centre, as
+  /// the viewers draw them): (vertices (V, 3) float32, triangles (T, 3)).
+  py::list meshes() {
+    const GroupedMesh& m = level_view().cells;
+    py::list out;
+    for (size_t c = 0; c < m.group_count(); ++c) {
+      const uint32_t v0 = m.first_vertex[c], v1 = m.first_vertex[c + 1];
+      const uint32_t i0 = m.first_index[c], i1 = m.first_index[c + 1];
+      py::array_t<float> v({static_cast<py::ssize_t>(v1 - v0), py::ssize_t{3}});
+      std::copy(m.positions.begin() + 3 * v0, m.positions.begin() + 3 * v1, v.mutable_data());
+      py::array_t<uint32_t> t({static_cast<py::ssize_t>((i1 - i0) / 3), py::ssize_t{3}});
+      uint32_t* o = t.mutable_data();
+      for (uint32_t i = i0; i < i1; ++i) *o++ = m.indices[i] - v0;
+      out.append(py::make_tuple(v, t));
+    }
+    return out;
+  }
+  py::array_t<double> costs() {
+    const std::vector<double>& c = level_view().cell_cost;
+    return py::array_t<double>(static_cast<py::ssize_t>(c.size()), c.data());
+  }
+  void write_gltf(const std::string& out) { write_level_gltf(out, level_view()); }
 };
 
 std::shared_ptr<Baked> bake(const py::object& scene, const std::string& output, const py::object& progress,
@@ -159,11 +285,24 @@ std::shared_ptr<Baked> bake(const py::object& scene, const std::string& output, 
     result = pipeline::bake(config, log);
     outputs.commit();
   }
-  auto out = std::make_shared<Baked>();
-  out->path = output;
-  out->file = read_pvs(output);
-  out->cells = std::make_unique<CellLocator>(out->file.bsp, out->file.leaf_cell, out->file.pvs.cell_count);
+  auto out = std::make_shared<Baked>(output, memory, config.model);
+  if (!memory) out->scene_file = config.scene;
   out->report = py::module_::import("json").attr("loads")(pipeline::report_json(result));
+  return out;
+}
+
+/// A .pvs file written earlier, with the scene it was baked from when given (a Scene, or its
+/// file's path and grouping, as `viewcells view --scene` takes them).
+std::shared_ptr<Baked> read_baked(const std::string& path, const py::object& scene, const std::string& objects) {
+  std::shared_ptr<const Scene> memory;
+  if (!scene.is_none() && !py::isinstance<py::str>(scene)) memory = scene.cast<std::shared_ptr<const Scene>>();
+  auto out = std::make_shared<Baked>(path, memory, CostModel{});
+  if (py::isinstance<py::str>(scene)) {
+    pipeline::SceneSource source;
+    source.path = scene.cast<std::string>();
+    source.grouping = parse_grouping(objects);
+    out->scene_file = source;
+  }
   return out;
 }
 
@@ -205,6 +344,12 @@ PYBIND11_MODULE(viewcells, m) {
       .def_property_readonly("object_count", &Scene::object_count)
       .def_property_readonly("triangle_count", &Scene::triangle_count)
       .def_property_readonly("fingerprint", &Scene::fingerprint)
+      .def_property_readonly("object_triangles",
+                             [](const Scene& s) {
+                               std::vector<uint32_t> n;
+                               for (const ObjectInfo& o : s.objects) n.push_back(o.triangle_count);
+                               return n;
+                             }, "Triangles per object (degenerate ones dropped)")
       .def_property_readonly("names", [](const Scene& s) {
         std::vector<std::string> n;
         for (const ObjectInfo& o : s.objects) n.push_back(o.name);
@@ -219,7 +364,24 @@ PYBIND11_MODULE(viewcells, m) {
       .def_property_readonly("cell_bounds", &Baked::bounds, "(cells, 2, 3): each cell's box, lo then hi")
       .def("query", &Baked::query, py::arg("point"), "The view cell of a point, or -1 outside the view space")
       .def("pvs", &Baked::pvs, py::arg("cell"), "The cell's visible objects: sorted ids")
-      .def_readonly("report", &Baked::report, "What `viewcells bake --report` writes, as a dict");
+      .def_readonly("report", &Baked::report, "What `viewcells bake --report` writes, as a dict (empty when read)")
+      .def("polyhedra", &Baked::polyhedra, py::arg("cell"),
+           "The cell's convex pieces (its BSP leaves): a list of (vertices (V, 3), faces), each face a list of "
+           "vertex indices counter-clockwise seen from outside")
+      .def("cut", &Baked::cut, py::arg("count"),
+           "The merge history's cut into `count` coarser cells: (the group of each cell, each group's PVS)")
+      .def_property_readonly("cell_meshes", &Baked::meshes,
+                             "Per cell, its leaves as a mesh (each shrunk 3% towards its centre, as the viewers "
+                             "draw them): (vertices (V, 3) float32, triangles (T, 3)). Needs the scene.")
+      .def_property_readonly("cell_costs", &Baked::costs,
+                             "Per cell, the render cost r(PVS) of its PVS (a + b * triangles per object, the "
+                             "viewers' colours). Needs the scene.")
+      .def("write_gltf", &Baked::write_gltf, py::arg("path"),
+           "Writes the scene and the cells as binary glTF, as `viewcells view --gltf` does. Needs the scene.");
+
+  m.def("read", &read_baked, py::arg("path"), py::arg("scene") = py::none(), py::arg("objects") = "auto",
+        "Reads a .pvs file; `scene` (a Scene or its file's path, with the grouping `objects` it was baked with) "
+        "is needed for cell_meshes, cell_costs and write_gltf");
 
   m.def("bake", &bake, py::arg("scene"), py::arg("output"), py::kw_only(), py::arg("progress") = py::none(),
         "Bakes `scene` (a Scene, or a scene file's path) into the .pvs file `output`, with `viewcells bake`'s "

@@ -105,3 +105,79 @@ def test_progress_and_see_through_and_errors(office, tmp_path):
     with pytest.raises(viewcells.Error, match="unrecognized|not expected|--no-such"):
         viewcells.bake(scene, str(tmp_path / "x.pvs"), cells=2, no_such_option=3)
     assert not (tmp_path / "x.pvs").exists()
+
+
+def polyhedron_volume(vertices, faces):
+    """Volume of a closed polyhedron whose faces are counter-clockwise seen from outside."""
+    total = 0.0
+    for f in faces:
+        a = vertices[f[0]]
+        for k in range(1, len(f) - 1):
+            total += np.dot(a, np.cross(vertices[f[k]], vertices[f[k + 1]])) / 6
+    return total
+
+
+def test_cells_as_convex_pieces_fill_the_view_box(office):
+    baked = viewcells.bake(str(office / "office.obj"), str(office / "p.pvs"), **SETTINGS)
+    bounds = baked.cell_bounds
+    box_lo, box_hi = bounds[:, 0].min(axis=0), bounds[:, 1].max(axis=0)
+    total = 0.0
+    for c in range(baked.cell_count):
+        pieces = baked.polyhedra(c)
+        assert pieces, f"cell {c} has no piece"
+        for vertices, faces in pieces:
+            volume = polyhedron_volume(vertices, faces)
+            assert volume > 0, "faces counter-clockwise from outside give a positive volume"
+            total += volume
+            assert np.all(vertices >= bounds[c, 0] - 1e-9) and np.all(vertices <= bounds[c, 1] + 1e-9)
+            assert baked.query(tuple(vertices.mean(axis=0))) == c  # a convex piece holds its centroid
+    assert total == pytest.approx(np.prod(box_hi - box_lo), rel=1e-9)
+    with pytest.raises(viewcells.Error, match="no view cell"):
+        baked.polyhedra(baked.cell_count)
+
+
+def test_merge_history_cuts_are_the_bakes_of_fewer_cells(office):
+    baked = viewcells.bake(str(office / "office.obj"), str(office / "h.pvs"), **SETTINGS)
+    n = baked.cell_count
+    group, lists = baked.cut(n)
+    assert list(group) == list(range(n)) and all(list(lists[c]) == list(baked.pvs(c)) for c in range(n))
+    group, lists = baked.cut(1)
+    assert set(group) == {0} and set(lists[0]) == set().union(*(set(baked.pvs(c)) for c in range(n)))
+    with pytest.raises(viewcells.Error, match="cuts from 1 to 12"):
+        baked.cut(n + 1)
+    with pytest.raises(viewcells.Error, match="cuts from 1 to 12"):
+        baked.cut(0)
+    # The cut of 5 is the partition a bake of 5 cells from the same hierarchy makes: every point
+    # lies in the same group of either (a bijection of group ids), and a group's PVS is the
+    # union of its cells'.
+    group, lists = baked.cut(5)
+    assert sorted(set(group)) == list(range(5))
+    for g in range(5):
+        assert set(lists[g]) == set().union(*(set(baked.pvs(c)) for c in range(n) if group[c] == g))
+    five = viewcells.bake(str(office / "office.obj"), str(office / "h5.pvs"), **dict(SETTINGS, cells=5))
+    rng = np.random.default_rng(5)
+    lo, hi = baked.cell_bounds[:, 0].min(axis=0), baked.cell_bounds[:, 1].max(axis=0)
+    pairs = {(int(group[baked.query(tuple(p))]), five.query(tuple(p))) for p in rng.uniform(lo, hi, size=(2000, 3))}
+    assert len(pairs) == len({a for a, _ in pairs}) == len({b for _, b in pairs}) == 5, sorted(pairs)
+
+
+def test_cell_meshes_costs_and_gltf_need_the_right_scene(office, tmp_path):
+    scene = viewcells.Scene.load(str(office / "office.obj"))
+    baked = viewcells.bake(scene, str(tmp_path / "m.pvs"), **SETTINGS)
+    meshes, costs = baked.cell_meshes, baked.cell_costs
+    assert len(meshes) == len(costs) == baked.cell_count
+    triangles = np.array(scene.object_triangles)
+    for c, (vertices, tris) in enumerate(meshes):
+        assert vertices.shape[1] == 3 and tris.shape[1] == 3 and tris.max() < len(vertices)
+        assert np.all(vertices >= baked.cell_bounds[c, 0] - 1e-4) and np.all(vertices <= baked.cell_bounds[c, 1] + 1e-4)
+        # r(PVS) with the default cost model, a = 100 per object and b = 1 per triangle
+        assert costs[c] == pytest.approx(np.maximum(100, triangles[baked.pvs(c)]).sum())
+    baked.write_gltf(str(tmp_path / "m.glb"))
+    assert (tmp_path / "m.glb").read_bytes()[:4] == b"glTF"
+    again = viewcells.read(str(tmp_path / "m.pvs"), str(office / "office.obj"))
+    assert np.array_equal(again.cell_costs, costs) and again.report == {}
+    with pytest.raises(viewcells.Error, match="needs the scene"):
+        viewcells.read(str(tmp_path / "m.pvs")).cell_costs
+    other = viewcells.Scene(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float), np.array([[0, 1, 2]]))
+    with pytest.raises(viewcells.Error, match="fingerprints differ"):
+        viewcells.read(str(tmp_path / "m.pvs"), other)
