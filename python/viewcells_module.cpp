@@ -344,6 +344,27 @@ PYBIND11_MODULE(viewcells, m) {
       .def_property_readonly("object_count", &Scene::object_count)
       .def_property_readonly("triangle_count", &Scene::triangle_count)
       .def_property_readonly("fingerprint", &Scene::fingerprint)
+      .def_property_readonly("vertices",
+                             [](const Scene& s) {
+                               py::array_t<double> a({static_cast<py::ssize_t>(s.vertices.size()), py::ssize_t{3}});
+                               auto o = a.mutable_unchecked<2>();
+                               for (size_t i = 0; i < s.vertices.size(); ++i)
+                                 for (int k = 0; k < 3; ++k) o(i, k) = s.vertices[i][k];
+                               return a;
+                             }, "(N, 3) float64, as the scene holds them (z up)")
+      .def_property_readonly("triangles",
+                             [](const Scene& s) {
+                               py::array_t<uint32_t> a({static_cast<py::ssize_t>(s.triangles.size()), py::ssize_t{3}});
+                               auto o = a.mutable_unchecked<2>();
+                               for (size_t i = 0; i < s.triangles.size(); ++i)
+                                 for (int k = 0; k < 3; ++k) o(i, k) = s.triangles[i][k];
+                               return a;
+                             }, "(M, 3) vertex indices")
+      .def_property_readonly("triangle_objects",
+                             [](const Scene& s) {
+                               return py::array_t<uint32_t>(static_cast<py::ssize_t>(s.triangle_object.size()),
+                                                            s.triangle_object.data());
+                             }, "(M,) each triangle's object")
       .def_property_readonly("object_triangles",
                              [](const Scene& s) {
                                std::vector<uint32_t> n;

@@ -181,3 +181,84 @@ def test_cell_meshes_costs_and_gltf_need_the_right_scene(office, tmp_path):
     other = viewcells.Scene(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float), np.array([[0, 1, 2]]))
     with pytest.raises(viewcells.Error, match="fingerprints differ"):
         viewcells.read(str(tmp_path / "m.pvs"), other)
+
+
+def write_png(path, rgb):
+    """An RGB image (h, w, 3) of uint8 as a PNG, with zlib alone."""
+    import struct
+    import zlib
+
+    def chunk(tag, data):
+        return struct.pack(">I", len(data)) + tag + data + struct.pack(">I", zlib.crc32(tag + data) & 0xFFFFFFFF)
+
+    h, w, _ = rgb.shape
+    raw = b"".join(b"\x00" + row.tobytes() for row in rgb)
+    with open(path, "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", struct.pack(">IIBBBBB", w, h, 8, 2, 0, 0, 0))
+                + chunk(b"IDAT", zlib.compress(raw, 9)) + chunk(b"IEND", b""))
+
+
+def cost_colour(t):
+    """blue -> cyan -> green -> yellow -> red for t in [0, 1] (the viewers' scale), per element."""
+    stops = np.array([(0, 0, 1), (0, 1, 1), (0, 1, 0), (1, 1, 0), (1, 0, 0)], float)
+    x = np.clip(t, 0, 1) * 4
+    i = np.minimum(x.astype(int), 3)
+    f = (x - i)[..., None]
+    return stops[i] + (stops[i + 1] - stops[i]) * f
+
+
+def test_a_slice_through_the_cells_from_python(office):
+    """The README's picture for Python: the office's cells at eye height, drawn from query() and
+    cell_costs alone (blue cheapest to red costliest, borders between cells and the walls' cut
+    dark), written to $VIEWCELLS_TEST_OUT/python-slice.png."""
+    scene = viewcells.Scene.load(str(office / "office.obj"))
+    baked = viewcells.bake(scene, str(office / "s.pvs"), **SETTINGS)
+    lo, hi = baked.cell_bounds[:, 0].min(axis=0), baked.cell_bounds[:, 1].max(axis=0)
+    z = lo[2] + 1.6
+    width = 480
+    height = int(round(width * (hi[1] - lo[1]) / (hi[0] - lo[0])))
+    xs = lo[0] + (np.arange(width) + 0.5) * (hi[0] - lo[0]) / width
+    ys = hi[1] - (np.arange(height) + 0.5) * (hi[1] - lo[1]) / height
+    cell = np.array([[baked.query((x, y, z)) for x in xs] for y in ys])
+    assert np.all(cell >= 0), "every point of the view box has a cell"
+    costs = baked.cell_costs
+    t = (costs[cell] - costs.min()) / max(costs.max() - costs.min(), 1e-300)
+    rgb = cost_colour(t) * 0.85 + 0.15
+    border = np.zeros(cell.shape, bool)
+    border[:, 1:] |= cell[:, 1:] != cell[:, :-1]
+    border[1:, :] |= cell[1:, :] != cell[:-1, :]
+    rgb[border] = 0.25
+    # The walls' cut: every triangle that crosses the plane z, drawn as its segment.
+    v = scene.vertices[scene.triangles]  # (M, 3, 3)
+    for tri in v:
+        d = tri[:, 2] - z
+        if d.min() > 0 or d.max() < 0:
+            continue
+        points = [tri[a] + (tri[b] - tri[a]) * (d[a] / (d[a] - d[b])) for a, b in ((0, 1), (1, 2), (2, 0))
+                  if (d[a] < 0) != (d[b] < 0)]
+        if len(points) != 2:
+            continue
+        for s in np.linspace(0, 1, 400):
+            p = points[0] + (points[1] - points[0]) * s
+            i = int((hi[1] - p[1]) / (hi[1] - lo[1]) * height)
+            j = int((p[0] - lo[0]) / (hi[0] - lo[0]) * width)
+            if 0 <= i < height and 0 <= j < width:
+                rgb[i, j] = 0.0
+    shown = set(np.unique(cell))
+    assert len(shown) >= baked.cell_count // 2, f"a slice at eye height crosses most cells: {sorted(shown)}"
+    out = os.environ.get("VIEWCELLS_TEST_OUT")
+    if out:
+        os.makedirs(out, exist_ok=True)
+        write_png(os.path.join(out, "python-slice.png"), (rgb * 255).astype(np.uint8))
+
+
+def test_the_measured_stop_from_python(office, tmp_path):
+    """holes= is --holes: the bake measures frames and stops once few enough show a hole; the
+    report, as a dict, says what the frames saw and what the run measured on the way."""
+    baked = viewcells.bake(str(office / "office.obj"), str(tmp_path / "holes.pvs"),
+                           **dict(SETTINGS, agvs_samples=None), holes="10%", measure_size="256x192", time=120)
+    m = baked.report["measured_pixel_error"]
+    assert (m["width"], m["height"], m["cameras"]) == (256, 192, 1000)
+    assert m["cameras_with_wrong_pixels"] <= 0.10 * m["cameras"]
+    curve = baked.report["measured_curve"]
+    assert curve and curve[-1]["frames_with_wrong_pixels_share"] <= 0.10
