@@ -199,6 +199,8 @@ struct BakeArgs {
   double seconds = 0;  ///< --time: the whole bake
   std::string holes, measure_size, frame_size = "256x192";
   uint32_t frame_samples = 0, frame_rounds = 1;
+  uint32_t near_samples = 0, near_rounds = 2, near_eyes = 64;
+  double near_distance = 0;
 };
 
 /// "1%" or "1" (percent) -> 0.01.
@@ -245,6 +247,10 @@ pipeline::BakeConfig bake_config(BakeArgs a, const Common& c) {
   config.frame_samples = a.frame_samples;
   config.frame_rounds = a.frame_rounds;
   std::tie(config.sample_frame.width, config.sample_frame.height) = parse_size(a.frame_size, "--frame-size", 2048);
+  config.near.rays_per_object = a.near_samples;
+  config.near.rounds = a.near_rounds;
+  config.near.distance = a.near_distance;
+  config.near_eyes = a.near_eyes;
   config.agvs = a.agvs.config(c);
   config.agvs.seed = a.sampling.seed;
   config.output = a.output;
@@ -324,6 +330,23 @@ std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, 
                  "about as many frames again")
       ->capture_default_str()
       ->check(whole(1, 64));
+  bk->add_option("--near-samples", a->near_samples,
+                 "After AGVS, near-object samples: every view cell tests each object whose box lies within "
+                 "--near-distance of an object of its PVS and that it lacks, with this many rays from its viewpoints "
+                 "(placed as measuring cameras are, --near-eyes a cell on average, a seed of their own) to random "
+                 "points on the object; the object joins the PVS when a ray reaches it unblocked (0: none)")
+      ->check(whole(0, 4096));
+  bk->add_option("--near-rounds", a->near_rounds,
+                 "Rounds of --near-samples: each round tests the neighbours of what the last one added")
+      ->capture_default_str()
+      ->check(whole(1, 64));
+  bk->add_option("--near-eyes", a->near_eyes, "Viewpoints a cell has on average for --near-samples")
+      ->capture_default_str()
+      ->check(whole(1, 100000));
+  bk->add_option("--near-distance", a->near_distance,
+                 "Objects are neighbours for --near-samples when their boxes are at most this far apart (default "
+                 "1/1000 of the scene's bounding box diagonal)")
+      ->check(non_negative());
   bk->add_option("--measure-size", a->measure_size,
                  "Frames of the measuring cameras, WIDTHxHEIGHT (default 1024x768 with --holes, else 64x48)");
   bk->add_option("--measure-cameras", a->measure_cameras,

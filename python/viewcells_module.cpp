@@ -256,6 +256,29 @@ struct Baked {
     return py::array_t<double>(static_cast<py::ssize_t>(c.size()), c.data());
   }
   void write_gltf(const std::string& out) { write_level_gltf(out, level_view()); }
+  std::vector<std::vector<uint32_t>> neighbours() const { return cells->neighbours(); }
+  /// The same view cells and point location with other PVSs, written as a .pvs (checked on
+  /// reading back), and read back.
+  std::shared_ptr<Baked> with_pvs(const std::string& out, const std::vector<std::vector<uint32_t>>& lists) const {
+    PvsFile f = file;
+    for (const auto& l : lists)
+      for (uint32_t o : l)
+        if (o >= f.object_count) throw Error(out, 0, "object id " + std::to_string(o) + " is not below the object count");
+    std::vector<std::vector<uint32_t>> sorted = lists;
+    for (auto& l : sorted) {
+      std::sort(l.begin(), l.end());
+      l.erase(std::unique(l.begin(), l.end()), l.end());
+    }
+    f.pvs = recompress_pvs(file.pvs, sorted);
+    {
+      OutputBatch outputs;
+      write_pvs(out, f);
+      outputs.commit();
+    }
+    auto b = std::make_shared<Baked>(out, scene, model);
+    b->scene_file = scene_file;
+    return b;
+  }
 };
 
 std::shared_ptr<Baked> bake(const py::object& scene, const std::string& output, const py::object& progress,
@@ -397,6 +420,11 @@ PYBIND11_MODULE(viewcells, m) {
       .def_property_readonly("cell_costs", &Baked::costs,
                              "Per cell, the render cost r(PVS) of its PVS (a + b * triangles per object, the "
                              "viewers' colours). Needs the scene.")
+      .def_property_readonly("neighbours", &Baked::neighbours,
+                             "Per cell, the cells sharing a part of its boundary of positive area, sorted")
+      .def("with_pvs", &Baked::with_pvs, py::arg("path"), py::arg("lists"),
+           "Writes the same cells with other PVSs (one list of object ids per cell) to `path` as a .pvs, "
+           "compressed through the same hierarchy, and returns it read back")
       .def("write_gltf", &Baked::write_gltf, py::arg("path"),
            "Writes the scene and the cells as binary glTF, as `viewcells view --gltf` does. Needs the scene.");
 

@@ -584,6 +584,22 @@ assert rounds and rounds[0][0] == 1 and rounds[0][1] > 0, rounds
 for (k, added), nxt in zip(rounds, rounds[1:] + [None]):
     assert (nxt is not None) == (added > 0 and k < 3), rounds
 " && ok || bad "bake --frame-rounds 3: $(grep 'frame round' err.txt)"
+# Near-object samples: after one AGVS batch, neighbours of what the cells see are tested and the
+# visible ones added (invariant on any CPU: the file holds at least the entries without them,
+# and the report counts what was tested and added).
+expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --max-cells 60 --agvs-samples 1000 --batch 1000 \
+  -o unnear.pvs --report unnear.json -q
+expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --max-cells 60 --agvs-samples 1000 --batch 1000 \
+  --near-samples 32 --near-eyes 16 -o near.pvs --report near.json -q
+python3 -c "
+import json, re
+a, b = json.load(open('unnear.json')), json.load(open('near.json'))
+e = b['effects']['near_samples']
+tested, added = map(int, re.match(r'(\d+) \(cell, neighbouring object\) pairs tested .* added (\d+) PVS entries', e['reason']).groups())
+assert e['enabled'] and tested > 0 and b['pvs_entries'] == a['pvs_entries'] + added, (e, a['pvs_entries'], b['pvs_entries'])
+assert not a['effects']['near_samples']['enabled']
+" && ok || bad "bake --near-samples: report"
+expect_error "near-samples" "$VC" bake office.obj --cells 12 --near-samples 5000 -o x.pvs
 cp bake1.pvs keep.pvs
 expect_error "too small" "$VC" bake office.obj --memory 50 --samples 20000 --max-cells 300 --agvs-samples 50000 \
   -o keep.pvs -q

@@ -332,6 +332,30 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
         ") added " + std::to_string(out.frame_sample_entries) + " PVS entries in " + fmt(out.frame_sample_seconds, 1) +
         " s");
   }
+  if (c.near.rays_per_object) {
+    // Viewpoints where viewers are, from a seed of their own, grouped by cell.
+    Stopwatch sw;
+    CameraConfig ec = c.cameras;
+    ec.count = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{c.near_eyes} * lists.size(), 10'000'000));
+    ec.seed = c.cameras.seed + 0x6e65'0001;
+    const CameraSet drawn = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), ec,
+                                         [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
+                                         &covered_cells);
+    std::vector<std::vector<Vec3>> eyes(lists.size());
+    for (size_t i = 0; i < drawn.cameras.size(); ++i)
+      if (drawn.cells[i] >= 0) eyes[static_cast<size_t>(drawn.cells[i])].push_back(drawn.cameras[i].eye);
+    NearSampleConfig nc = c.near;
+    nc.seed = c.agvs.seed;
+    out.near = add_near_samples(*loaded.scene, *loaded.caster, eyes, nc, lists);
+    out.near_eyes = drawn.cameras.size();
+    out.near_seconds = sw.seconds();
+    std::string rounds;
+    for (uint64_t a : out.near.added_by_round) rounds += (rounds.empty() ? "" : ", ") + std::to_string(a);
+    log("viewcells: bake: near-object samples (" + drawn.rule + ", " + std::to_string(out.near_eyes) +
+        " viewpoints; neighbours within " + fmt(out.near.distance, 3) + "): " + std::to_string(out.near.tested) +
+        " objects tested with " + std::to_string(out.near.rays) + " rays added " + std::to_string(out.near.added) +
+        " PVS entries (by round: " + rounds + ") in " + fmt(out.near_seconds, 2) + " s");
+  }
   out.agvs_cells = static_cast<uint32_t>(set.cells.size());
   ViewCellSet written = set;
   std::vector<std::vector<uint32_t>> written_lists = lists;
@@ -355,7 +379,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     bytes = write_cut(c.output, file, written, &written_lists, true, written_box);
   }
   if (cams) {
-    if (written.cells.size() == set.cells.size() && !out.measured_curve.empty() && !c.frame_samples) {
+    if (written.cells.size() == set.cells.size() && !out.measured_curve.empty() && !c.frame_samples && !c.near.rays_per_object) {
       out.measured = out.measured_curve.back().measured;  // the PVSs written, measured last
     } else {
       // The cells written (coarser when the budget coarsened them): each camera's is found again.

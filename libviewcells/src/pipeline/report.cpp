@@ -622,7 +622,15 @@ std::string report_json(const BakeResult& r) {
                                    "x" + std::to_string(c.sample_frame.height) + " from cameras of their own seed added " +
                                    std::to_string(r.frame_sample_entries) + " PVS entries in " +
                                    fmt(r.frame_sample_seconds, 2) + " s (--frame-samples)"
-                             : "not asked for (--frame-samples)")}}},
+                             : "not asked for (--frame-samples)")},
+                 {"near_samples",
+                  effect(c.near.rays_per_object > 0,
+                         c.near.rays_per_object > 0
+                             ? std::to_string(r.near.tested) + " (cell, neighbouring object) pairs tested with " +
+                                   std::to_string(r.near.rays) + " rays from " + std::to_string(r.near_eyes) +
+                                   " viewpoints added " + std::to_string(r.near.added) + " PVS entries in " +
+                                   fmt(r.near_seconds, 2) + " s (--near-samples)"
+                             : "not asked for (--near-samples)")}}},
                {"scene_fingerprint", r.scene_fingerprint},
                {"objects", r.object_count},
                {"cells", r.cells},

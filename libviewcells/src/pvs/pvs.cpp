@@ -127,6 +127,45 @@ constexpr char kFlatMagic[5] = "VFLT";
 
 }  // namespace
 
+PvsHierarchy recompress_pvs(const PvsHierarchy& shape, const std::vector<std::vector<uint32_t>>& cell_pvs) {
+  if (cell_pvs.size() != shape.cell_count) throw Error("recompress_pvs: one PVS per view cell is needed");
+  const size_t total = shape.node_count();
+  std::vector<std::vector<uint32_t>> full(total);
+  std::vector<bool> filled(total, false);
+  for (size_t c = 0; c < cell_pvs.size(); ++c) {
+    if (!std::is_sorted(cell_pvs[c].begin(), cell_pvs[c].end()) ||
+        std::adjacent_find(cell_pvs[c].begin(), cell_pvs[c].end()) != cell_pvs[c].end())
+      throw Error("recompress_pvs: the PVS of cell " + std::to_string(c) + " is not sorted distinct ids");
+    full[c] = cell_pvs[c];
+    filled[c] = true;
+  }
+  for (size_t n = 0; n < total; ++n) {  // children come before their parent
+    const int32_t p = shape.parent[n];
+    if (p < 0) continue;
+    if (!filled[p]) {
+      full[p] = full[n];
+      filled[p] = true;
+    } else {
+      std::vector<uint32_t> both;
+      std::set_intersection(full[p].begin(), full[p].end(), full[n].begin(), full[n].end(), std::back_inserter(both));
+      full[p].swap(both);
+    }
+  }
+  PvsHierarchy out;
+  out.cell_count = shape.cell_count;
+  out.parent = shape.parent;
+  out.stored.resize(total);
+  for (size_t n = 0; n < total; ++n) {
+    if (out.parent[n] < 0) {
+      out.stored[n] = full[n];
+      continue;
+    }
+    const auto& up = full[out.parent[n]];
+    std::set_difference(full[n].begin(), full[n].end(), up.begin(), up.end(), std::back_inserter(out.stored[n]));
+  }
+  return out;
+}
+
 uint64_t list_bytes(const std::vector<std::vector<uint32_t>>& lists, uint32_t object_count, uint32_t format) {
   VC_CHECK(format == 1 || format == kVersion);
   for (const auto& l : lists)

@@ -14,6 +14,7 @@
 #include "viewcells/merge/merge.h"
 #include "viewcells/pipeline/build.h"
 #include "viewcells/pipeline/pvs.h"
+#include "viewcells/pvs/near_samples.h"
 
 namespace viewcells::pipeline {
 
@@ -56,6 +57,11 @@ struct BakeConfig {
   /// Rounds of frame samples: after the first, only the cells whose last frames added an entry
   /// get about as many frames again (drawn from the same distribution, kept in those cells).
   uint32_t frame_rounds = 1;
+  /// Near-object samples after AGVS (and the frame samples): each cell tests the neighbours of
+  /// its PVS's objects with rays from `near_eyes` viewpoints a cell on average (placed as the
+  /// measuring cameras are, from a seed of their own). rays_per_object 0: none.
+  NearSampleConfig near{0, 2, 0, 1};
+  uint32_t near_eyes = 64;
   std::string output;              ///< .pvs
   std::string work_dir;            ///< empty: nothing kept between runs
   double checkpoint_seconds = 60;  ///< with a work directory: AGVS state saved this often (0: at the end)
@@ -84,6 +90,9 @@ struct BakeResult {
   // Frames as a sampler (frame_samples): cameras drawn, entries they added, seconds.
   uint64_t frame_sample_cameras = 0, frame_sample_entries = 0;
   double frame_sample_seconds = 0;
+  NearSampleStats near;  ///< of the near-object samples
+  uint64_t near_eyes = 0;
+  double near_seconds = 0;
   bool agvs_in_view_space = false;  ///< a Quake 3 map: AGVS drew its points in the non-solid space
   uint64_t pvs_entries = 0, file_bytes = 0;
   uint64_t list_bytes = 0;  ///< the visible sets of the file written as a compact handle holds them

@@ -33,6 +33,12 @@ struct PvsHierarchy {
 PvsHierarchy compress_pvs(const MergeHistory& h, const std::vector<int32_t>& cells,
                           const std::vector<std::vector<uint32_t>>& cell_pvs);
 
+/// The hierarchy `shape` (its cells and merge nodes, each parent after its children) holding the
+/// cells' PVSs `cell_pvs` instead (sorted ids, one list per cell): each merge node keeps the
+/// intersection of its children's, as compress_pvs. Error when a list is not sorted or the
+/// count differs.
+PvsHierarchy recompress_pvs(const PvsHierarchy& shape, const std::vector<std::vector<uint32_t>>& cell_pvs);
+
 /// Bytes of sorted id lists below `object_count` as the .pvs file codes them (binary
 /// interpolative coding, runtime/src/id_lists.h; before the container's zstd, which finds
 /// little more in them). Linear in the entries. `format` 1 gives what format 1 took (LEB128
