@@ -1,6 +1,6 @@
 #pragma once
 // The coding of the .pvs file's object lists (format version 2), shared by the toolkit that
-// writes them (libviewcells/src/pvs/pvs.cpp) and the engines' reader (runtime.cpp).
+// writes them (libviewcells/src/pvs/pvs.cpp) and the engines' reader (load.cpp, c_api.cpp).
 //
 // Every list of the hierarchy is a sorted set of distinct object ids below `universe` (the
 // file's object count). The lists follow one another in one bit stream, least significant
