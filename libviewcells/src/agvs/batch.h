@@ -1,0 +1,59 @@
+#pragma once
+// AGVS paper 4.1: what one batch of global visibility sampling holds between its steps, drawn
+// (batch_draw.cpp), cast (batch_cast.cpp) and applied (batch.cpp). Internal to the solver.
+#include <cstdint>
+#include <vector>
+
+#include "solver_impl.h"
+
+namespace viewcells {
+
+/// The view space-direction samples last: they also replace the draws that failed (no
+/// mutation candidate left, a degenerate two-point pair), so every batch has n samples.
+inline constexpr int kOrder[kDists] = {kSil, kTpm, kOd, kTp, kVsd};
+
+/// A batch's samples, grouped by distribution so that each distribution's rays are counted
+/// exactly: samples first_of[d] .. end_of[d] - 1 are distribution d's.
+struct AgvsSolver::Impl::BatchSamples {
+  std::vector<Vec3> points, dirs;
+  std::vector<int32_t> ref_cell;  ///< REF: the cell each sample belongs to
+  /// The mutation samples' runs by lane: distribution, lane, first sample, count. Only the
+  /// lane's owner (a rank) knows their points.
+  struct LaneRange {
+    int dist;
+    uint32_t lane, first, size;
+  };
+  std::vector<LaneRange> lane_ranges;
+  uint32_t first_of[kDists] = {}, end_of[kDists] = {};
+  uint64_t discovery_rays = 0;  ///< the silhouette searches' rays
+};
+
+/// Segments cast from a fixed run of one distribution's samples.
+struct AgvsSolver::Impl::BatchChunk {
+  uint32_t first = 0, size = 0;
+  int dist = 0;
+  int32_t lane = -1;  ///< the first mutation lane whose samples these are (-1: a stationary distribution's)
+  SegmentSet segs;
+  std::vector<uint32_t> sample_of;
+  /// Every (segment, cell) with the segment having length in the cell, in segment order (not for
+  /// REF); on several ranks only those of this rank's cells (cell mod ranks == rank).
+  struct CellPair {
+    uint32_t segment;  ///< index in the chunk
+    int32_t cell;
+  };
+  std::vector<CellPair> pairs;
+  uint64_t pierced = 0;  ///< all ranks' pairs
+  uint64_t rays = 0;
+  size_t seg_start = 0;  ///< index of its first segment among the batch's
+};
+
+
+/// Lane l's share of n draws.
+inline uint32_t lane_share(uint32_t n, size_t lanes, size_t l) {
+  return static_cast<uint32_t>(n / lanes + (l < n % lanes ? 1 : 0));
+}
+/// Lane l's random stream in batch `index`: lane 0's is the batch's own (one lane draws as the
+/// single buffer did).
+inline uint64_t lane_stream(uint64_t index, size_t l) { return 1000 + index + (static_cast<uint64_t>(l) << 40); }
+
+}  // namespace viewcells
