@@ -178,6 +178,7 @@ namespace {
 /// The bytes of a cut's .pvs: the whole file, and its compressed PVS lists alone.
 struct CutBytes {
   uint64_t file = 0, lists = 0;
+  std::shared_ptr<const PvsFile> pvs;  ///< the file's content, when written (or kept in memory)
   uint64_t budgeted(bool lists_only) const { return lists_only ? lists : file; }
 };
 
@@ -191,12 +192,14 @@ CutBytes write_cut(const std::string& path, const SubdivisionFile& file, const V
   if (lists) pf.pvs = compress_pvs(*file.history, set.cells, *lists);
   CutBytes b;
   b.lists = compact_pvs_bytes(pf.pvs, pf.object_count);
-  if (!check) {
+  if (!check || path.empty()) {  // sizing a candidate cut, or a bake kept in memory
     b.file = pvs_file_bytes(pf);
+    if (check) b.pvs = std::make_shared<const PvsFile>(std::move(pf));
     return b;
   }
   write_pvs_checked(path, pf, *lists);
   b.file = std::filesystem::file_size(staged_path(path));
+  b.pvs = std::make_shared<const PvsFile>(std::move(pf));
   return b;
 }
 
@@ -399,6 +402,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
           fmt(out.measured->median_pixels, 3) + ") in " + fmt(sw.seconds(), 1) + " s");
     }
   }
+  out.file = bytes.pvs;
   out.file_bytes = bytes.file;
   out.list_bytes = bytes.lists;
   out.cells = static_cast<uint32_t>(written.cells.size());
@@ -415,7 +419,8 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
       (out.measured ? ", measured " + fmt(out.measured->pixels, 2) + " (median camera " +
                           fmt(out.measured->median_pixels, 2) + ")"
                     : std::string()) +
-      " after " + std::to_string(out.agvs.samples) + " samples (" + out.agvs.stop_reason + "); " + c.output + ": " +
+      " after " + std::to_string(out.agvs.samples) + " samples (" + out.agvs.stop_reason + "); " +
+      (c.output.empty() ? std::string("in memory") : c.output) + ": " +
       std::to_string(out.file_bytes) + " bytes in " + fmt(out.seconds, 1) + " s");
   return out;
 }

@@ -7,6 +7,7 @@
 /// With a work directory, a rerun with the same settings reuses the hierarchy and continues
 /// the AGVS state instead of starting over.
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -62,7 +63,7 @@ struct BakeConfig {
   /// measuring cameras are, from a seed of their own). rays_per_object 0: none.
   NearSampleConfig near{0, 2, 0, 1};
   uint32_t near_eyes = 64;
-  std::string output;              ///< .pvs
+  std::string output;              ///< .pvs; empty: nothing written (the result is in BakeResult::file)
   std::string work_dir;            ///< empty: nothing kept between runs
   double checkpoint_seconds = 60;  ///< with a work directory: AGVS state saved this often (0: at the end)
 };
@@ -94,6 +95,9 @@ struct BakeResult {
   uint64_t near_eyes = 0;
   double near_seconds = 0;
   bool agvs_in_view_space = false;  ///< a Quake 3 map: AGVS drew its points in the non-solid space
+  /// The view cells and PVSs baked, as written to `output` (point location, hierarchy,
+  /// compressed lists and names): what read_pvs(output) gives, also when nothing was written.
+  std::shared_ptr<const PvsFile> file;
   uint64_t pvs_entries = 0, file_bytes = 0;
   uint64_t list_bytes = 0;  ///< the visible sets of the file written as a compact handle holds them
   double mean_pvs = 0;
