@@ -444,7 +444,9 @@ b, m = json.load(open('dm2mbake.json')), json.load(open('dm2mm.json'))
 e = b['measured_pixel_error']
 assert e['pixels'] <= 300 and e['cameras'] == 300 and 'spawn points' in e['placement'], e
 assert b['agvs']['stop_reason'].startswith('measured pixel error'), b['agvs']['stop_reason']
-assert b['measured_curve'][-1]['measured_pixels'] == e['pixels'], b['measured_curve']
+# The near-object samples after AGVS (bake's default) only add entries: the file written shows
+# at most what AGVS's last measurement did.
+assert e['pixels'] <= b['measured_curve'][-1]['measured_pixels'], (b['measured_curve'][-1], e)
 assert abs(m['pixel_error']['pixels'] - e['pixels']) <= 1e-9 * max(1, e['pixels']), (m['pixel_error'], e)
 " && ok || bad "bake --measured-error on oa_dm2: the report and measure disagree"
   expect_ok "$VC" measure "$MAPS/oa_dm2.bsp" dm2.pvs --count 300 --width 64 --height 48 --report ourm.json -q
@@ -588,7 +590,7 @@ for (k, added), nxt in zip(rounds, rounds[1:] + [None]):
 # visible ones added (invariant on any CPU: the file holds at least the entries without them,
 # and the report counts what was tested and added).
 expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --max-cells 60 --agvs-samples 1000 --batch 1000 \
-  -o unnear.pvs --report unnear.json -q
+  --near-samples 0 -o unnear.pvs --report unnear.json -q
 expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --max-cells 60 --agvs-samples 1000 --batch 1000 \
   --near-samples 32 --near-eyes 16 -o near.pvs --report near.json -q
 python3 -c "

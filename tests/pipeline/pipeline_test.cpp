@@ -365,8 +365,18 @@ TEST(Pipeline, BakeMeetsAHoleTargetThatIndependentCamerasConfirm) {
   c.cells = 60;
   c.agvs.max_samples = 1000;
   c.agvs.batch_size = 1000;
+  c.near.rays_per_object = 0;  // AGVS alone
   pipeline::bake(c, quiet);
-  EXPECT_GT(holes_of(early, 2), target + slack) << "a bake of one batch should miss the target";
+  const double early_holes = holes_of(early, 2);
+  EXPECT_GT(early_holes, target + slack) << "a bake of one batch should miss the target";
+  // The same batch with near-object samples (bake's default) only adds entries: never more
+  // holes, and here far fewer.
+  const std::string near = test::temp_path("holes-near.pvs");
+  c.output = near;
+  c.near = NearSampleConfig{};
+  const pipeline::BakeResult with_near = pipeline::bake(c, quiet);
+  EXPECT_GT(with_near.near.added, 0u);
+  EXPECT_LT(holes_of(near, 2), early_holes);
   c = small_bake(met);
   c.cells = 60;
   c.agvs.max_samples = 0;

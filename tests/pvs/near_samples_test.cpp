@@ -70,10 +70,11 @@ TEST(NearSamples, AddVisibleNeighboursOnlyAndDoNotDependOnTheThreads) {
   EXPECT_EQ(lists[1], std::vector<uint32_t>{w.far});  // the far box touches nothing
   EXPECT_EQ(lists[2], std::vector<uint32_t>{w.wall});  // no viewpoints: left as it was
   EXPECT_EQ(stats.added, 2u);
-  // Round 1 tests the wall's three neighbours; round 2 the neighbours of the trim and the glass,
-  // the wall alone, which the PVS holds: nothing more.
+  // Round 1 tests the wall's three neighbours; round 2 would test the neighbours of the trim and
+  // the glass, the wall alone, which the PVS holds: there is no round 2.
   EXPECT_EQ(stats.tested, 3u);
-  EXPECT_EQ(stats.added_by_round, (std::vector<uint64_t>{2, 0}));
+  EXPECT_EQ(stats.added_by_round, (std::vector<uint64_t>{2}));
+  EXPECT_EQ(stats.rays_by_round, (std::vector<uint64_t>{64}));
   EXPECT_EQ(stats.rays, stats.tested * config.rays_per_object);
   // Once more: nothing to add. And one thread gives the same lists.
   auto again = lists;
@@ -82,6 +83,25 @@ TEST(NearSamples, AddVisibleNeighboursOnlyAndDoNotDependOnTheThreads) {
   ThreadLimit one(1);
   add_near_samples(w.scene, *caster, cell_eyes, config, serial);
   EXPECT_EQ(serial, lists);
+}
+
+TEST(NearSamples, TheRayBudgetLowersTheRaysACandidateInPackets) {
+  const WallScene w;
+  const auto caster = make_embree_caster(w.scene);
+  const std::vector<std::vector<Vec3>> cell_eyes = {{{-2.0, 0.25, 1.5}}};
+  NearSampleConfig config;
+  config.rays_per_object = 1024;
+  config.distance = 0.01;
+  config.max_rays = 3 * 100;  // three candidates: 100 rays each, down to 96 in whole packets
+  std::vector<std::vector<uint32_t>> lists = {{w.wall}};
+  const NearSampleStats stats = add_near_samples(w.scene, *caster, cell_eyes, config, lists);
+  EXPECT_EQ(stats.rays_by_round, (std::vector<uint64_t>{96}));
+  EXPECT_EQ(stats.rays, 3u * 96u);
+  // Too little for a packet a candidate: nothing is cast.
+  config.max_rays = 3 * 15;
+  std::vector<std::vector<uint32_t>> none = {{w.wall}};
+  EXPECT_EQ(add_near_samples(w.scene, *caster, cell_eyes, config, none).rays, 0u);
+  EXPECT_EQ(none, (std::vector<std::vector<uint32_t>>{{w.wall}}));
 }
 
 }  // namespace

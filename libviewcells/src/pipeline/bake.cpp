@@ -353,7 +353,11 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     out.near_eyes = drawn.cameras.size();
     out.near_seconds = sw.seconds();
     std::string rounds;
-    for (uint64_t a : out.near.added_by_round) rounds += (rounds.empty() ? "" : ", ") + std::to_string(a);
+    for (size_t i = 0; i < out.near.added_by_round.size(); ++i)
+      rounds += (rounds.empty() ? "" : ", ") + std::to_string(out.near.added_by_round[i]) +
+                (out.near.rays_by_round[i] < c.near.rays_per_object
+                     ? " (" + std::to_string(out.near.rays_by_round[i]) + " rays a candidate)"
+                     : std::string());
     log("viewcells: bake: near-object samples (" + drawn.rule + ", " + std::to_string(out.near_eyes) +
         " viewpoints; neighbours within " + fmt(out.near.distance, 3) + "): " + std::to_string(out.near.tested) +
         " objects tested with " + std::to_string(out.near.rays) + " rays added " + std::to_string(out.near.added) +

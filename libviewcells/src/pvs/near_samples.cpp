@@ -93,46 +93,64 @@ NearSampleStats add_near_samples(const Scene& scene, const RayCaster& caster,
   // Per cell, the objects the last round added (the first round: its whole PVS): their
   // neighbours are the next candidates.
   std::vector<std::vector<uint32_t>> fresh = lists;
+  uint64_t rays_left = config.max_rays;
   for (uint32_t round = 0; round < config.rounds; ++round) {
-    std::vector<std::vector<uint32_t>> found(cells);
-    std::vector<uint64_t> tested(cells, 0);
-    Progress progress("near-object samples, round " + std::to_string(round + 1), cells);
+    // Each cell's candidates: the neighbours of what it gained last that it lacks.
+    std::vector<std::vector<uint32_t>> missing(cells);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, cells, 1), [&](const tbb::blocked_range<size_t>& range) {
       std::vector<uint32_t> candidates;
-      std::vector<Ray> rays;
-      std::vector<Hit> hits;
       for (size_t c = range.begin(); c < range.end(); ++c) {
-        throw_if_interrupted("near-object samples");
-        progress.advance();
         if (eyes[c].empty() || fresh[c].empty()) continue;
         candidates.clear();
         for (uint32_t o : fresh[c]) candidates.insert(candidates.end(), near[o].begin(), near[o].end());
         std::sort(candidates.begin(), candidates.end());
         candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
-        std::vector<uint32_t> missing;
         std::set_difference(candidates.begin(), candidates.end(), lists[c].begin(), lists[c].end(),
-                            std::back_inserter(missing));
+                            std::back_inserter(missing[c]));
+        missing[c].erase(std::remove_if(missing[c].begin(), missing[c].end(),
+                                        [&](uint32_t o) { return surface[o].triangles.empty(); }),
+                         missing[c].end());
+      }
+    });
+    uint64_t pairs = 0;
+    for (const auto& m : missing) pairs += m.size();
+    if (pairs == 0) break;
+    // Rays per pair: as asked, fewer (in whole packets of 16, at least one) where the candidates
+    // would take more than the rays left; the same for any number of threads.
+    uint64_t k = config.rays_per_object;
+    if (pairs * k > rays_left) k = std::max<uint64_t>(16, rays_left / pairs / 16 * 16);
+    k = std::min<uint64_t>(k, config.rays_per_object);
+    if (pairs * k > rays_left) break;  // not even a packet a pair is left
+    rays_left -= pairs * k;
+    stats.rays_by_round.push_back(k);
+    const uint32_t per = static_cast<uint32_t>(k);
+    std::vector<std::vector<uint32_t>> found(cells);
+    std::vector<uint64_t> tested(cells, 0);
+    Progress progress("near-object samples, round " + std::to_string(round + 1), cells);
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, cells, 1), [&](const tbb::blocked_range<size_t>& range) {
+      std::vector<Ray> rays(per);
+      std::vector<Hit> hits(per);
+      std::vector<Vec3> targets(per);
+      for (size_t c = range.begin(); c < range.end(); ++c) {
+        throw_if_interrupted("near-object samples");
+        progress.advance();
         Rng rng(config.seed ^ 0x6e65'6172'0000'0000ULL, (uint64_t{round} << 40) ^ c);
-        for (uint32_t o : missing) {
-          if (surface[o].triangles.empty()) continue;
+        for (uint32_t o : missing[c]) {
           ++tested[c];
-          rays.resize(config.rays_per_object);
-          std::vector<Vec3> targets(config.rays_per_object);
           // Sixteen rays from one eye to sixteen points of the object run side by side: Embree
           // casts them as a coherent packet (intersect_coherent).
           const Vec3* eye = nullptr;
-          for (uint32_t k = 0; k < config.rays_per_object; ++k) {
-            if (k % 16 == 0) eye = &eyes[c][rng.below(eyes[c].size())];
-            targets[k] = surface[o].point(scene, rng);
-            rays[k] = Ray{*eye, targets[k] - *eye, 0.0, 1.0 + 1e-6};
+          for (uint32_t r = 0; r < per; ++r) {
+            if (r % 16 == 0) eye = &eyes[c][rng.below(eyes[c].size())];
+            targets[r] = surface[o].point(scene, rng);
+            rays[r] = Ray{*eye, targets[r] - *eye, 0.0, 1.0 + 1e-6};
           }
-          hits.resize(rays.size());
           caster.intersect_coherent(rays, hits);
           const bool occluder = scene.objects[o].occluder;
-          for (uint32_t k = 0; k < config.rays_per_object; ++k) {
+          for (uint32_t r = 0; r < per; ++r) {
             // An occluder is seen when the ray's first hit is on it; what one sees through (not
             // hit by any ray) when nothing stops the ray before the point on it.
-            const bool seen = occluder ? hits[k].hit() && hits[k].object == o : !(hits[k].hit() && hits[k].t < 1 - 1e-6);
+            const bool seen = occluder ? hits[r].hit() && hits[r].object == o : !(hits[r].hit() && hits[r].t < 1 - 1e-6);
             if (seen) {
               found[c].push_back(o);
               break;
@@ -145,7 +163,7 @@ NearSampleStats add_near_samples(const Scene& scene, const RayCaster& caster,
     uint64_t added = 0;
     for (size_t c = 0; c < cells; ++c) {
       stats.tested += tested[c];
-      stats.rays += tested[c] * config.rays_per_object;
+      stats.rays += tested[c] * per;
       std::vector<uint32_t> merged;
       std::set_union(lists[c].begin(), lists[c].end(), found[c].begin(), found[c].end(), std::back_inserter(merged));
       added += merged.size() - lists[c].size();

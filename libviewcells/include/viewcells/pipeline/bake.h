@@ -61,8 +61,8 @@ struct BakeConfig {
   /// Near-object samples after AGVS (and the frame samples): each cell tests the neighbours of
   /// its PVS's objects with rays from `near_eyes` viewpoints a cell on average (placed as the
   /// measuring cameras are, from a seed of their own). rays_per_object 0: none.
-  NearSampleConfig near{0, 2, 0, 1};
-  uint32_t near_eyes = 64;
+  NearSampleConfig near;
+  uint32_t near_eyes = 512;
   std::string output;              ///< .pvs; empty: nothing written (the result is in BakeResult::file)
   std::string work_dir;            ///< empty: nothing kept between runs
   double checkpoint_seconds = 60;  ///< with a work directory: AGVS state saved this often (0: at the end)

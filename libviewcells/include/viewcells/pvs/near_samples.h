@@ -21,11 +21,14 @@
 namespace viewcells {
 
 struct NearSampleConfig {
-  uint32_t rays_per_object = 16;  ///< rays from the cell to each neighbour tested, per round
-  uint32_t rounds = 2;            ///< rounds; a round tests the neighbours of what the last one added
+  uint32_t rays_per_object = 2048;  ///< rays from the cell to each neighbour tested, per round (0: none)
+  uint32_t rounds = 4;              ///< rounds; a round tests the neighbours of what the last one added
   /// Objects are neighbours when their bounding boxes are at most this far apart; <= 0: 1e-3 of
   /// the scene's bounding box diagonal.
   double distance = 0;
+  /// All rounds' rays at most (a bound on the time whatever the scene): where the candidates
+  /// would take more, a round casts fewer rays a candidate, in packets of 16.
+  uint64_t max_rays = uint64_t{1} << 31;
   uint64_t seed = 1;
 };
 
@@ -35,6 +38,7 @@ struct NearSampleStats {
   uint64_t added = 0;   ///< PVS entries added
   double distance = 0;  ///< the neighbour distance used
   std::vector<uint64_t> added_by_round;
+  std::vector<uint64_t> rays_by_round;  ///< rays a candidate each round cast (below K under max_rays)
 };
 
 /// Pairs of rendered objects whose bounding boxes are within `distance` of each other, as a
