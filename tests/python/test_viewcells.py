@@ -262,3 +262,19 @@ def test_the_measured_stop_from_python(office, tmp_path):
     assert m["cameras_with_wrong_pixels"] <= 0.10 * m["cameras"]
     curve = baked.report["measured_curve"]
     assert curve and curve[-1]["frames_with_wrong_pixels_share"] <= 0.10
+
+
+def test_with_pvs_rewrites_the_lists_through_the_same_hierarchy(office, tmp_path):
+    baked = viewcells.bake(str(office / "office.obj"), str(tmp_path / "a.pvs"), **SETTINGS)
+    lists = [baked.pvs(c).tolist() for c in range(baked.cell_count)]
+    same = baked.with_pvs(str(tmp_path / "same.pvs"), lists)
+    assert (tmp_path / "same.pvs").read_bytes() == (tmp_path / "a.pvs").read_bytes()
+    extra = next(o for o in range(baked.object_count) if o not in lists[0])
+    lists[0] = lists[0] + [extra]
+    edited = baked.with_pvs(str(tmp_path / "edited.pvs"), lists)
+    assert extra in edited.pvs(0).tolist()
+    assert all(edited.pvs(c).tolist() == baked.pvs(c).tolist() for c in range(1, baked.cell_count))
+    assert len(same.neighbours) == baked.cell_count and all(c not in n for c, n in enumerate(same.neighbours))
+    with pytest.raises(viewcells.Error, match="not below the object count"):
+        baked.with_pvs(str(tmp_path / "bad.pvs"), [[10**6]] * baked.cell_count)
+    assert not (tmp_path / "bad.pvs").exists()

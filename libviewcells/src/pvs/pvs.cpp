@@ -27,6 +27,24 @@ uint64_t PvsHierarchy::stored_entries() const {
   return n;
 }
 
+namespace {
+
+/// What each node of `out` keeps, given every node's whole PVS `full`: a root all of it, any
+/// other node what its parent's lacks (so a cell's PVS is the union along its path).
+void keep_differences(const std::vector<std::vector<uint32_t>>& full, PvsHierarchy& out) {
+  out.stored.assign(full.size(), {});
+  for (size_t n = 0; n < full.size(); ++n) {
+    if (out.parent[n] < 0) {
+      out.stored[n] = full[n];
+      continue;
+    }
+    const auto& up = full[out.parent[n]];
+    std::set_difference(full[n].begin(), full[n].end(), up.begin(), up.end(), std::back_inserter(out.stored[n]));
+  }
+}
+
+}  // namespace
+
 PvsHierarchy compress_pvs(const MergeHistory& h, const std::vector<int32_t>& cells,
                           const std::vector<std::vector<uint32_t>>& cell_pvs) {
   if (cells.size() != cell_pvs.size()) throw Error("compress_pvs: one PVS per cell is needed");
@@ -66,15 +84,7 @@ PvsHierarchy compress_pvs(const MergeHistory& h, const std::vector<int32_t>& cel
     out.parent[c0->second] = me;
     out.parent[c1->second] = me;
   }
-  out.stored.resize(total);
-  for (size_t n = 0; n < total; ++n) {
-    if (out.parent[n] < 0) {
-      out.stored[n] = full[n];
-      continue;
-    }
-    const auto& up = full[out.parent[n]];
-    std::set_difference(full[n].begin(), full[n].end(), up.begin(), up.end(), std::back_inserter(out.stored[n]));
-  }
+  keep_differences(full, out);
   return out;
 }
 
@@ -154,15 +164,7 @@ PvsHierarchy recompress_pvs(const PvsHierarchy& shape, const std::vector<std::ve
   PvsHierarchy out;
   out.cell_count = shape.cell_count;
   out.parent = shape.parent;
-  out.stored.resize(total);
-  for (size_t n = 0; n < total; ++n) {
-    if (out.parent[n] < 0) {
-      out.stored[n] = full[n];
-      continue;
-    }
-    const auto& up = full[out.parent[n]];
-    std::set_difference(full[n].begin(), full[n].end(), up.begin(), up.end(), std::back_inserter(out.stored[n]));
-  }
+  keep_differences(full, out);
   return out;
 }
 
