@@ -6,8 +6,10 @@
 # The maps are split in two fixed halves by alphabetical position: the tuning half (positions
 # 4k+2 and 4k+3, which holds oa_dm2 and oa_thor, where the sampler's settings were chosen) and
 # the held-out half (the others). Resumable: what a map already has in out/bench/near-samples
-# is kept. Writes the section "nearsamples-HALF" of docs/accuracy-vs-time.md.
-# Usage: scripts/near-samples.sh tuning|held-out [K EYES ROUNDS]   (defaults 2048 512 4)
+# is kept, with the commit its executable was built from (out/bench/near-samples/commit-HALF; the
+# table names it). NEAR_TABLE_ONLY=1 bakes nothing more and writes the table of the maps done
+# so far. Writes the section "nearsamples-HALF" of docs/accuracy-vs-time.md.
+# Usage: scripts/near-samples.sh tuning|held-out [K EYES ROUNDS]   (defaults 2048 512 4, bake's own)
 set -euo pipefail
 half="${1:?tuning or held-out}"
 k="${2:-2048}"
@@ -28,6 +30,7 @@ for i in "${!all[@]}"; do
   esac
 done
 common=(--cells 300 --samples 300000 --agvs-samples 5000000 --seed 1)
+[ -f "$out/commit-$half" ] || git rev-parse --short HEAD > "$out/commit-$half"
 timed_bake() {  # OUT.pvs JSON SECONDS_FILE ARGS...
   local pvs=$1 json=$2 secs=$3
   shift 3
@@ -40,8 +43,12 @@ timed_bake() {  # OUT.pvs JSON SECONDS_FILE ARGS...
 rows=()
 for m in "${maps[@]}"; do
   map="data/maps/bsp/$m.bsp"
+  if [ -n "${NEAR_TABLE_ONLY:-}" ]; then
+    [ -f "$out/$m-q3map2-m.json" ] && [ -f "$out/$m-near$k-$eyes-$rounds-m.json" ] && rows+=("$m")
+    continue
+  fi
   echo "near-samples: $m" >&2
-  timed_bake "$out/$m-base.pvs" "$out/$m-base-bake.json" "$out/$m-base.secs" "$map" "${common[@]}"
+  timed_bake "$out/$m-base.pvs" "$out/$m-base-bake.json" "$out/$m-base.secs" "$map" "${common[@]}" --near-samples 0
   timed_bake "$out/$m-near$k-$eyes-$rounds.pvs" "$out/$m-near$k-$eyes-$rounds-bake.json" \
     "$out/$m-near$k-$eyes-$rounds.secs" "$map" "${common[@]}" --near-samples "$k" --near-eyes "$eyes" --near-rounds "$rounds"
   for side in base "near$k-$eyes-$rounds"; do
@@ -50,14 +57,15 @@ for m in "${maps[@]}"; do
   [ -f "$out/$m-q3map2-m.json" ] || "$vc" -q measure "$map" --count 300 --seed 7 --report "$out/$m-q3map2-m.json"
   rows+=("$m")
 done
-python3 - "$out" "$half" "$k-$eyes-$rounds" "$(git rev-parse --short HEAD)" "${rows[@]}" > "$out/table-$half.md" <<'PY'
+python3 - "$out" "$half" "$k-$eyes-$rounds" "$(cat "$out/commit-$half")" "${#maps[@]}" "${rows[@]}" > "$out/table-$half.md" <<'PY'
 import datetime, json, statistics, sys
-out, half, setting, commit, maps = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5:]
+out, half, setting, commit, planned, maps = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5]), sys.argv[6:]
 k, eyes, rounds = setting.split("-")
 load = lambda m, side: json.load(open(f"{out}/{m}-{side}-m.json"))
 secs = lambda m, side: float(open(f"{out}/{m}-{side}.secs").read())
-print(f"{datetime.date.today()}, commit {commit}, 2 threads; the {half} half ({len(maps)} maps). Each map baked with "
-      f"`viewcells bake MAP --cells 300 --samples 300000 --agvs-samples 5000000 --seed 1` (base) and the same with "
+done = f"{len(maps)} maps" if len(maps) == planned else f"{len(maps)} of its {planned} maps: the run was stopped there"
+print(f"{datetime.date.today()}, commit {commit}, 2 threads; the {half} half ({done}). Each map baked with "
+      f"`viewcells bake MAP --cells 300 --samples 300000 --agvs-samples 5000000 --seed 1 --near-samples 0` (base) and the same with "
       f"`--near-samples {k} --near-eyes {eyes} --near-rounds {rounds}` (near), measured with q3map2's own PVS by "
       "`viewcells measure MAP [PVS] --count 300 --seed 7` (player eyes, 1024x768, 90 degrees). Holes: the share of "
       "frames with any wrong pixel (q3map2's is 0 on every map); wrong pixels per 1024x1024 frame; cost: r(PVS) per "
