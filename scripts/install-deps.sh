@@ -27,7 +27,8 @@ packages=(
   valgrind               # instruction counts of an A/B benchmark (scripts/bench-ab-instructions.sh)
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest   # the Python module (python/) and its tests
   blender                # the module inside Blender 3.4, headless (tests/blender/)
-  xvfb xauth             # Blender with a window, on a virtual X server (tests/blender/addon_gui_test.py)
+  xvfb xauth             # Blender with a window, on a virtual X server (tests/blender/addon_gui_test.py),
+  libgl1-mesa-dri        # drawing its OpenGL in software (Mesa)
 )
 
 # scripts/fuzz.sh also needs clang with libFuzzer's runtime.
