@@ -602,6 +602,15 @@ assert e['enabled'] and tested > 0 and b['pvs_entries'] == a['pvs_entries'] + ad
 assert not a['effects']['near_samples']['enabled']
 " && ok || bad "bake --near-samples: report"
 expect_error "near-samples" "$VC" bake office.obj --cells 12 --near-samples 5000 -o x.pvs
+# Where no viewpoint can be placed (the view box inside a closed cube, sampled with empty space
+# detection off), bake's default near-object samples are skipped, said so, and the bake succeeds.
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\nf 1 3 2\nf 1 4 3\nf 5 6 7\nf 5 7 8\nf 1 2 6\nf 1 6 5\nf 2 3 7\nf 2 7 6\nf 3 4 8\nf 3 8 7\nf 4 1 5\nf 4 5 8\n' > cube.obj
+expect_ok "$VC" bake cube.obj --cells 2 --samples 20000 --agvs-samples 20000 --view-box 0.2,0.2,0.2,0.8,0.8,0.8 \
+  --empty-space off -o cube.pvs --report cube.json -q
+python3 -c "
+import json; e = json.load(open('cube.json'))['effects']['near_samples']
+assert not e['enabled'] and 'no viewpoints' in e['reason'], e
+" && ok || bad "bake: near-object samples without viewpoints should be skipped"
 cp bake1.pvs keep.pvs
 expect_error "too small" "$VC" bake office.obj --memory 50 --samples 20000 --max-cells 300 --agvs-samples 50000 \
   -o keep.pvs -q

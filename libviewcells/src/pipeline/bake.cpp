@@ -10,6 +10,7 @@
 
 #include "viewcells/core/format.h"
 #include "viewcells/core/error.h"
+#include "viewcells/core/interrupt.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/core/binary_file.h"
@@ -341,9 +342,18 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     CameraConfig ec = c.cameras;
     ec.count = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{c.near_eyes} * lists.size(), 10'000'000));
     ec.seed = c.cameras.seed + 0x6e65'0001;
-    const CameraSet drawn = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), ec,
-                                         [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
-                                         &covered_cells);
+    // Bake's default: where no viewpoint can be placed (a view box inside solids, a map whose
+    // floors cannot be found), the bake goes on without them and says so.
+    CameraSet drawn;
+    try {
+      drawn = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), ec,
+                           [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); }, &covered_cells);
+    } catch (const Interrupted&) {
+      throw;
+    } catch (const Error& e) {
+      out.near_skipped = e.what();
+      log("viewcells: bake: near-object samples skipped: no viewpoints (" + out.near_skipped + ")");
+    }
     std::vector<std::vector<Vec3>> eyes(lists.size());
     for (size_t i = 0; i < drawn.cameras.size(); ++i)
       if (drawn.cells[i] >= 0) eyes[static_cast<size_t>(drawn.cells[i])].push_back(drawn.cameras[i].eye);
@@ -353,12 +363,13 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     out.near_eyes = drawn.cameras.size();
     out.near_seconds = sw.seconds();
     std::string rounds;
-    for (size_t i = 0; i < out.near.added_by_round.size(); ++i)
+    for (size_t i = 0; i < out.near.added_by_round.size() && out.near_skipped.empty(); ++i)
       rounds += (rounds.empty() ? "" : ", ") + std::to_string(out.near.added_by_round[i]) +
                 (out.near.rays_by_round[i] < c.near.rays_per_object
                      ? " (" + std::to_string(out.near.rays_by_round[i]) + " rays a candidate)"
                      : std::string());
-    log("viewcells: bake: near-object samples (" + drawn.rule + ", " + std::to_string(out.near_eyes) +
+    if (out.near_skipped.empty())
+      log("viewcells: bake: near-object samples (" + drawn.rule + ", " + std::to_string(out.near_eyes) +
         " viewpoints; neighbours within " + fmt(out.near.distance, 3) + "): " + std::to_string(out.near.tested) +
         " objects tested with " + std::to_string(out.near.rays) + " rays added " + std::to_string(out.near.added) +
         " PVS entries (by round: " + rounds + ") in " + fmt(out.near_seconds, 2) + " s");

@@ -164,8 +164,9 @@ std::string report_json(const BakeResult& r) {
                                    fmt(r.frame_sample_seconds, 2) + " s (--frame-samples)"
                              : "not asked for (--frame-samples)")},
                  {"near_samples",
-                  effect(c.near.rays_per_object > 0,
-                         c.near.rays_per_object > 0
+                  effect(c.near.rays_per_object > 0 && r.near_skipped.empty(),
+                         !r.near_skipped.empty() ? "skipped: no viewpoints (" + r.near_skipped + ")"
+                         : c.near.rays_per_object > 0
                              ? std::to_string(r.near.tested) + " (cell, neighbouring object) pairs tested with " +
                                    std::to_string(r.near.rays) + " rays from " + std::to_string(r.near_eyes) +
                                    " viewpoints added " + std::to_string(r.near.added) + " PVS entries in " +

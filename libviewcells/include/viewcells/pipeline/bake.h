@@ -94,6 +94,7 @@ struct BakeResult {
   NearSampleStats near;  ///< of the near-object samples
   uint64_t near_eyes = 0;
   double near_seconds = 0;
+  std::string near_skipped;  ///< why the near-object samples did not run (no viewpoints), or empty
   bool agvs_in_view_space = false;  ///< a Quake 3 map: AGVS drew its points in the non-solid space
   /// The view cells and PVSs baked, as written to `output` (point location, hierarchy,
   /// compressed lists and names): what read_pvs(output) gives, also when nothing was written.
