@@ -297,8 +297,9 @@ std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, 
   add_agvs_options(bk, a->agvs, false, "--agvs-samples", "--agvs-time");
   bk->add_option("--time", a->seconds,
                  "Bound the whole bake to this many seconds: each of the merge's two AGVS runs stops at a quarter of "
-                 "it, the PVSs' AGVS when it runs out (a hierarchy that uses it all up is an error, and with --work "
-                 "is kept for a rerun). --agvs-time bounds the PVSs' AGVS alone")
+                 "it, the PVSs' AGVS at three quarters of what is left, the near-object samples when it runs out (a "
+                 "hierarchy that uses it all up is an error, and with --work is kept for a rerun). --agvs-time bounds "
+                 "the PVSs' AGVS alone")
       ->check(positive());
   bk->add_option("--work", a->work,
                  "Work directory: keeps the hierarchy and the AGVS state, so that a rerun with the same scene and "

@@ -104,5 +104,19 @@ TEST(NearSamples, TheRayBudgetLowersTheRaysACandidateInPackets) {
   EXPECT_EQ(none, (std::vector<std::vector<uint32_t>>{{w.wall}}));
 }
 
+TEST(NearSamples, ATimeLimitStopsThem) {
+  const WallScene w;
+  const auto caster = make_embree_caster(w.scene);
+  const std::vector<std::vector<Vec3>> cell_eyes = {{{-2.0, 0.25, 1.5}}};
+  NearSampleConfig config;
+  config.distance = 0.01;
+  config.max_seconds = 1e-12;  // spent before the first cell
+  std::vector<std::vector<uint32_t>> lists = {{w.wall}};
+  const NearSampleStats stats = add_near_samples(w.scene, *caster, cell_eyes, config, lists);
+  EXPECT_TRUE(stats.stopped_by_time);
+  EXPECT_EQ(stats.added, 0u);
+  EXPECT_EQ(lists, (std::vector<std::vector<uint32_t>>{{w.wall}}));
+}
+
 }  // namespace
 }  // namespace viewcells

@@ -267,7 +267,10 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
                                    "sampled: give more time, fewer --samples or --max-cells" +
                                    (c.work_dir.empty() ? std::string(", or --work to keep the hierarchy for a rerun")
                                                        : std::string(" (the hierarchy is kept in " + c.work_dir + ")")));
-    run.agvs.max_seconds = run.agvs.max_seconds > 0 ? std::min(run.agvs.max_seconds, left) : left;
+    // With near-object samples after it, AGVS leaves them a quarter of what is left; they stop
+    // at the bake's limit.
+    const double agvs_left = c.near.rays_per_object ? 0.75 * left : left;
+    run.agvs.max_seconds = run.agvs.max_seconds > 0 ? std::min(run.agvs.max_seconds, agvs_left) : agvs_left;
   }
   out.elementary_cells = static_cast<uint32_t>(h.leaf_count);
   out.scene_fingerprint = file.scene_fingerprint;
@@ -359,6 +362,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
       if (drawn.cells[i] >= 0) eyes[static_cast<size_t>(drawn.cells[i])].push_back(drawn.cameras[i].eye);
     NearSampleConfig nc = c.near;
     nc.seed = c.agvs.seed;
+    if (c.max_seconds > 0) nc.max_seconds = std::max(c.max_seconds - total.seconds(), 1e-9);
     out.near = add_near_samples(*loaded.scene, *loaded.caster, eyes, nc, lists);
     out.near_eyes = drawn.cameras.size();
     out.near_seconds = sw.seconds();
@@ -372,7 +376,8 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
       log("viewcells: bake: near-object samples (" + drawn.rule + ", " + std::to_string(out.near_eyes) +
         " viewpoints; neighbours within " + fmt(out.near.distance, 3) + "): " + std::to_string(out.near.tested) +
         " objects tested with " + std::to_string(out.near.rays) + " rays added " + std::to_string(out.near.added) +
-        " PVS entries (by round: " + rounds + ") in " + fmt(out.near_seconds, 2) + " s");
+        " PVS entries (by round: " + rounds + ") in " + fmt(out.near_seconds, 2) + " s" +
+        (out.near.stopped_by_time ? " (stopped at the time limit)" : ""));
   }
   out.agvs_cells = static_cast<uint32_t>(set.cells.size());
   ViewCellSet written = set;

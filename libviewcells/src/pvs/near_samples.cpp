@@ -5,6 +5,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <iterator>
 #include <numeric>
@@ -94,7 +96,16 @@ NearSampleStats add_near_samples(const Scene& scene, const RayCaster& caster,
   // neighbours are the next candidates.
   std::vector<std::vector<uint32_t>> fresh = lists;
   uint64_t rays_left = config.max_rays;
-  for (uint32_t round = 0; round < config.rounds; ++round) {
+  const auto start = std::chrono::steady_clock::now();
+  std::atomic<bool> out_of_time{false};
+  auto time_is_up = [&] {
+    if (config.max_seconds <= 0) return false;
+    if (!out_of_time.load(std::memory_order_relaxed) &&
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > config.max_seconds)
+      out_of_time = true;
+    return out_of_time.load(std::memory_order_relaxed);
+  };
+  for (uint32_t round = 0; round < config.rounds && !time_is_up(); ++round) {
     // Each cell's candidates: the neighbours of what it gained last that it lacks.
     std::vector<std::vector<uint32_t>> missing(cells);
     tbb::parallel_for(tbb::blocked_range<size_t>(0, cells, 1), [&](const tbb::blocked_range<size_t>& range) {
@@ -134,6 +145,7 @@ NearSampleStats add_near_samples(const Scene& scene, const RayCaster& caster,
       for (size_t c = range.begin(); c < range.end(); ++c) {
         throw_if_interrupted("near-object samples");
         progress.advance();
+        if (time_is_up()) continue;
         Rng rng(config.seed ^ 0x6e65'6172'0000'0000ULL, (uint64_t{round} << 40) ^ c);
         for (uint32_t o : missing[c]) {
           ++tested[c];
@@ -174,6 +186,7 @@ NearSampleStats add_near_samples(const Scene& scene, const RayCaster& caster,
     stats.added_by_round.push_back(added);
     if (added == 0) break;
   }
+  stats.stopped_by_time = out_of_time;
   return stats;
 }
 

@@ -29,6 +29,9 @@ struct NearSampleConfig {
   /// All rounds' rays at most (a bound on the time whatever the scene): where the candidates
   /// would take more, a round casts fewer rays a candidate, in packets of 16.
   uint64_t max_rays = uint64_t{1} << 31;
+  /// Seconds at most (0: no limit): past them no further cell is started and no round begins
+  /// (then, and only then, the lists depend on the machine's speed).
+  double max_seconds = 0;
   uint64_t seed = 1;
 };
 
@@ -39,6 +42,7 @@ struct NearSampleStats {
   double distance = 0;  ///< the neighbour distance used
   std::vector<uint64_t> added_by_round;
   std::vector<uint64_t> rays_by_round;  ///< rays a candidate each round cast (below K under max_rays)
+  bool stopped_by_time = false;         ///< max_seconds ran out
 };
 
 /// Pairs of rendered objects whose bounding boxes are within `distance` of each other, as a
