@@ -156,6 +156,7 @@ NearSampleStats add_near_samples(const Scene& scene, const RayCaster& caster,
             if (r % 16 == 0) eye = &eyes[c][rng.below(eyes[c].size())];
             targets[r] = surface[o].point(scene, rng);
             rays[r] = Ray{*eye, targets[r] - *eye, 0.0, 1.0 + 1e-6};
+            if (!(dot(rays[r].dir, rays[r].dir) > 0)) rays[r] = Ray{*eye, {1, 0, 0}, 0.0, 0.0};  // an eye on the object
           }
           caster.intersect_coherent(rays, hits);
           const bool occluder = scene.objects[o].occluder;
