@@ -121,7 +121,10 @@ struct Baked {
   std::optional<LevelView> level;                      ///< with a scene (lazily)
 
   Baked(std::string p, std::shared_ptr<const Scene> s, const CostModel& m)
-      : path(std::move(p)), file(read_pvs(path)), scene(std::move(s)), model(m) {
+      : Baked(p, read_pvs(p), std::move(s), m) {}
+  /// The file's content already in memory (what the bake just wrote), not read again.
+  Baked(std::string p, PvsFile f, std::shared_ptr<const Scene> s, const CostModel& m)
+      : path(std::move(p)), file(std::move(f)), scene(std::move(s)), model(m) {
     cells = std::make_unique<CellLocator>(file.bsp, file.leaf_cell, file.pvs.cell_count);
     if (scene && scene->fingerprint() != file.scene_fingerprint)
       throw Error(scene->source, 0, "is not the scene " + path + " was baked from (fingerprints differ)");
@@ -308,7 +311,7 @@ std::shared_ptr<Baked> bake(const py::object& scene, const std::string& output, 
     result = pipeline::bake(config, log);
     outputs.commit();
   }
-  auto out = std::make_shared<Baked>(output, memory, config.model);
+  auto out = std::make_shared<Baked>(output, *result.file, memory, config.model);
   if (!memory) out->scene_file = config.scene;
   out->report = py::module_::import("json").attr("loads")(pipeline::report_json(result));
   return out;
