@@ -9,6 +9,7 @@
 # Usage: mpi_test.sh VIEWCELLS_BINARY
 set -uo pipefail
 VC="$1"
+MAPS="$(cd "$(dirname "$0")/../../data/maps/bsp" 2>/dev/null && pwd)"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 export OMPI_MCA_btl_vader_single_copy_mechanism=none  # containers without ptrace permission
 # One node's transports only: probing for others (UCX) took 0.2 s of each launch's 0.7 s, and
@@ -89,6 +90,17 @@ for n in 2 3; do
     -o "l$n.pvs" || bad "pvs with lanes on the city on $n ranks"
   same_files "pvs with lanes on the city, $n ranks" l0.pvs "l$n.pvs"
 done
+# A map's play space: the stationary distributions' chunks are Halton index ranges whose points
+# outside it are skipped, each drawn only by the rank that casts it.
+if [ -n "$MAPS" ] && [ -f "$MAPS/oa_dm2.bsp" ]; then
+  "$VC" -q bake "$MAPS/oa_dm2.bsp" --cells 20 --samples 20000 --max-cells 40 --merge-pvs samples --agvs-samples 60000 \
+    --near-samples 0 --mutation-lanes 3 -o m0.pvs || bad "bake on a map"
+  ranks 3 -q bake "$MAPS/oa_dm2.bsp" --cells 20 --samples 20000 --max-cells 40 --merge-pvs samples --agvs-samples 60000 \
+    --near-samples 0 --mutation-lanes 3 -o m3.pvs || bad "bake on a map on 3 ranks"
+  same_files "bake on a map, 3 ranks" m0.pvs m3.pvs
+else
+  echo "mpi_test: no maps (scripts/fetch-maps.sh): the play space case is skipped"
+fi
 [ "$(jq -r .cluster.ranks s3.json)" = 3 ] && [ "$(jq -r .cluster.bytes_received s3.json)" -gt 0 ] && ok ||
   bad "the report of 3 ranks does not say what they exchanged: $(jq -c .cluster s3.json)"
 

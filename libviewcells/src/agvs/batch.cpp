@@ -24,28 +24,18 @@ struct AgvsSolver::Impl::BatchCounts {
   std::vector<uint8_t> camera_rays, wrong_rays, has_segment;
 };
 
-template <class OnSegment>
-void AgvsSolver::Impl::insert_segments(const BatchSamples& s, const std::vector<BatchChunk>& chunks,
-                                       OnSegment&& on_segment, std::vector<uint32_t>& gains,
+void AgvsSolver::Impl::insert_segments(const std::vector<BatchChunk>& chunks, std::vector<uint32_t>& gains,
                                        std::vector<uint8_t>& flags, std::vector<uint8_t>& own) {
   const size_t total = gains.size();
-  // Per segment: its chunk and index there, and whether it is its sample's camera segment (the
-  // first of a view space-direction sample through the sample's point; a chunk holds its
-  // samples' every segment), with the cell of that point.
+  // Per segment: its chunk and index there, and whether it is its sample's camera segment.
   std::vector<std::pair<const BatchChunk*, uint32_t>> at(total);
   own.assign(total, 0);
-  std::vector<int32_t> origin_cell(s.points.size(), -1);
   tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t ci) {
     const BatchChunk& c = chunks[ci];
-    std::vector<uint8_t> seen(c.size, 0);
     for (size_t i = 0; i < c.segs.size(); ++i) {
       const size_t k = c.seg_start + i;
       at[k] = {&c, static_cast<uint32_t>(i)};
-      const uint32_t sample = c.first + c.sample_of[i];
-      if (c.dist != kVsd || seen[c.sample_of[i]] || !on_segment(c, i, sample)) continue;
-      seen[c.sample_of[i]] = 1;
-      own[k] = 1;
-      origin_cell[sample] = cells.cell_at(s.points[sample]);
+      if (!c.camera_cell.empty() && c.camera_cell[i] != BatchChunk::kNotCamera) own[k] = 1;
     }
   });
   // This rank's cells divided among parts, each inserting into its own cells in sample order
@@ -77,7 +67,7 @@ void AgvsSolver::Impl::insert_segments(const BatchSamples& s, const std::vector<
         const uint32_t i = at[pair.segment].second;
         const uint32_t objs[2] = {c.segs.object_a[i], c.segs.object_b[i]};
         const uint32_t cell = static_cast<uint32_t>(pair.cell);
-        const bool origin = own[pair.segment] && pair.cell == origin_cell[c.first + c.sample_of[i]];
+        const bool origin = own[pair.segment] && pair.cell == c.camera_cell[i];
         bool contributed[2] = {false, false}, at_origin[2] = {false, false};
         pair.gain = contribute_in_cell([&](uint32_t o) { return pvs.insert_in_row(cell, o); }, objs, origin,
                                        contributed, at_origin);
@@ -115,8 +105,7 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
   std::vector<uint32_t> gains(total, 0);
   std::vector<uint8_t> flags(total, 0);  // contributed a, b; at origin a, b (REF: wrong ray)
   std::vector<uint8_t> own;              // not REF: the segment is its sample's camera segment
-  // Whether the sample's point lies on this segment: its own segment (re-casts of points
-  // inside solids start elsewhere; see-through companions are the first one's).
+  // REF: whether the sample's point lies on this segment: its own segment.
   auto on_segment = [&](const BatchChunk& c, size_t i, uint32_t sample) {
     const Vec3 a = c.segs.a(i), ab = c.segs.b(i) - a;
     const double t = dot(s.points[sample] - a, ab);
@@ -140,7 +129,7 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
       }
     }
   } else {
-    insert_segments(s, chunks, on_segment, gains, flags, own);
+    insert_segments(chunks, gains, flags, own);
   }
   cluster::sum(gains);
   cluster::bit_or(flags);
@@ -294,8 +283,8 @@ void AgvsSolver::Impl::batch(uint64_t index, uint32_t n) {
   draw_samples(index, n, share, s);
   stats.draw_seconds += since(t) - (stats.mutation_seconds - lanes_before);
   t = Clock::now();
-  const size_t count = s.points.size();
   const std::vector<BatchChunk> chunks = cast_samples(s);
+  const size_t count = s.count;
   stats.cast_seconds += since(t);
   t = Clock::now();
   lanes_before = stats.mutation_seconds;

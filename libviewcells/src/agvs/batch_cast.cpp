@@ -39,47 +39,79 @@ void AgvsSolver::Impl::cast_ref_chunk(const BatchSamples& s, BatchChunk& c) cons
   }
 }
 
-std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const BatchSamples& s) {
+std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(BatchSamples& s) {
   // Cast in fixed chunks within each distribution, in parallel; outputs in sample order.
-  constexpr uint32_t kChunk = 1024;
   std::vector<BatchChunk> chunks;
   auto add_chunks = [&](int d, uint32_t first, uint32_t end, int32_t lane) {
-    for (uint32_t f = first; f < end; f += kChunk) {
+    for (uint32_t f = first; f < end; f += kChunkSamples) {
       BatchChunk c;
       c.first = f;
-      c.size = std::min(kChunk, end - f);
+      c.size = std::min(kChunkSamples, end - f);
       c.dist = d;
       c.lane = lane;
       chunks.push_back(std::move(c));
     }
   };
   for (int d : kOrder) {
-    if (d != kSil && d != kTpm) {
+    if (config.method == AgvsMethod::kRef) {
       add_chunks(d, s.first_of[d], s.end_of[d], -1);
-      continue;
-    }
-    // A mutation's samples in runs of one lane group each.
-    const BatchSamples::LaneRange* run = nullptr;
-    uint32_t end = 0;
-    for (const BatchSamples::LaneRange& r : s.lane_ranges) {
-      if (r.dist != d) continue;
-      if (run && lane_group(r.lane) == lane_group(run->lane)) {
-        end = r.first + r.size;
-        continue;
+    } else if (d == kSil || d == kTpm) {
+      // A mutation's samples in runs of one lane group each.
+      const BatchSamples::LaneRange* run = nullptr;
+      uint32_t end = 0;
+      for (const BatchSamples::LaneRange& r : s.lane_ranges) {
+        if (r.dist != d) continue;
+        if (run && lane_group(r.lane) == lane_group(run->lane)) {
+          end = r.first + r.size;
+          continue;
+        }
+        if (run) add_chunks(d, run->first, end, static_cast<int32_t>(run->lane));
+        run = &r, end = r.first + r.size;
       }
       if (run) add_chunks(d, run->first, end, static_cast<int32_t>(run->lane));
-      run = &r, end = r.first + r.size;
+    } else {
+      for (const BatchSamples::HaltonRange& r : s.stationary) {
+        if (r.dist != d) continue;
+        BatchChunk c;
+        c.dist = d;
+        c.halton_first = r.first;
+        c.halton_count = r.count;
+        chunks.push_back(std::move(c));
+      }
     }
-    if (run) add_chunks(d, run->first, end, static_cast<int32_t>(run->lane));
   }
-  // A chunk: its samples cast, and the cells of each segment.
+  // A chunk: its samples (a stationary distribution's drawn here), cast, and the cells of each
+  // segment.
   auto cast_chunk = [&](BatchChunk& c) {
     if (config.method == AgvsMethod::kRef) {
       cast_ref_chunk(s, c);
       return;
     }
-    c.rays = caster().cast(std::span<const Vec3>(s.points.data() + c.first, c.size),
-                           std::span<const Vec3>(s.dirs.data() + c.first, c.size), c.segs, c.sample_of);
+    std::vector<Vec3> drawn_points, drawn_dirs;
+    const Vec3* points = s.points.data() + c.first;
+    const Vec3* dirs = s.dirs.data() + c.first;
+    if (c.halton_count > 0) {
+      draw_stationary(c.dist, c.halton_first, c.halton_count, drawn_points, drawn_dirs);
+      c.size = static_cast<uint32_t>(drawn_points.size());
+      points = drawn_points.data(), dirs = drawn_dirs.data();
+    }
+    c.rays = caster().cast(std::span<const Vec3>(points, c.size), std::span<const Vec3>(dirs, c.size), c.segs,
+                           c.sample_of);
+    if (c.dist == kVsd) {
+      // The estimator's camera segment of each sample: its first segment through its point
+      // (re-casts of points inside solids start elsewhere; see-through companions are the
+      // first one's).
+      std::vector<uint8_t> seen(c.size, 0);
+      c.camera_cell.assign(c.segs.size(), BatchChunk::kNotCamera);
+      for (size_t i = 0; i < c.segs.size(); ++i) {
+        const uint32_t k = c.sample_of[i];
+        const Vec3 a = c.segs.a(i), ab = c.segs.b(i) - a;
+        const double t = dot(points[k] - a, ab);
+        if (seen[k] || !(t >= 0 && t <= dot(ab, ab))) continue;
+        seen[k] = 1;
+        c.camera_cell[i] = cells.cell_at(points[k]);
+      }
+    }
     std::vector<std::tuple<int32_t, double, double>> stack;
     std::vector<int32_t> pierced;
     for (size_t i = 0; i < c.segs.size(); ++i) {
@@ -89,11 +121,11 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
     c.pierced = c.pairs.size();
   };
   if (cluster::size() > 1) {
-    // Several ranks: each casts the chunks it owns (numbered across batches, so that the work
-    // turns round the ranks; a chunk's owner may differ between rank counts, its content does
-    // not), and every rank receives all chunks. A mutation lane's chunks are its owner's, the
-    // only rank that drew their points. A chunk's pairs travel sorted by the rank of their cell:
-    // each rank keeps its own.
+    // Several ranks: each draws and casts the chunks it owns (numbered across batches, so that
+    // the work turns round the ranks; a chunk's owner may differ between rank counts, its
+    // content does not), and every rank receives all chunks. A mutation lane's chunks are its
+    // owner's, the only rank that drew their points. A chunk's pairs travel sorted by the rank
+    // of their cell: each rank keeps its own.
     std::vector<std::string> items(chunks.size());
     const uint64_t base = stats.batches * 4096;
     const uint64_t ranks = static_cast<uint64_t>(cluster::size());
@@ -105,9 +137,11 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
       BatchChunk& c = chunks[k];
       cast_chunk(c);
       ByteWriter w;
+      w.put(c.size);
       w.put(c.rays);
       w.put_array(c.sample_of);
       put_segments(w, c.segs);
+      w.put_array(c.camera_cell);
       w.put(c.pierced);
       std::vector<std::vector<BatchChunk::CellPair>> of_rank(ranks);
       for (const BatchChunk::CellPair& p : c.pairs) of_rank[static_cast<uint64_t>(p.cell) % ranks].push_back(p);
@@ -118,9 +152,21 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
     for (size_t k = 0; k < chunks.size(); ++k) {
       BatchChunk& c = chunks[k];
       ByteReader r(items[k], "a rank's casting results");
+      const uint32_t size = r.get<uint32_t>();
+      if (c.halton_count > 0 ? size > c.halton_count : size != c.size) r.fail("a chunk's sample count is wrong");
+      c.size = size;
       c.rays = r.get<uint64_t>();
       r.get_array(c.sample_of, items[k].size());
       get_segments(r, c.segs, items[k].size());
+      if (c.sample_of.size() != c.segs.size()) r.fail("a chunk's segments and samples differ in number");
+      for (uint32_t sample : c.sample_of)
+        if (sample >= c.size) r.fail("a segment's sample is out of range");
+      r.get_array(c.camera_cell, items[k].size());
+      if (!c.camera_cell.empty() && (c.dist != kVsd || c.camera_cell.size() != c.segs.size()))
+        r.fail("a chunk's camera segments are wrong");
+      for (int32_t cell : c.camera_cell)
+        if (cell != BatchChunk::kNotCamera && (cell < -1 || cell >= static_cast<int32_t>(cells.cell_count())))
+          r.fail("a camera's cell is out of range");
       c.pierced = r.get<uint64_t>();
       std::vector<BatchChunk::CellPair> pairs;
       for (uint64_t rank = 0; rank < ranks; ++rank) {
@@ -136,6 +182,18 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(const B
   } else {
     tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) { cast_chunk(chunks[k]); });
   }
+  // The stationary distributions' samples follow the mutations' (kOrder), numbered in chunk
+  // order now that each chunk's count is known.
+  uint32_t next = static_cast<uint32_t>(s.points.size());
+  int last = -1;
+  for (BatchChunk& c : chunks) {
+    if (c.halton_count == 0) continue;
+    if (c.dist != last) s.first_of[c.dist] = next, last = c.dist;
+    c.first = next;
+    next += c.size;
+    s.end_of[c.dist] = next;
+  }
+  s.count = next;
   size_t total = 0;
   for (BatchChunk& c : chunks) {
     c.seg_start = total;

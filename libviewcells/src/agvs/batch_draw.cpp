@@ -9,6 +9,7 @@
 
 #include <array>
 #include <chrono>
+#include <cmath>
 #include <span>
 #include <tuple>
 
@@ -156,16 +157,25 @@ void AgvsSolver::Impl::draw_samples(uint64_t index, uint32_t n, const double sha
       s.dirs.push_back(sphere_direction(rng.uniform(), rng.uniform()));
       s.ref_cell.push_back(static_cast<int32_t>(c));
     }
-    s.end_of[kVsd] = n;
+    s.end_of[kVsd] = s.count = n;
     return;
   }
-  uint32_t failed = draw_mutations(index, want, s);
-  // Quasi-random, from Halton indices alone: computed in parallel, taken in order.
+  const uint32_t failed = draw_mutations(index, want, s);
+  // The stationary distributions: ranges of Halton indices, as many as should give the wanted
+  // samples, in chunks of about kChunkSamples samples each. Their samples are drawn where they
+  // are cast (cast_samples()), so no rank draws another's.
+  constexpr uint64_t kMaxTries = 10000;  // a view space of nearly no volume must not stall a batch
   for (int d : kOrder) {
     if (d == kSil || d == kTpm) continue;
-    s.first_of[d] = static_cast<uint32_t>(s.points.size());
-    failed += stationary_samples(d, want[d] + (d == kVsd ? failed : 0), s.points, s.dirs);
-    s.end_of[d] = static_cast<uint32_t>(s.points.size());
+    const uint64_t wanted = want[d] + (d == kVsd ? failed : 0);
+    if (wanted == 0) continue;
+    const double yield = sample_share(d);
+    const uint64_t indices = std::min<uint64_t>(static_cast<uint64_t>(std::ceil(static_cast<double>(wanted) / yield)), wanted * kMaxTries);
+    const uint64_t per_chunk =
+        std::min<uint64_t>(static_cast<uint64_t>(std::ceil(kChunkSamples / yield)), kChunkSamples * kMaxTries);
+    for (uint64_t f = 0; f < indices; f += per_chunk)
+      s.stationary.push_back({d, halton_index[d] + f, static_cast<uint32_t>(std::min(per_chunk, indices - f))});
+    halton_index[d] += indices;
   }
 }
 

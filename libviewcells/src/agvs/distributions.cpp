@@ -2,9 +2,6 @@
 // object-direction and two-point (stationary), two-point and silhouette mutations.
 #include "solver_impl.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <numbers>
@@ -49,54 +46,35 @@ Vec3 AgvsSolver::Impl::object_point(double u0, double u1, double u2, double u3, 
   return p;
 }
 
-void AgvsSolver::Impl::view_points(int d, int dim, uint32_t attempts, std::vector<uint64_t>& index,
-                                   std::vector<Vec3>& point) {
-  const Halton& h = halton[d];
-  index.assign(attempts, kNoIndex);
-  point.assign(attempts, Vec3{});
-  auto at = [&](uint64_t i) { return view_point(h.at(i, dim), h.at(i, dim + 1), h.at(i, dim + 2)); };
-  if (!config.view_space && !config.view_point_map) {
-    const uint64_t first = halton_index[d];
-    halton_index[d] += attempts;
-    tbb::parallel_for(tbb::blocked_range<uint32_t>(0, attempts, 256), [&](const tbb::blocked_range<uint32_t>& r) {
-      for (uint32_t k = r.begin(); k < r.end(); ++k) index[k] = first + k, point[k] = at(first + k);
-    });
-    return;
+double AgvsSolver::Impl::sample_share(int d) {
+  if (d == kOd || (!config.view_space && !config.view_point_map)) return 1.0;
+  constexpr uint64_t kPilot = 4096;
+  if (halton_index[d] >= kPilot)
+    return (static_cast<double>(stats.dist_samples[d]) + 1) / (static_cast<double>(halton_index[d]) + 2);
+  if (pilot_share[d] < 0) {
+    std::vector<Vec3> points, dirs;
+    draw_stationary(d, 0, kPilot, points, dirs);
+    pilot_share[d] = (static_cast<double>(points.size()) + 1) / (kPilot + 2);
   }
-  // Most of a map's view box may be solid: points outside the view space are skipped, and an
-  // attempt that meets kMaxTries of them in a row fails (a view space of nearly no volume must
-  // not stall the batch). The points are tested a block at a time in parallel (blocks sized
-  // from the share inside so far: only their cost depends on it) and taken in order.
-  constexpr uint32_t kMaxTries = 10000;
-  uint32_t k = 0, tries = 0;
-  uint64_t tested = 0, inside_count = 0;
-  std::vector<Vec3> candidates;
-  std::vector<uint8_t> inside;
-  while (k < attempts) {
-    const double share = (inside_count + 1.0) / (tested + 2.0);
-    const size_t block =
-        std::clamp<size_t>(static_cast<size_t>(1.1 * (attempts - k) / share) + 64, 256, size_t{1} << 20);
-    const uint64_t first = halton_index[d];
-    candidates.resize(block);
-    inside.resize(block);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, block, 256), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t j = r.begin(); j < r.end(); ++j) {
-        candidates[j] = at(first + j);
-        inside[j] = !std::isnan(candidates[j].x) && (!config.view_space || config.view_space(candidates[j])) ? 1 : 0;
-      }
-    });
-    size_t used = 0;
-    for (; used < block && k < attempts; ++used) {
-      ++tries;
-      if (inside[used]) {
-        index[k] = first + used, point[k] = candidates[used];
-        ++k, ++inside_count, tries = 0;
-      } else if (tries == kMaxTries) {
-        ++k, tries = 0;  // this attempt fails
-      }
+  return pilot_share[d];
+}
+
+void AgvsSolver::Impl::draw_stationary(int d, uint64_t first, uint32_t count, std::vector<Vec3>& points,
+                                       std::vector<Vec3>& dirs) const {
+  // Most of a map's view box may be solid: its view points outside the view space are skipped.
+  const Halton& h = halton[d];
+  const int dim = d == kTp ? 4 : 0;
+  const bool space = config.view_space || config.view_point_map;
+  for (uint64_t i = first; i < first + count; ++i) {
+    Vec3 at{};
+    if (d != kOd) {
+      at = view_point(h.at(i, dim), h.at(i, dim + 1), h.at(i, dim + 2));
+      if (space && (std::isnan(at.x) || (config.view_space && !config.view_space(at)))) continue;
     }
-    halton_index[d] = first + used;
-    tested += used;
+    Vec3 point, dir;
+    if (!stationary_sample(d, i, at, point, dir)) continue;
+    points.push_back(point);
+    dirs.push_back(dir);
   }
 }
 
@@ -130,35 +108,6 @@ bool AgvsSolver::Impl::stationary_sample(int d, uint64_t i, const Vec3& at, Vec3
     }
   }
   return false;
-}
-
-uint32_t AgvsSolver::Impl::stationary_samples(int d, uint32_t attempts, std::vector<Vec3>& points,
-                                              std::vector<Vec3>& dirs) {
-  std::vector<uint64_t> index;
-  std::vector<Vec3> at;
-  if (d == kOd) {  // object points: every index gives a sample
-    index.resize(attempts);
-    for (uint32_t k = 0; k < attempts; ++k) index[k] = halton_index[d]++;
-    at.assign(attempts, Vec3{});
-  } else {
-    view_points(d, d == kTp ? 4 : 0, attempts, index, at);
-  }
-  std::vector<Vec3> p(attempts), dir(attempts);
-  std::vector<uint8_t> ok(attempts);
-  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, attempts, 256), [&](const tbb::blocked_range<uint32_t>& r) {
-    for (uint32_t k = r.begin(); k < r.end(); ++k)
-      ok[k] = index[k] != kNoIndex && stationary_sample(d, index[k], at[k], p[k], dir[k]);
-  });
-  uint32_t failed = 0;
-  for (uint32_t k = 0; k < attempts; ++k) {
-    if (!ok[k]) {
-      ++failed;
-      continue;
-    }
-    points.push_back(p[k]);
-    dirs.push_back(dir[k]);
-  }
-  return failed;
 }
 
 bool AgvsSolver::Impl::draw_two_point_mutation(Rng& rng, MutationLane& lane, Vec3& point, Vec3& dir) {

@@ -136,19 +136,20 @@ struct AgvsSolver::Impl {
     return {b.lo.x + e.x * u0, b.lo.y + e.y * u1, b.lo.z + e.z * u2};
   }
 
-  static constexpr uint64_t kNoIndex = ~uint64_t{0};
-  /// The Halton points of distribution d (dimensions dim .. dim+2) in the view space for the
-  /// next `attempts` samples, and their indices, as taking the indices one by one gives them:
-  /// per attempt the first index whose point is in the view space, or kNoIndex when 10,000 in
-  /// a row were not (the attempt fails).
-  void view_points(int d, int dim, uint32_t attempts, std::vector<uint64_t>& index, std::vector<Vec3>& point);
   /// Sample `i` of a stationary distribution d (view space-direction, object-direction,
-  /// two-point) into (point, dir), `at` its view point (view_points()); false when degenerate.
-  /// Thread-safe.
+  /// two-point) into (point, dir), `at` its view point (unused for object-direction); false
+  /// when degenerate. Thread-safe.
   bool stationary_sample(int d, uint64_t i, const Vec3& at, Vec3& point, Vec3& dir) const;
-  /// The next `attempts` samples of stationary distribution d appended in order, computed in
-  /// parallel; returns how many attempts failed.
-  uint32_t stationary_samples(int d, uint32_t attempts, std::vector<Vec3>& points, std::vector<Vec3>& dirs);
+  /// The samples of stationary distribution d at Halton indices first .. first + count - 1,
+  /// appended in order: an index whose view point lies outside the view space, or whose sample
+  /// is degenerate, gives none. Depends on nothing else, so a chunk's caster draws it alone.
+  /// Thread-safe.
+  void draw_stationary(int d, uint64_t first, uint32_t count, std::vector<Vec3>& points, std::vector<Vec3>& dirs) const;
+  /// The expected share of distribution d's Halton indices that give a sample: 1 without a
+  /// view space (or for object-direction); else from the samples and indices so far, and before
+  /// the first 4,096 indices from a test of those (computed once, the same on every rank).
+  double sample_share(int d);
+  double pilot_share[kDists] = {-1, -1, -1, -1, -1};
   /// Draws one two-point mutation sample from `lane` into (point, dir); false when it cannot
   /// (no candidate, a degenerate pair).
   bool draw_two_point_mutation(Rng& rng, MutationLane& lane, Vec3& point, Vec3& dir);
@@ -225,7 +226,9 @@ struct AgvsSolver::Impl {
                       const std::vector<uint8_t>& flags, const std::vector<std::array<double, 2>>& radius);
   /// REF's casting as the paper describes it: one forward ray per sample, into chunk `c`.
   void cast_ref_chunk(const BatchSamples& s, BatchChunk& c) const;
-  std::vector<BatchChunk> cast_samples(const BatchSamples& s);
+  /// Draws the stationary distributions' chunks and casts every chunk (on several ranks, each its
+  /// own, then shared); numbers the stationary samples (s.first_of, s.end_of, s.count).
+  std::vector<BatchChunk> cast_samples(BatchSamples& s);
   /// Applies a batch's segments in sample order: the table (on several ranks, each rank's own
   /// cells, then the gains and flags reduced over the ranks), then the counts and mutation
   /// candidates that follow from them.
@@ -233,11 +236,9 @@ struct AgvsSolver::Impl {
   /// Pass 1 of apply_segments for every method but REF: each segment's objects into the table
   /// of every cell it pierces (this rank's), in sample order per cell, in parallel over cells;
   /// its gains (entries added) and flags (contributed a, b; at origin a, b), and whether it is
-  /// its sample's camera segment (the first of a view space-direction sample through the
-  /// sample's point), which the estimator counts.
-  template <class OnSegment>
-  void insert_segments(const BatchSamples& s, const std::vector<BatchChunk>& chunks, OnSegment&& on_segment,
-                       std::vector<uint32_t>& gains, std::vector<uint8_t>& flags, std::vector<uint8_t>& own);
+  /// its sample's camera segment (BatchChunk::camera_cell), which the estimator counts.
+  void insert_segments(const std::vector<BatchChunk>& chunks, std::vector<uint32_t>& gains,
+                       std::vector<uint8_t>& flags, std::vector<uint8_t>& own);
   /// Combines the ranks' rows (and the filter's densities): afterwards every rank holds the
   /// whole table. Collective. No-op in one process.
   void sync();

@@ -6,7 +6,7 @@ namespace viewcells {
 
 namespace {
 constexpr char kStateMagic[5] = "VAGS";
-constexpr uint32_t kStateVersion = 4;
+constexpr uint32_t kStateVersion = 5;  // 5: stationary samples drawn by Halton index ranges
 }  // namespace
 
 void AgvsSolver::save(const std::string& path, uint64_t identity) const {

@@ -157,11 +157,12 @@ struct AgvsStats {
   uint64_t camera_rays = 0, wrong_camera_rays = 0;  ///< the estimator's rays since the start
   double seconds = 0;
   /// Where this run's time went, batch by batch (not saved with the state), in four parts that
-  /// add up: drawing the stationary distributions' samples (every rank draws them all), the
-  /// mutation lanes (drawing their samples, silhouette searches included, and taking their
-  /// candidates: divided among threads and, on a cluster, ranks), casting and finding the cells
-  /// (spread over the ranks; the exchange of results included), and applying the segments to
-  /// the table (divided by cells).
+  /// add up: planning the batch (the mixture's shares and the stationary distributions' Halton
+  /// index ranges; REF's draws), the mutation lanes (drawing their samples, silhouette searches
+  /// included, and taking their candidates: divided among threads and, on a cluster, ranks),
+  /// drawing the stationary distributions' samples, casting them and finding the cells (chunk by
+  /// chunk, each drawn and cast by one rank; the exchange of results included), and applying the
+  /// segments to the table (divided by cells).
   double draw_seconds = 0, cast_seconds = 0, apply_seconds = 0, mutation_seconds = 0;
   uint64_t segments = 0, pierced_cells = 0;  ///< segments applied, and cells they pierced in all
   std::string stop_reason;
