@@ -24,9 +24,10 @@ bad() { echo "FAIL: $*"; failed=$((failed + 1)); }
 # One thread a rank, not bound to a core: the ranks share the machine's cores with each other and
 # with the tests that run beside this one (mpirun binds each of one or two ranks to a core).
 ranks() { local n=$1; shift; timeout 300 mpirun --oversubscribe --bind-to none -np "$n" "$VC" "$@" --threads 1; }
-# A report without what may differ between runs: timings, rates, thread and rank counts.
+# A report without what may differ between runs: timings, rates, thread and rank counts (and the
+# per-rank phases, one entry a rank).
 numbers() {
-  jq -S 'del(.cluster) | walk(if type == "object" then with_entries(select(.key | test("seconds|per_second|time|threads|^output$|^report$") | not)) else . end)' "$1"
+  jq -S 'del(.cluster, .phases.per_rank) | walk(if type == "object" then with_entries(select(.key | test("seconds|per_second|time|threads|^output$|^report$") | not)) else . end)' "$1"
 }
 same_files() {  # WHAT A B
   if cmp -s "$2" "$3"; then ok; else bad "$1: $2 and $3 differ"; fi

@@ -3,6 +3,8 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
+#include "viewcells/core/cluster.h"
+
 namespace viewcells {
 
 struct ThreadLimit::Impl {
@@ -21,6 +23,12 @@ int hardware_threads() { return tbb::info::default_concurrency(); }
 
 int worker_threads() {
   return static_cast<int>(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+}
+
+std::string workers_text() {
+  const int t = worker_threads(), r = cluster::size();
+  const std::string threads = std::to_string(t) + (t == 1 ? " thread" : " threads");
+  return r > 1 ? std::to_string(r) + " ranks of " + threads : threads;
 }
 
 }  // namespace viewcells

@@ -254,6 +254,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     run.merge_agvs->max_seconds = run.merge_agvs->max_seconds > 0 ? std::min(run.merge_agvs->max_seconds, share) : share;
   }
   out.threads = worker_threads();
+  log("viewcells: bake on " + workers_text());
   const uint32_t max_cells = c.subdivision.max_cells ? c.subdivision.max_cells : (c.cells ? 4 * c.cells : 4096);
   LoadedScene loaded = load_scene_for_rays(c.scene, log);
   SubdivisionFile file = hierarchy(run, loaded, max_cells, out, log);

@@ -254,6 +254,22 @@ bool run_to_measured_error(AgvsSolver& solver, const AgvsConfig& a, const Measur
   }
 }
 
+std::vector<RankPhases> gather_phases(const AgvsStats& stats) {
+  RankPhases mine{stats.draw_seconds, stats.mutation_seconds, stats.cast_seconds, stats.apply_seconds,
+                  cluster::traffic().seconds};
+  std::vector<std::string> items(static_cast<size_t>(cluster::size()));
+  ByteWriter w;
+  w.put(mine);
+  items[static_cast<size_t>(cluster::rank())] = w.take();
+  cluster::share(items, [](size_t i) { return static_cast<int>(i); });
+  std::vector<RankPhases> all;
+  for (const std::string& item : items) {
+    ByteReader r(item, "a rank's phases");
+    all.push_back(r.get<RankPhases>());
+  }
+  return all;
+}
+
 PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   check_config(c);
   PvsResult out;
@@ -282,7 +298,7 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   out.rule = set.rule;
   out.cells = cells.cell_count();
   log("viewcells: " + std::to_string(cells.cell_count()) + " view cells (" + set.rule + "), PVS by " +
-      to_string(c.agvs.method) + " until " + describe_stop(c));
+      to_string(c.agvs.method) + " until " + describe_stop(c) + ", on " + workers_text());
   // On a Quake 3 map, AGVS's points are drawn in its non-solid space, and cameras stand where players do.
   std::shared_ptr<const Q3Map> map;
   if (is_q3_map(c.scene_path)) map = std::make_shared<const Q3Map>(read_q3bsp(c.scene_path));
@@ -325,6 +341,7 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
     log("viewcells: state -> " + c.save + " (continue with --resume)");
   }
   out.stats = solver->stats();
+  out.rank_phases = gather_phases(out.stats);
   if (measured_stop)
     out.stats.stop_reason = "measured pixel error at most " + fmt(c.measured_error, 3) + " (mean of " +
                             std::to_string(c.measure_cameras) + " cameras)";

@@ -15,6 +15,23 @@ namespace viewcells::pipeline {
 
 using namespace report_detail;  // the shared parts (report_parts.h)
 
+namespace {
+/// Each rank's phases: with its waiting in collectives, whether more ranks would help.
+json rank_phases_json(const std::vector<RankPhases>& ranks) {
+  json a = json::array();
+  for (size_t i = 0; i < ranks.size(); ++i) {
+    const RankPhases& p = ranks[i];
+    a.push_back({{"rank", i},
+                 {"draw_seconds", p.draw_seconds},
+                 {"mutation_seconds", p.mutation_seconds},
+                 {"cast_seconds", p.cast_seconds},
+                 {"apply_seconds", p.apply_seconds},
+                 {"exchange_seconds", p.exchange_seconds}});
+  }
+  return a;
+}
+}  // namespace
+
 std::string report_json(const PvsResult& r) {
   const PvsConfig& c = r.config;
   const AgvsStats& st = r.stats;
@@ -69,7 +86,8 @@ std::string report_json(const PvsResult& r) {
                  {"apply_seconds", st.apply_seconds},
                  {"mutation_seconds", st.mutation_seconds},
                  {"segments", st.segments},
-                 {"pierced_cells", st.pierced_cells}}},
+                 {"pierced_cells", st.pierced_cells},
+                 {"per_rank", rank_phases_json(r.rank_phases)}}},
                {"distributions", agvs_distributions(st)},
                {"curve", agvs_curve(st, c.references.size())}});
 }

@@ -2,6 +2,7 @@
 /// Thread control. Stages are written so that their output never depends on the thread count;
 /// this only bounds how many cores they use.
 #include <memory>
+#include <string>
 
 namespace viewcells {
 
@@ -26,5 +27,7 @@ class ThreadLimit {
 int hardware_threads();
 /// Threads parallel stages use now (the innermost ThreadLimit's, else all hardware threads).
 int worker_threads();
+/// What this run works on, for log lines: "2 threads", or on a cluster "3 ranks of 2 threads".
+std::string workers_text();
 
 }  // namespace viewcells

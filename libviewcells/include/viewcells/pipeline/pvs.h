@@ -91,11 +91,20 @@ bool run_to_measured_error(AgvsSolver& solver, const AgvsConfig& limits, const M
                            const SolverMeasuring& m, std::vector<MeasuredPoint>& curve, const Log& log,
                            const std::function<void()>& after_run = {});
 
+/// Where one rank's AGVS time went (AgvsStats' phases, and its waiting in collectives).
+struct RankPhases {
+  double draw_seconds = 0, mutation_seconds = 0, cast_seconds = 0, apply_seconds = 0, exchange_seconds = 0;
+};
+
+/// Every rank's phases, in rank order, on every rank (one entry in one process). Collective.
+std::vector<RankPhases> gather_phases(const AgvsStats& stats);
+
 struct PvsResult {
   PvsConfig config;
   std::string rule;
   uint32_t cells = 0;
   AgvsStats stats;
+  std::vector<RankPhases> rank_phases;  ///< where each rank's time went
   AgvsConfig agvs;  ///< as run (resolution, window, filter statistics)
   bool filtering = false;
   double mean_pvs = 0, mean_written = 0;
