@@ -1284,6 +1284,17 @@ def mpi_model(*args):
         "one lane": "as built, with one mutation lane (the default): the same, but the mutations drawn and fed "
                     "serially by one rank",
         "bound": "if everything were divided like casting (not built: the bound from the exchange alone)"}
+    print(f"One node of {cores} cores against one core (with {lanes:,} lanes; issue 58's target: at least 25x), and "
+          "the bound the network sets on the speed-up over one node (every rank receiving every segment: the "
+          "exchange alone, at any number of nodes):")
+    print()
+    print("| cells | one node over one core | the network's bound over one node |")
+    print("| --- | ---: | ---: |")
+    for cells, m in sorted(inputs.items()):
+        one_core = sum(m[key]["repeated"] + m[key]["divided"] for key in phase_keys)
+        node = per_sample(m, 1, "lanes")
+        print(f"| {cells:,} | {one_core / node:.1f}x | {node / (m['bytes'] / bandwidth):.1f}x |")
+    print()
     for mode, what in whats.items():
         print(f"{what}; batches of {batch:,} samples, {cores} cores per node, {bandwidth / 1e9:.0f} GB/s and "
               f"{latency * 1e6:.0f} µs between nodes: speed-up over one node (parallel efficiency)")
