@@ -14,5 +14,9 @@ int main(int argc, char** argv) {
   // Ctrl-C ends a long stage with an error and leaves the outputs as they were. On several
   // ranks mpirun or srun stop them all: one rank leaving a collective alone would hang the rest.
   if (viewcells::cluster::size() == 1) viewcells::install_interrupt_handlers();
-  return viewcells::cli::run(argc, argv);
+  const int rc = viewcells::cli::run(argc, argv);
+  // An error on one rank (a corrupt message, say) would leave the others waiting in a
+  // collective, and MPI_Finalize with them: end them all.
+  if (rc != 0 && viewcells::cluster::size() > 1) viewcells::cluster::abort_all(rc);
+  return rc;
 }

@@ -72,6 +72,19 @@ struct AgvsSolver::Impl::BatchChunk {
   /// knows the points.
   static constexpr int32_t kNotCamera = std::numeric_limits<int32_t>::min();
   std::vector<int32_t> camera_cell;
+  /// On several ranks (not REF): the pairs of this rank's cells, routed to it by the chunk's
+  /// caster with what inserting needs of their segment (pairs is then empty).
+  struct RoutedPair {
+    uint32_t segment;  ///< index in the chunk
+    int32_t cell;
+    uint32_t objects[2];
+    int32_t camera_cell;  ///< as camera_cell (kNotCamera: not its sample's camera segment)
+  };
+  std::vector<RoutedPair> routed;
+  /// Whether this rank cast the chunk and holds its segments: always in one process and for
+  /// REF; on several ranks otherwise only its caster, and the others know its counts alone.
+  bool here = true;
+  uint32_t segment_count = 0;  ///< its segments, known on every rank
   uint64_t pierced = 0;  ///< all ranks' pairs
   uint64_t rays = 0;
   size_t seg_start = 0;  ///< index of its first segment among the batch's

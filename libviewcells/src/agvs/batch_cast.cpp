@@ -120,68 +120,40 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(BatchSa
     }
     c.pierced = c.pairs.size();
   };
-  if (cluster::size() > 1) {
-    // Several ranks: each draws and casts the chunks it owns (numbered across batches, so that
-    // the work turns round the ranks; a chunk's owner may differ between rank counts, its
-    // content does not), and every rank receives all chunks. A mutation lane's chunks are its
-    // owner's, the only rank that drew their points. A chunk's pairs travel sorted by the rank
-    // of their cell: each rank keeps its own.
+  if (cluster::size() > 1 && config.method == AgvsMethod::kRef) {
+    // Several ranks, REF: each casts the chunks it owns, and every rank receives all of them
+    // (REF inserts one object a sample, into the sample's cell; every rank's cells are read
+    // from the segments).
     std::vector<std::string> items(chunks.size());
-    const uint64_t base = stats.batches * 4096;
-    const uint64_t ranks = static_cast<uint64_t>(cluster::size());
-    auto owner = [&](size_t k) {
-      return chunks[k].lane >= 0 ? lane_owner(static_cast<size_t>(chunks[k].lane)) : static_cast<int>((base + k) % ranks);
-    };
+    auto owner = [&](size_t k) { return chunk_owner(chunks, k); };
     tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
       if (owner(k) != cluster::rank()) return;
       BatchChunk& c = chunks[k];
       cast_chunk(c);
       ByteWriter w;
-      w.put(c.size);
       w.put(c.rays);
       w.put_array(c.sample_of);
       put_segments(w, c.segs);
-      w.put_array(c.camera_cell);
-      w.put(c.pierced);
-      std::vector<std::vector<BatchChunk::CellPair>> of_rank(ranks);
-      for (const BatchChunk::CellPair& p : c.pairs) of_rank[static_cast<uint64_t>(p.cell) % ranks].push_back(p);
-      for (const auto& pairs : of_rank) w.put_array(pairs);
       items[k] = w.take();
     });
     cluster::share(items, owner);
     for (size_t k = 0; k < chunks.size(); ++k) {
       BatchChunk& c = chunks[k];
       ByteReader r(items[k], "a rank's casting results");
-      const uint32_t size = r.get<uint32_t>();
-      if (c.halton_count > 0 ? size > c.halton_count : size != c.size) r.fail("a chunk's sample count is wrong");
-      c.size = size;
       c.rays = r.get<uint64_t>();
       r.get_array(c.sample_of, items[k].size());
       get_segments(r, c.segs, items[k].size());
       if (c.sample_of.size() != c.segs.size()) r.fail("a chunk's segments and samples differ in number");
       for (uint32_t sample : c.sample_of)
         if (sample >= c.size) r.fail("a segment's sample is out of range");
-      r.get_array(c.camera_cell, items[k].size());
-      if (!c.camera_cell.empty() && (c.dist != kVsd || c.camera_cell.size() != c.segs.size()))
-        r.fail("a chunk's camera segments are wrong");
-      for (int32_t cell : c.camera_cell)
-        if (cell != BatchChunk::kNotCamera && (cell < -1 || cell >= static_cast<int32_t>(cells.cell_count())))
-          r.fail("a camera's cell is out of range");
-      c.pierced = r.get<uint64_t>();
-      std::vector<BatchChunk::CellPair> pairs;
-      for (uint64_t rank = 0; rank < ranks; ++rank) {
-        r.get_array(pairs, items[k].size());
-        if (rank != static_cast<uint64_t>(cluster::rank())) continue;
-        for (const BatchChunk::CellPair& p : pairs)
-          if (p.segment >= c.segs.size() || p.cell < 0 || static_cast<uint32_t>(p.cell) >= cells.cell_count() ||
-              !cluster::mine(static_cast<uint64_t>(p.cell)))
-            r.fail("a segment's cell is out of range");
-        c.pairs = std::move(pairs);
-      }
     }
+  } else if (cluster::size() > 1) {
+    route_chunks(chunks, cast_chunk);
   } else {
     tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) { cast_chunk(chunks[k]); });
   }
+  for (BatchChunk& c : chunks)
+    if (c.here) c.segment_count = static_cast<uint32_t>(c.segs.size());
   // The stationary distributions' samples follow the mutations' (kOrder), numbered in chunk
   // order now that each chunk's count is known.
   uint32_t next = static_cast<uint32_t>(s.points.size());
@@ -197,7 +169,7 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(BatchSa
   size_t total = 0;
   for (BatchChunk& c : chunks) {
     c.seg_start = total;
-    total += c.segs.size();
+    total += c.segment_count;
   }
   return chunks;
 }
@@ -205,5 +177,89 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(BatchSa
 /// What applying a batch counted: per distribution, and the estimator's camera rays per sample
 /// (0 when the sample's point is inside a solid: no camera stands there) and those that were
 /// wrong pixels (an entry new to the point's cell).
+
+int AgvsSolver::Impl::chunk_owner(const std::vector<BatchChunk>& chunks, size_t k) const {
+  // Numbered across batches, so that the work turns round the ranks; a chunk's owner may differ
+  // between rank counts, its content does not. A mutation lane's chunks are its owner's, the
+  // only rank that drew their points.
+  const uint64_t ranks = static_cast<uint64_t>(cluster::size());
+  return chunks[k].lane >= 0 ? lane_owner(static_cast<size_t>(chunks[k].lane))
+                             : static_cast<int>((stats.batches * 4096 + k) % ranks);
+}
+
+void AgvsSolver::Impl::route_chunks(std::vector<BatchChunk>& chunks, const std::function<void(BatchChunk&)>& cast_chunk) {
+  // Several ranks: each draws and casts the chunks it owns. Every rank learns every chunk's
+  // counts (a small allgather); the segments stay with their caster, and each (segment, cell)
+  // pair goes only to the rank of its cell, with the segment's objects and camera cell (an
+  // all-to-all), in segment order.
+  const int me = cluster::rank();
+  const size_t ranks = static_cast<size_t>(cluster::size());
+  std::vector<std::string> meta(chunks.size());
+  std::vector<std::vector<std::vector<BatchChunk::RoutedPair>>> out(chunks.size());
+  tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
+    if (chunk_owner(chunks, k) != me) return;
+    BatchChunk& c = chunks[k];
+    cast_chunk(c);
+    ByteWriter w;
+    w.put(c.size);
+    w.put(static_cast<uint32_t>(c.segs.size()));
+    w.put(c.rays);
+    w.put(c.pierced);
+    meta[k] = w.take();
+    out[k].resize(ranks);
+    for (const BatchChunk::CellPair& p : c.pairs) {
+      const uint32_t i = p.segment;
+      out[k][static_cast<uint64_t>(p.cell) % ranks].push_back(
+          {i, p.cell, {c.segs.object_a[i], c.segs.object_b[i]},
+           c.camera_cell.empty() ? BatchChunk::kNotCamera : c.camera_cell[i]});
+    }
+    c.routed = std::move(out[k][static_cast<size_t>(me)]);
+    c.pairs = {};
+  });
+  cluster::share(meta, [&](size_t k) { return chunk_owner(chunks, k); });
+  for (size_t k = 0; k < chunks.size(); ++k) {
+    BatchChunk& c = chunks[k];
+    if (chunk_owner(chunks, k) == me) continue;
+    ByteReader r(meta[k], "a rank's casting counts");
+    const uint32_t size = r.get<uint32_t>();
+    if (c.halton_count > 0 ? size > c.halton_count : size != c.size) r.fail("a chunk's sample count is wrong");
+    c.size = size;
+    c.segment_count = r.get<uint32_t>();
+    c.rays = r.get<uint64_t>();
+    c.pierced = r.get<uint64_t>();
+    c.here = false;
+  }
+  std::vector<std::string> to(ranks);
+  for (size_t q = 0; q < ranks; ++q) {
+    if (q == static_cast<size_t>(me)) continue;
+    ByteWriter w;
+    for (size_t k = 0; k < chunks.size(); ++k) {
+      if (out[k].empty() || out[k][q].empty()) continue;
+      w.put(static_cast<uint64_t>(k));
+      w.put_array(out[k][q]);
+    }
+    to[q] = w.take();
+  }
+  const std::vector<std::string> from = cluster::exchange(std::move(to));
+  const uint32_t n_cells = cells.cell_count(), n_objects = pvs.object_count();
+  for (size_t q = 0; q < ranks; ++q) {
+    if (q == static_cast<size_t>(me)) continue;
+    ByteReader r(from[q], "a rank's routed segments");
+    while (!r.at_end()) {
+      const uint64_t k = r.get<uint64_t>();
+      if (k >= chunks.size() || chunk_owner(chunks, k) != static_cast<int>(q)) r.fail("a chunk from a rank not its caster");
+      BatchChunk& c = chunks[k];
+      r.get_array(c.routed, from[q].size());
+      for (const BatchChunk::RoutedPair& p : c.routed) {
+        const bool object_ok = (p.objects[0] == kNoObject || p.objects[0] < n_objects) &&
+                               (p.objects[1] == kNoObject || p.objects[1] < n_objects);
+        if (p.segment >= c.segment_count || p.cell < 0 || static_cast<uint32_t>(p.cell) >= n_cells ||
+            !cluster::mine(static_cast<uint64_t>(p.cell)) || !object_ok ||
+            (p.camera_cell != BatchChunk::kNotCamera && (p.camera_cell < -1 || p.camera_cell >= static_cast<int32_t>(n_cells))))
+          r.fail("a routed segment is out of range");
+      }
+    }
+  }
+}
 
 }  // namespace viewcells

@@ -236,9 +236,23 @@ struct AgvsSolver::Impl {
   /// Pass 1 of apply_segments for every method but REF: each segment's objects into the table
   /// of every cell it pierces (this rank's), in sample order per cell, in parallel over cells;
   /// its gains (entries added) and flags (contributed a, b; at origin a, b), and whether it is
-  /// its sample's camera segment (BatchChunk::camera_cell), which the estimator counts.
+  /// its sample's camera segment (BatchChunk::camera_cell), which the estimator counts. Its
+  /// pairs are the chunks' own (one process) or those routed to this rank.
   void insert_segments(const std::vector<BatchChunk>& chunks, std::vector<uint32_t>& gains,
-                       std::vector<uint8_t>& flags, std::vector<uint8_t>& own);
+                       std::vector<uint8_t>& flags);
+  /// Several ranks (not REF): the rank that casts chunk k (the same function on every rank).
+  int chunk_owner(const std::vector<BatchChunk>& chunks, size_t k) const;
+  /// Several ranks (not REF): each rank draws and casts its chunks, every rank learns every
+  /// chunk's counts, and each (segment, cell) pair goes only to its cell's rank.
+  void route_chunks(std::vector<BatchChunk>& chunks, const std::function<void(BatchChunk&)>& cast_chunk);
+  /// Several ranks (not REF): each segment's gains and flags from the ranks of its cells to its
+  /// caster, summed and or-ed there.
+  void return_outcomes(const std::vector<BatchChunk>& chunks, std::vector<uint32_t>& gains,
+                       std::vector<uint8_t>& flags);
+  /// Several ranks (not REF): the casters send each contributing end's candidate to its lane's
+  /// owner, which feeds its lanes in sample order; every rank learns the lanes' counts.
+  void route_candidates(const std::vector<BatchChunk>& chunks, const std::vector<uint8_t>& flags,
+                        const std::vector<std::array<double, 2>>& radius);
   /// Combines the ranks' rows (and the filter's densities): afterwards every rank holds the
   /// whole table. Collective. No-op in one process.
   void sync();

@@ -49,9 +49,7 @@ Candidate Builder::best_geometry_candidate(int32_t node, Evaluation& ev, const d
   // order, for all the planes' passes; in a larger one, each object's extreme part ends, from
   // which the planes are bounded (below). A large cell's parts are not kept: only about one of
   // its planes in 25 is then evaluated on all of them (oa_shouse: 1,251 of 31,732), and
-  // that pass reads them again from the segments. (Kept, and the extremes taken in a pass of
-  // their own, the map's subdivision took 0.91 s against 0.87 s by medians of seven
-  // alternating runs: scripts/bench-ab-subdivision.sh 93e71b1 7 map:oa_shouse.)
+  // that pass reads them again from the segments (BENCHMARKS.md, "Decisions measured").
   constexpr size_t kBoundedParts = 2048;
   const bool large = refs.size() > kBoundedParts;
   struct PartEnds {

@@ -325,11 +325,8 @@ class FilteredSide {
 };
 
 /// One object's part ends that lie lowest and highest along each axis: real ends, so that the
-/// exact side of any of them is that of an end of one of the object's parts. (With the 4 body
-/// diagonals of a cube too, 7 directions, the bound let through 7% fewer planes to a pass over
-/// all parts, but oa_shouse's subdivision took 8% longer in alternating runs: 1.57-1.60 s
-/// against 1.44-1.48 s; with the 6 face diagonals as well, longer still. With two axes, 33%
-/// more passes and 1.52-1.57 s.)
+/// exact side of any of them is that of an end of one of the object's parts. (Three axes: more
+/// directions or fewer were slower; BENCHMARKS.md, "Decisions measured".)
 struct ObjectExtremes {
   static constexpr int kEnds = 6;
   uint32_t object;

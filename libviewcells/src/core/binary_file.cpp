@@ -205,8 +205,7 @@ std::string read_container(const std::string& path, const char (&magic)[5], uint
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec))
     throw Error(path, 0, std::filesystem::exists(path, ec) ? "not a regular file" : "no such file");
-  // Read in blocks: through a character iterator, `extract` of the city's default 50k-cell
-  // hierarchy (72 MB) took 2.8-3.0 s, in one read 2.4-2.55 s (three alternating runs).
+  // Read in blocks, not through a character iterator (BENCHMARKS.md, "Decisions measured").
   const std::string file = read_file_bytes(path);
   ByteReader r(file, path);
   if (file.size() < 32) throw Error(path, 0, "not a " + std::string(magic) + " file (too short)");

@@ -66,6 +66,14 @@ Session::~Session() {
 #endif
 }
 
+void abort_all(int code) {
+#ifdef VIEWCELLS_MPI
+  if (g_mpi && g_size > 1) MPI_Abort(MPI_COMM_WORLD, code);
+#else
+  (void)code;
+#endif
+}
+
 int rank() { return g_rank; }
 int size() { return g_size; }
 bool built_with_mpi() {
@@ -125,6 +133,45 @@ void share(std::vector<std::string>& items, const std::function<int(size_t)>& ow
   g_traffic.bytes_sent += static_cast<uint64_t>(len);
   g_traffic.bytes_received += total - static_cast<uint64_t>(len);
   g_traffic.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+#endif
+}
+
+std::vector<std::string> exchange(std::vector<std::string> to) {
+  if (to.size() != static_cast<size_t>(g_size)) throw Error("MPI: an exchange needs one message per rank");
+  if (g_size == 1) return to;
+#ifdef VIEWCELLS_MPI
+  const auto start = std::chrono::steady_clock::now();
+  std::vector<int> send_lens(g_size), send_offsets(g_size), recv_lens(g_size), recv_offsets(g_size);
+  std::string send;
+  for (int r = 0; r < g_size; ++r) {
+    if (r == g_rank) continue;
+    if (send.size() + to[r].size() > static_cast<uint64_t>(INT32_MAX))
+      throw Error("MPI: a rank's share of one exchange exceeds 2 GB; use smaller batches");
+    send_offsets[r] = static_cast<int>(send.size());
+    send_lens[r] = static_cast<int>(to[r].size());
+    send += to[r];
+  }
+  check(MPI_Alltoall(send_lens.data(), 1, MPI_INT, recv_lens.data(), 1, MPI_INT, MPI_COMM_WORLD), "alltoall of sizes");
+  uint64_t total = 0;
+  for (int r = 0; r < g_size; ++r) {
+    recv_offsets[r] = static_cast<int>(total);
+    total += static_cast<uint64_t>(recv_lens[r]);
+    if (total > static_cast<uint64_t>(INT32_MAX)) throw Error("MPI: one exchange exceeds 2 GB; use smaller batches");
+  }
+  std::string recv(total, '\0');
+  check(MPI_Alltoallv(send.data(), send_lens.data(), send_offsets.data(), MPI_BYTE, recv.data(), recv_lens.data(),
+                      recv_offsets.data(), MPI_BYTE, MPI_COMM_WORLD),
+        "alltoallv");
+  std::vector<std::string> from(g_size);
+  for (int r = 0; r < g_size; ++r)
+    from[r] = r == g_rank ? std::move(to[r]) : recv.substr(static_cast<size_t>(recv_offsets[r]), recv_lens[r]);
+  g_traffic.calls += 1;
+  g_traffic.bytes_sent += send.size();
+  g_traffic.bytes_received += total;
+  g_traffic.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return from;
+#else
+  return to;
 #endif
 }
 

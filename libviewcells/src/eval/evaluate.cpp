@@ -180,10 +180,8 @@ uint32_t objects_seen(const SegmentSet& eval) {
 
 constexpr size_t kMaxBitBytes = size_t{512} << 20;
 /// Bits only from 512 objects on: few objects make short lists, which the check of the last
-/// pair keeps cheap, so the lists lose nothing measurable there. (On the office's 3,392 leaves
-/// and 100 objects, 4.4M segments in bench/eval_bench.cpp, bits forced took 1.76-2.23 s and
-/// the lists 1.95-2.52 s in alternating runs: within the noise; with the bits stored per leaf,
-/// 1.79-1.83 s against 1.84-1.98 s.)
+/// pair keeps cheap, so the lists lose nothing measurable there (BENCHMARKS.md, "Decisions
+/// measured").
 constexpr size_t kMinBitObjects = 512;
 
 /// Whether the automatic gather takes bits for rows of `leaves` x `objects`.

@@ -28,6 +28,9 @@ class Session {
   Session& operator=(const Session&) = delete;
 };
 
+/// Ends every rank of the run with `code` (MPI_Abort): after an error on one rank, which would
+/// otherwise leave the others waiting in a collective. Returns only in one process.
+void abort_all(int code);
 int rank();  ///< 0 .. size() - 1
 int size();
 inline bool writer() { return rank() == 0; }
@@ -43,6 +46,9 @@ void share(std::vector<std::string>& items, uint64_t first = 0);
 /// As above, with item i belonging to rank owner(i) (the same function on every rank).
 void share(std::vector<std::string>& items, const std::function<int(size_t)>& owner);
 
+/// All-to-all: to[r] is what this rank sends rank r (to[rank()] stays here); returns from[r],
+/// what rank r sent this one. Collective: every rank calls it with size() entries.
+std::vector<std::string> exchange(std::vector<std::string> to);
 /// Element-wise sums and bitwise ors over all ranks, in place (every rank gets the result).
 /// Collective: every rank calls them with vectors of the same length.
 void sum(std::vector<uint16_t>& v);

@@ -194,8 +194,7 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
 /// Held-out random samples of a validated merge per construction sample. With as many as the
 /// construction drew, the office's choice let cuts through that 16M independent samples a set
 /// rate 2.5% worse than AV-S's (docs/accuracy-vs-time.md); with 4x none (8x chose the same), for
-/// about 1.6x AV-M's build time (office at 5,000 cells 15.3 s against 9.8 s; the city's merge of
-/// 50k cells 97 s against 59 s, BENCHMARKS.md, before the held-out walk in Z-order).
+/// about 1.6x AV-M's build time (BENCHMARKS.md, "Decisions measured").
 constexpr uint64_t kHeldOutPerConstructionSample = 4;
 /// The held-out random samples are drawn and walked down the tree this many at a time (memory).
 constexpr uint64_t kHeldOutChunk = 1'000'000;
