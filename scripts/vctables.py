@@ -9,6 +9,7 @@ Usage: vctables.py COMMAND ARGS...   (vctables.py --help lists the commands)
 import csv
 import glob
 import json
+import subprocess
 import math
 import os
 import re
@@ -1095,6 +1096,11 @@ def agvs_measured(out, seconds, *scenes):
     """BENCHMARKS.md, agvs-measured: time to a measured pixel error for AGVS, SGVS and REF; writes OUT/SCENE/METHOD.dat."""
     errors = (10000, 1000, 100, 10, 1)
     names = {"agvs": "AGVS", "sgvs": "SGVS", "ref": "REF"}
+    made = subprocess.run(["sh", "-c", "echo \"$(date +%Y-%m-%d), commit $(git rev-parse --short HEAD), "
+                           "$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //'), $(nproc) cores.\""],
+                          capture_output=True, text=True).stdout.strip()
+    print(made)
+    print()
     print(f"Each method computes the PVSs of the same view cells for {float(seconds):.0f} s (the solver's own clock; "
           "2 threads), measured part-way at log-spaced sample counts (`pvs --measure-at`) by the same 5,000 cameras "
           "of 32x32 pixels, 90 degrees wide: on the maps player eyes above floors reachable from the spawn points "
