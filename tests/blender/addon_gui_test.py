@@ -73,8 +73,13 @@ def watch():
     print(f"ticks {state['ticks']}, progress seen {steps}, status '{s.status}'")
     if cells is None or len(cells.objects) != 8:
         finish(f"FAIL: no cells after the background bake ({s.status})", 1)
-    if len(steps) < 3 or state["progress"] != sorted(state["progress"]):
-        finish(f"FAIL: the progress bar should rise through several stages: {state['progress']}", 1)
+    # The bar as the timers saw it only rises; the bake's stages, as the add-on set them, are
+    # several (the timers, every 0.25 s, may miss the short early ones on a fast machine).
+    print(f"stages set: {addon.last_stages}")
+    if len(steps) < 2 or state["progress"] != sorted(state["progress"]):
+        finish(f"FAIL: the progress bar should rise while the bake runs: {state['progress']}", 1)
+    if len(addon.last_stages) < 5 or addon.last_stages != sorted(addon.last_stages):
+        finish(f"FAIL: the bake should go through its stages in order: {addon.last_stages}", 1)
     if not os.path.exists(s.output) or not os.path.exists(s.gltf):
         finish("FAIL: the .pvs or the .glb is missing", 1)
     # A click on a cell (here: making it the active object) selects its PVS, through the

@@ -576,15 +576,17 @@ class MpiModelTest(unittest.TestCase):
         # Per sample in µs: repeated + divided among ranks (serial share among a node's cores).
         cells = row(out, "500")
         self.assertEqual(cells[1:8], ["100.00 + 0.00 (20%)", "0.00 + 40.00 (0%)", "0.00 + 1000.00 (0%)",
-                                      "100.00 + 100.00 (50%)", "30.00", "100", "2.0"])
+                                      "100.00 + 100.00 (50%)", "30.00", "200", "2.0"])
         # Pierced cells double per tenfold cells: at 50,000 cells 8 per segment, applying doubled.
         self.assertIn("cells^0.30", out)
         self.assertEqual(row(out, "50,000")[4], "200.00 + 200.00 (50%)")
         rows = [l for l in out.splitlines() if l.startswith("| 500 | 1.0 (100%)")]
         self.assertEqual(len(rows), 3)
 
+        # Routed: all ranks' bytes are twice what rank 0 sent and received at two ranks (200 a
+        # sample), of which a rank receives (n - 1) / n^2.
         def exchange(n):
-            return (n - 1) / n * 100 / 1e10 + (5 * math.ceil(math.log2(n)) * 5e-6 / 20000 if n > 1 else 0)
+            return (n - 1) / n ** 2 * 200 / 1e10 + (5 * math.ceil(math.log2(n)) * 5e-6 / 20000 if n > 1 else 0)
 
         def node(r, dv, share, n):
             return (r + dv / n) * (share + (1 - share) / 32)
@@ -600,6 +602,13 @@ class MpiModelTest(unittest.TestCase):
         for k, t in enumerate((lambda n: built(n, False), lambda n: built(n, True), bound)):
             self.assertEqual(rows[k].split("|")[3].strip(), f"{t(1) / t(2):.1f} ({100 * t(1) / t(2) / 2:.0f}%)")
             self.assertEqual(rows[k].split("|")[8].strip(), f"{t(1) / t(64):.1f} ({100 * t(1) / t(64) / 64:.0f}%)")
+        # One node of 32 cores over one core, and the model's bytes received at four ranks
+        # (no four-rank run here: not measured).
+        one_node = [l for l in out.splitlines() if l.startswith("| 500 |") and l.endswith("% |") and "x |" in l]
+        self.assertEqual(len(one_node), 1)
+        fields = [f.strip() for f in one_node[0].split("|")[1:-1]]
+        self.assertEqual(fields[1], f"{(1e-4 + 4e-5 + 1e-3 + 2e-4) / built(1, False):.1f}x")
+        self.assertEqual(fields[2], "- / 38")
 
 
 if __name__ == "__main__":

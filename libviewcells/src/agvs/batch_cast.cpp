@@ -91,6 +91,8 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(BatchSa
     const Vec3* points = s.points.data() + c.first;
     const Vec3* dirs = s.dirs.data() + c.first;
     if (c.halton_count > 0) {
+      drawn_points.reserve(std::min(c.halton_count, 2 * kChunkSamples));
+      drawn_dirs.reserve(std::min(c.halton_count, 2 * kChunkSamples));
       draw_stationary(c.dist, c.halton_first, c.halton_count, drawn_points, drawn_dirs);
       c.size = static_cast<uint32_t>(drawn_points.size());
       points = drawn_points.data(), dirs = drawn_dirs.data();
@@ -121,32 +123,7 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(BatchSa
     c.pierced = c.pairs.size();
   };
   if (cluster::size() > 1 && config.method == AgvsMethod::kRef) {
-    // Several ranks, REF: each casts the chunks it owns, and every rank receives all of them
-    // (REF inserts one object a sample, into the sample's cell; every rank's cells are read
-    // from the segments).
-    std::vector<std::string> items(chunks.size());
-    auto owner = [&](size_t k) { return chunk_owner(chunks, k); };
-    tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
-      if (owner(k) != cluster::rank()) return;
-      BatchChunk& c = chunks[k];
-      cast_chunk(c);
-      ByteWriter w;
-      w.put(c.rays);
-      w.put_array(c.sample_of);
-      put_segments(w, c.segs);
-      items[k] = w.take();
-    });
-    cluster::share(items, owner);
-    for (size_t k = 0; k < chunks.size(); ++k) {
-      BatchChunk& c = chunks[k];
-      ByteReader r(items[k], "a rank's casting results");
-      c.rays = r.get<uint64_t>();
-      r.get_array(c.sample_of, items[k].size());
-      get_segments(r, c.segs, items[k].size());
-      if (c.sample_of.size() != c.segs.size()) r.fail("a chunk's segments and samples differ in number");
-      for (uint32_t sample : c.sample_of)
-        if (sample >= c.size) r.fail("a segment's sample is out of range");
-    }
+    gather_chunks(chunks, cast_chunk);
   } else if (cluster::size() > 1) {
     route_chunks(chunks, cast_chunk);
   } else {
@@ -177,6 +154,35 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(BatchSa
 /// What applying a batch counted: per distribution, and the estimator's camera rays per sample
 /// (0 when the sample's point is inside a solid: no camera stands there) and those that were
 /// wrong pixels (an entry new to the point's cell).
+
+void AgvsSolver::Impl::gather_chunks(std::vector<BatchChunk>& chunks, const std::function<void(BatchChunk&)>& cast_chunk) {
+  // Several ranks, REF: each casts the chunks it owns, and every rank receives all of them
+  // (REF inserts one object a sample, into the sample's cell; every rank's cells are read
+  // from the segments).
+  std::vector<std::string> items(chunks.size());
+  auto owner = [&](size_t k) { return chunk_owner(chunks, k); };
+  tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
+    if (owner(k) != cluster::rank()) return;
+    BatchChunk& c = chunks[k];
+    cast_chunk(c);
+    ByteWriter w;
+    w.put(c.rays);
+    w.put_array(c.sample_of);
+    put_segments(w, c.segs);
+    items[k] = w.take();
+  });
+  cluster::share(items, owner);
+  for (size_t k = 0; k < chunks.size(); ++k) {
+    BatchChunk& c = chunks[k];
+    ByteReader r(items[k], "a rank's casting results");
+    c.rays = r.get<uint64_t>();
+    r.get_array(c.sample_of, items[k].size());
+    get_segments(r, c.segs, items[k].size());
+    if (c.sample_of.size() != c.segs.size()) r.fail("a chunk's segments and samples differ in number");
+    for (uint32_t sample : c.sample_of)
+      if (sample >= c.size) r.fail("a segment's sample is out of range");
+  }
+}
 
 int AgvsSolver::Impl::chunk_owner(const std::vector<BatchChunk>& chunks, size_t k) const {
   // Numbered across batches, so that the work turns round the ranks; a chunk's owner may differ

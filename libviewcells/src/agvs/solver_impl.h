@@ -240,7 +240,9 @@ struct AgvsSolver::Impl {
   /// pairs are the chunks' own (one process) or those routed to this rank.
   void insert_segments(const std::vector<BatchChunk>& chunks, std::vector<uint32_t>& gains,
                        std::vector<uint8_t>& flags);
-  /// Several ranks (not REF): the rank that casts chunk k (the same function on every rank).
+  /// Several ranks, REF: each rank casts its chunks, and every rank receives all of them.
+  void gather_chunks(std::vector<BatchChunk>& chunks, const std::function<void(BatchChunk&)>& cast_chunk);
+  /// Several ranks: the rank that casts chunk k (the same function on every rank).
   int chunk_owner(const std::vector<BatchChunk>& chunks, size_t k) const;
   /// Several ranks (not REF): each rank draws and casts its chunks, every rank learns every
   /// chunk's counts, and each (segment, cell) pair goes only to its cell's rank.

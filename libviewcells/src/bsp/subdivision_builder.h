@@ -13,13 +13,17 @@
 #include <array>
 #include <atomic>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
+#include <queue>
+#include <utility>
 #include <vector>
 
 #include "bsp/subdivision_parts.h"
 #include "viewcells/bsp/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
+#include "viewcells/core/progress.h"
 #include "viewcells/scene/scene.h"
 
 namespace viewcells::subdivision_detail {
@@ -141,6 +145,31 @@ class Builder {
   /// Removes the nodes from id n on and the planes of uncommitted splits (the splits undone).
   void truncate_nodes(size_t n);
 
+  /// The queue of cells to split: by priority, ties to the older node.
+  using QueueEntry = std::pair<double, int32_t>;  // priority, node
+  struct QueueOrder {
+    bool operator()(const QueueEntry& x, const QueueEntry& y) const {
+      return x.first < y.first || (x.first == y.first && x.second > y.second);  // ties: older node first
+    }
+  };
+  std::priority_queue<QueueEntry, std::vector<QueueEntry>, QueueOrder> queue_;
+  double cost_ = 0;         ///< the tree's cost so far
+  uint32_t stagnant_ = 0;   ///< successive splits below the minimum reduction
+  bool stopped_ = false;    ///< the stagnation rule stopped the splits
+
+  /// The root: planes of the view box, the segments in Z-order, the polygons or viewpoints of
+  /// the baselines, the initial cost, and its first evaluation in the queue.
+  void start_tree();
+  /// The next round: the queue's first cells with their cells cut (run()).
+  void take_round(std::vector<PendingSplit>& round, size_t round_size);
+  /// A prepared and evaluated round split in the serial order until a child outranks the next
+  /// cell (or the stagnation rule stops); the rest undone and queued again. Returns the cells
+  /// it went through.
+  size_t replay_round(const std::vector<PendingSplit>& round, size_t first_child,
+                      const std::vector<Evaluation>& evaluations, Progress& progress);
+  /// Each leaf's segment ids in the caller's numbering, and the statistics.
+  void finish_tree();
+
   /// Adds what evaluating a node of the tree took to the statistics (counted once the node is
   /// in the tree: evaluations of a round's undone children are not).
   void count_evaluation(int32_t node, const Evaluation& e);
@@ -208,6 +237,29 @@ class Builder {
   /// (the best axis-aligned reduction: ties keep the axis) are evaluated on all parts, so a
   /// plane left out could not have been chosen.
   Candidate best_geometry_candidate(int32_t node, Evaluation& ev, const double* r, double to_beat);
+
+  /// What best_geometry_candidate gathers from a cell's parts in one pass.
+  struct GeometryParts {
+    struct PartEnds {
+      Vec3 p0, p1;
+      uint32_t object_a, object_b;
+    };
+    bool large = false;                    ///< too many parts to keep: bounded by the extremes
+    std::vector<PartEnds> parts;           ///< not large: every part's ends and objects, in order
+    std::vector<ObjectExtremes> extremes;  ///< large: each object's extreme part ends
+    Box3 points;                           ///< every part end
+    std::vector<uint32_t> tris;            ///< the distinct triangles hit at ends inside, sorted
+  };
+  GeometryParts gather_geometry_parts(int32_t node);
+  /// One triangle per distinct plane of `tris` (a random subset of at most ga_candidates).
+  std::vector<uint32_t> geometry_planes(int32_t node, const std::vector<uint32_t>& tris) const;
+  /// r(PVS) of each side of `plane`: exact from the parts, or a lower bound from the extremes.
+  std::pair<double, double> geometry_side_costs(int32_t node, const GeometryParts& g, const Plane& plane,
+                                                bool from_extremes, const double* r);
+  /// Bounded candidates (valid, reduction = bound) evaluated exactly (`exact(j)`) from the
+  /// highest bound down until no later one can beat the best; the others made invalid.
+  void evaluate_best_bounds(std::vector<Candidate>& results, double to_beat, double margin,
+                            const std::function<double(size_t)>& exact);
 
   const Scene& scene_;
   const SegmentSet& segs_;

@@ -38,6 +38,7 @@ CELLS_COLLECTION = "viewcells cells"
 CELL_MATERIAL = "viewcells cell"
 _baked = {}  # .pvs path (absolute) -> viewcells.Baked of this session
 _job = None  # the bake running in the background (a modal run from the panel)
+last_stages = []  # the progress values the last background bake went through, in order
 
 
 # ---------------------------------------------------------------------------------------------
@@ -406,11 +407,14 @@ class VIEWCELLS_OT_bake(bpy.types.Operator):
             context.scene.viewcells.status = f"failed: {e}"
             self.report({"ERROR"}, str(e))
             return {"CANCELLED"}
-        job = {"line": "starting", "p": 0.0, "baked": None, "error": None, "members": members}
+        job = {"line": "starting", "p": 0.0, "baked": None, "error": None, "members": members, "stages": []}
 
         def progress(line):
             job["line"] = line.replace("viewcells: ", "")
-            job["p"] = progress_of(line, job["p"])
+            p = progress_of(line, job["p"])
+            if p != job["p"]:
+                job["stages"].append(p)
+            job["p"] = p
 
         def run():
             try:
@@ -443,6 +447,7 @@ class VIEWCELLS_OT_bake(bpy.types.Operator):
         context.window_manager.event_timer_remove(self._timer)
         context.window_manager.progress_end()
         _job = None
+        last_stages[:] = job["stages"]
         settings.progress = 0
         if job["error"]:
             settings.status = f"failed: {job['error']}"
