@@ -15,14 +15,13 @@ bench_ab_binaries "$old"
 scene=$(bench_scene city 23)
 out="$dir/ab-agvs-thread"
 mkdir -p "$out"
-[ -f "$out/city5000.vcells" ] || "$vc" -q build "$scene" --samples 1000000 --max-cells 5000 --merge-pvs samples \
-  --seed 1 -o "$out/city5000.vcells"
+level=$(bench_city_cells 1000000 5000)
 results="$out/runs.tsv"
 : >"$results"
 for r in $(seq "$runs"); do
   for cells in 500 5000; do
     for side in old new; do
-      "${bin[$side]}" --threads 1 -q pvs "$out/city5000.vcells" --scene "$scene" --cells "$cells" --samples 1000000 \
+      "${bin[$side]}" --threads 1 -q pvs "$level" --scene "$scene" --cells "$cells" --samples 1000000 \
         --batch 20000 --seed 1 -o "$out/$cells-$side.pvs" --report "$out/run.json"
       printf '%s\t%s\t%s\n' "$cells" "$side" "$(jq .samples_per_second "$out/run.json")" >>"$results"
     done

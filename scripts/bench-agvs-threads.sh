@@ -14,15 +14,14 @@ source "$(dirname "$0")/bench-setup.sh"
 scene=$(bench_scene city 23)
 out="$dir/agvs-threads"
 mkdir -p "$out"
-[ -f "$out/city50000.vcells" ] || "$vc" -q build "$scene" --samples 4000000 --max-cells 50000 --merge-pvs samples \
-  --seed 1 -o "$out/city50000.vcells"
+level=$(bench_city_cells 4000000 50000)
 lines="$out/runs.jsonl"
 : >"$lines"
 for r in $(seq "$runs"); do
   for cells in 500 5000 50000; do
     for l in 1 "$lanes"; do
       for t in 1 2; do
-        "$vc" --threads "$t" -q pvs "$out/city50000.vcells" --scene "$scene" --cells "$cells" --samples 1000000 \
+        "$vc" --threads "$t" -q pvs "$level" --scene "$scene" --cells "$cells" --samples 1000000 \
           --batch 20000 --seed 1 --mutation-lanes "$l" -o "$out/$cells-$l-$t.pvs" --report "$out/run.json"
         jq -c --argjson c "$cells" --argjson l "$l" --argjson t "$t" \
           '{cells: $c, lanes: $l, threads: $t, seconds: .seconds, phases: .phases}' "$out/run.json" >>"$lines"

@@ -14,15 +14,14 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 scene=$(bench_scene city 23)
 out="$dir/mpi"
 mkdir -p "$out"
-[ -f "$out/city5000.vcells" ] || "$vc" -q build "$scene" --samples 1000000 --max-cells 5000 --merge-pvs samples --seed 1 \
-  -o "$out/city5000.vcells"
+level=$(bench_city_cells 1000000 5000)
 lines="$out/runs.jsonl"
 : >"$lines"
 lanes=2048
 # pvs_run RANKS THREADS CELLS NAME [LANES]: one AGVS run, its line in runs.jsonl.
 pvs_run() {
   local n_lanes=${5:-$lanes}
-  mpirun --oversubscribe --bind-to none -np "$1" "$vc" --threads "$2" -q pvs "$out/city5000.vcells" --scene "$scene" --cells "$3" \
+  mpirun --oversubscribe --bind-to none -np "$1" "$vc" --threads "$2" -q pvs "$level" --scene "$scene" --cells "$3" \
     --samples 1000000 --batch 20000 --seed 1 --mutation-lanes "$n_lanes" -o "$out/$4.pvs" --report "$out/$4.json"
   jq -c --arg kind pvs --argjson cells "$3" --argjson ranks "$1" --argjson threads "$2" --argjson lanes "$n_lanes" '{kind:
     $kind, cells: $cells, lanes: $lanes, ranks: $ranks, threads: $threads, samples: .samples, seconds: .seconds,

@@ -13,6 +13,15 @@ bench_scene() {
   [ -f "$path" ] || "$vc" generate "$1" --size "$2" --seed 1 -o "$path" -q
   echo "$path"
 }
+# bench_city_cells SAMPLES CELLS: the merge history the AGVS scaling benchmarks share, of at most
+# CELLS AV-S cells of the city of size 23 (seed 1) from SAMPLES construction samples, merged on
+# the samples' PVSs; built once into out/bench/city23-CELLS.vcells, whose path it prints.
+bench_city_cells() {
+  local path="$dir/city23-$2.vcells"
+  [ -f "$path" ] || "$vc" -q build "$(bench_scene city 23)" --samples "$1" --max-cells "$2" --merge-pvs samples \
+    --seed 1 -o "$path"
+  echo "$path"
+}
 # bench_level SCENE CELLS OUT: the view cells the PVS benchmarks share, a merge history of AV-S
 # cells (500,000 construction samples, 4 x CELLS cells, seed 1), written to OUT/level.vcells.
 bench_level() {

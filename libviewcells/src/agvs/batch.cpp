@@ -19,6 +19,32 @@
 
 namespace viewcells {
 
+namespace {
+
+/// Several ranks: an all-to-all of one array per rank, out[q] to rank q (this rank's own is not
+/// sent); `take(reader, array)` gets what each other rank sent, in rank order.
+template <class T, class Take>
+void exchange_arrays(const std::vector<std::vector<T>>& out, const char* what, Take&& take) {
+  const size_t me = static_cast<size_t>(cluster::rank());
+  std::vector<std::string> to(out.size());
+  for (size_t q = 0; q < out.size(); ++q) {
+    if (q == me) continue;
+    ByteWriter w;
+    w.put_array(out[q]);
+    to[q] = w.take();
+  }
+  const std::vector<std::string> from = cluster::exchange(std::move(to));
+  std::vector<T> got;
+  for (size_t q = 0; q < from.size(); ++q) {
+    if (q == me) continue;
+    ByteReader r(from[q], what);
+    r.get_array(got, from[q].size());
+    take(r, got);
+  }
+}
+
+}  // namespace
+
 struct AgvsSolver::Impl::BatchCounts {
   uint64_t contribution[kDists] = {}, rays[kDists] = {};
   /// The estimator's camera rays over the view space-direction samples, and those that were
@@ -86,7 +112,6 @@ void AgvsSolver::Impl::return_outcomes(const std::vector<BatchChunk>& chunks, st
   // Several ranks, routed: each rank sends every segment's outcome in its cells (entries added,
   // flags) back to the segment's caster, which sums and ors them (an all-to-all of the
   // segments that touched anything new).
-  const int me = cluster::rank();
   const size_t ranks = static_cast<size_t>(cluster::size());
   struct Outcome {
     uint32_t segment;  ///< in the batch
@@ -103,26 +128,14 @@ void AgvsSolver::Impl::return_outcomes(const std::vector<BatchChunk>& chunks, st
       if (gains[at] || flags[at]) to.push_back({static_cast<uint32_t>(at), gains[at], flags[at]});
     }
   }
-  std::vector<std::string> to(ranks);
-  for (size_t q = 0; q < ranks; ++q) {
-    if (q == static_cast<size_t>(me)) continue;
-    ByteWriter w;
-    w.put_array(out[q]);
-    to[q] = w.take();
-  }
-  const std::vector<std::string> from = cluster::exchange(std::move(to));
-  std::vector<Outcome> got;
-  for (size_t q = 0; q < ranks; ++q) {
-    if (q == static_cast<size_t>(me)) continue;
-    ByteReader r(from[q], "a rank's segment outcomes");
-    r.get_array(got, from[q].size());
+  exchange_arrays(out, "a rank's segment outcomes", [&](ByteReader& r, const std::vector<Outcome>& got) {
     for (const Outcome& o : got) {
       if (o.segment >= gains.size() || o.gain > 2 * cells.cell_count() || o.flags > 15)
         r.fail("a segment's outcome is out of range");
       gains[o.segment] += o.gain;
       flags[o.segment] |= o.flags;
     }
-  }
+  });
 }
 
 void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<BatchChunk>& chunks,
@@ -273,26 +286,15 @@ void AgvsSolver::Impl::route_candidates(const std::vector<BatchChunk>& chunks, c
       }
     }
   }
-  std::vector<std::string> to(ranks);
-  for (size_t q = 0; q < ranks; ++q) {
-    if (q == static_cast<size_t>(me)) continue;
-    ByteWriter w;
-    w.put_array(out[q]);
-    to[q] = w.take();
-  }
-  const std::vector<std::string> from = cluster::exchange(std::move(to));
-  std::vector<Routed> mine = std::move(out[static_cast<size_t>(me)]), got;
+  std::vector<Routed> mine = out[static_cast<size_t>(me)];
   const uint32_t n_objects = pvs.object_count();
-  for (size_t q = 0; q < ranks; ++q) {
-    if (q == static_cast<size_t>(me)) continue;
-    ByteReader r(from[q], "a rank's mutation candidates");
-    r.get_array(got, from[q].size());
+  exchange_arrays(out, "a rank's mutation candidates", [&](ByteReader& r, const std::vector<Routed>& got) {
     for (const Routed& x : got)
       if (x.lane >= n_lanes || !my_lane(x.lane) || x.chunk >= chunks.size() || x.end > 1 ||
           (x.candidate.object != kNoObject && x.candidate.object >= n_objects))
         r.fail("a routed mutation candidate is out of range");
     mine.insert(mine.end(), got.begin(), got.end());
-  }
+  });
   std::sort(mine.begin(), mine.end(), [](const Routed& a, const Routed& b) {
     return std::tie(a.chunk, a.segment, a.end) < std::tie(b.chunk, b.segment, b.end);
   });
