@@ -11,14 +11,15 @@
 
 #include "container.h"
 #include "handle.h"
-#include "id_lists.h"
-#include "orientation.h"
+#include "viewcells/format/id_lists.h"
+#include "viewcells/format/orientation.h"
 
 using viewcells::runtime_detail::FileError;
 using viewcells::runtime_detail::GeneralPlane;
 using viewcells::runtime_detail::kIndex;
 using viewcells::runtime_detail::Node;
-using viewcells::runtime_detail::orientation;
+using viewcells::format::orientation;
+using viewcells::runtime_detail::read_bytes;
 using viewcells::runtime_detail::read_file;
 using viewcells::runtime_detail::Vec;
 
@@ -35,28 +36,36 @@ extern "C" {
 
 namespace {
 
-int open_handle(const char* path, vc_pvs** out, char* error, size_t error_size, bool compact) {
+/// Opens a handle from the file `path`, or from `size` bytes at `bytes` when `path` is null
+/// (named `name` in messages).
+int open_handle(const char* path, const void* bytes, size_t size, vc_pvs** out, char* error, size_t error_size,
+                bool compact) {
+  const char* name = path ? path : "(memory)";
   if (out) *out = nullptr;
-  if (!path || !out) {
-    put_error(error, error_size, "vc_pvs_open: path and out must not be NULL");
+  if ((!path && !bytes) || !out) {
+    put_error(error, error_size, path || bytes ? "vc_pvs_open: out must not be NULL"
+                                               : "vc_pvs_open: the path (or the bytes) and out must not be NULL");
     return 1;
   }
   vc_pvs* f = nullptr;
   try {
     f = new vc_pvs;
     f->compact = compact;
-    read_file(path, *f);
+    if (path)
+      read_file(path, *f);
+    else
+      read_bytes(std::string(static_cast<const char*>(bytes), size), *f);
   } catch (const FileError& e) {
     delete f;
-    put_error(error, error_size, std::string(path) + ": " + e.what());
+    put_error(error, error_size, std::string(name) + ": " + e.what());
     return 2;
   } catch (const std::bad_alloc&) {
     delete f;
-    put_error(error, error_size, std::string(path) + ": out of memory");
+    put_error(error, error_size, std::string(name) + ": out of memory");
     return 3;
   } catch (const std::exception& e) {
     delete f;
-    put_error(error, error_size, std::string(path) + ": " + e.what());
+    put_error(error, error_size, std::string(name) + ": " + e.what());
     return 4;
   }
   *out = f;
@@ -93,11 +102,15 @@ void decode_cell(const vc_pvs* pvs, uint32_t cell, std::vector<uint32_t>& out) {
 }  // namespace
 
 int vc_pvs_open(const char* path, vc_pvs** out, char* error, size_t error_size) {
-  return open_handle(path, out, error, error_size, false);
+  return open_handle(path, nullptr, 0, out, error, error_size, false);
 }
 
 int vc_pvs_open_compact(const char* path, vc_pvs** out, char* error, size_t error_size) {
-  return open_handle(path, out, error, error_size, true);
+  return open_handle(path, nullptr, 0, out, error, error_size, true);
+}
+
+int vc_pvs_open_memory(const void* bytes, size_t size, int compact, vc_pvs** out, char* error, size_t error_size) {
+  return open_handle(nullptr, bytes, size, out, error, error_size, compact != 0);
 }
 
 void vc_pvs_close(vc_pvs* pvs) { delete pvs; }

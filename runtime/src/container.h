@@ -1,7 +1,6 @@
 #pragma once
-// The .pvs container as the toolkit writes it (libviewcells/src/core/binary_file.cpp): magic,
-// version, payload size, FNV-1a checksum, compressed size, zstd frame; and bounds-checked reads
-// of the payload.
+// The .pvs container as the runtime reads it (the format itself: viewcells/format/container.h),
+// and bounds-checked reads of the payload.
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -64,8 +63,9 @@ class Reader {
   size_t pos_ = 0;
 };
 
-/// The container: magic, version (low 16 bits; the third byte names the writer's Embree
-/// ISA), payload size, FNV-1a checksum, compressed size, zstd frame.
+/// The payload of the .pvs file at `path`, checked (format/container.h), and its version.
 std::string read_container(const std::string& path, uint32_t& version);
+/// The payload of a .pvs file's bytes `file`, checked, and its version.
+std::string decode_container(const std::string& file, uint32_t& version);
 
 }  // namespace viewcells::runtime_detail

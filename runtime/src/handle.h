@@ -2,8 +2,7 @@
 // The runtime's handle (runtime.h's opaque vc_pvs): the BSP as location walks it, the general
 // planes, the visible sets (expanded, or coded for a compact handle) and the grid where
 // location starts. Internal to the runtime's files:
-//   container.cpp    the .pvs container: magic, version, checksum, zstd frame
-//   orientation.cpp  the exact orientation predicate for general planes
+//   container.cpp    the .pvs container read (the format: format/, shared with the toolkit)
 //   load.cpp         the payload read into a handle, every count and index checked
 //   c_api.cpp        the C API (runtime.h)
 #include <cstdint>
@@ -14,13 +13,12 @@
 #include <sys/mman.h>
 #include <vector>
 
+#include "viewcells/format/orientation.h"
 #include "viewcells/runtime.h"
 
 namespace viewcells::runtime_detail {
 
-struct Vec {
-  double v[3];
-};
+using format::Vec;
 
 /// A BSP node as location walks it: 16 bytes, laid out in preorder so that the negative
 /// child follows its parent. `right` is the positive child, or 0 for a leaf (the root is
@@ -37,9 +35,7 @@ struct Node {
 };
 constexpr uint32_t kIndex = (1u << 30) - 1;
 
-struct GeneralPlane {
-  Vec a, b, c;  // the three points that define it (the toolkit's Plane::points)
-};
+using format::GeneralPlane;
 
 /// Memory for the large arrays that every query touches at random (the visible sets, the
 /// BSP): 2 MB aligned and, on Linux, marked for transparent huge pages, so that a lookup does
@@ -76,6 +72,10 @@ struct LargePages {
 
 /// Reads and checks the .pvs file `path` into `f` (FileError on any inconsistency).
 void read_file(const std::string& path, vc_pvs& f);
+/// The same from the file's bytes in memory.
+void read_bytes(const std::string& bytes, vc_pvs& f);
+/// The same from the payload of a container of format `version`.
+void read_payload(const std::string& payload, uint32_t version, vc_pvs& f);
 
 }  // namespace viewcells::runtime_detail
 

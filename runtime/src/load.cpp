@@ -10,8 +10,8 @@
 
 #include "container.h"
 #include "handle.h"
-#include "id_lists.h"
-#include "orientation.h"
+#include "viewcells/format/id_lists.h"
+#include "viewcells/format/orientation.h"
 
 namespace viewcells::runtime_detail {
 
@@ -215,7 +215,7 @@ uint32_t deepest_node(const vc_pvs& f, const double lo[3], const double hi[3]) {
       // be right where it descends, and exact signs of a grid of corners could be slow).
       for (int c = 0; c < 8 && (all_neg || all_pos); ++c) {
         const Vec corner{{(c & 1) ? hi[0] : lo[0], (c & 2) ? hi[1] : lo[1], (c & 4) ? hi[2] : lo[2]}};
-        const int side = filtered_orientation(f.planes[node.meta & kIndex], corner);
+        const int side = format::filtered_orientation(f.planes[node.meta & kIndex], corner);
         all_neg &= side < 0;
         all_pos &= side > 0;
       }
@@ -276,7 +276,17 @@ void build_grid(vc_pvs& f) {
 
 void read_file(const std::string& path, vc_pvs& f) {
   uint32_t version = 0;
-  const std::string payload = read_container(path, version);
+  const std::string payload = read_container(path, version);  // sets version: before the call below
+  read_payload(payload, version, f);
+}
+
+void read_bytes(const std::string& bytes, vc_pvs& f) {
+  uint32_t version = 0;
+  const std::string payload = decode_container(bytes, version);
+  read_payload(payload, version, f);
+}
+
+void read_payload(const std::string& payload, uint32_t version, vc_pvs& f) {
   Reader r(payload);
   const uint64_t max_items = payload.size();
   f.fingerprint = r.get<uint64_t>();

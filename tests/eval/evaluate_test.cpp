@@ -13,6 +13,7 @@
 #include "viewcells/eval/compare.h"
 #include "viewcells/eval/evaluate.h"
 #include "viewcells/eval/validated_merge.h"
+#include "eval/validated_merge_choice.h"  // libviewcells/src: the choice inside it
 #include "viewcells/merge/merge.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"

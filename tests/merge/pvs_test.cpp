@@ -8,7 +8,7 @@
 #include <iterator>
 #include <nlohmann/json.hpp>
 
-#include "id_lists.h"
+#include "viewcells/format/id_lists.h"
 #include "support/test_scenes.h"
 #include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/core/error.h"
@@ -176,7 +176,7 @@ std::vector<uint32_t> decoded_one(const std::string& bytes, uint32_t universe, b
 }
 
 TEST(Pvs, ListCodingRoundTripsAndIsCompact) {
-  // Golden bytes lock the format (runtime/src/id_lists.h): the size as Elias gamma of n + 1,
+  // Golden bytes lock the format (format/include/viewcells/format/id_lists.h): the size as Elias gamma of n + 1,
   // then the ids by binary interpolative coding, least significant bit first.
   EXPECT_EQ(id_lists::encode({{2, 3, 7}}, 10), std::string("\x44\x1b", 2));
   EXPECT_EQ(id_lists::encode({{}}, 10), std::string("\x01", 1));

@@ -8,7 +8,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "id_lists.h"
+#include "viewcells/format/id_lists.h"
 #include "support/test_scenes.h"
 #include "viewcells/core/binary_file.h"
 #include "viewcells/cells/hierarchy_file.h"
@@ -82,6 +82,22 @@ TEST(Runtime, ReadsWhatTheToolkitWrites) {
   uint8_t small = 0;
   EXPECT_EQ(vc_pvs_cell_bits(r.handle(), 0, &small, 0), -1);
   EXPECT_GT(r.memory_bytes(), 4 * l.file.pvs.stored_entries());
+  // The file's bytes opened from memory answer the same as the file, and a null buffer is refused.
+  std::ifstream in(l.path, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  vc_pvs* m = nullptr;
+  ASSERT_EQ(vc_pvs_open_memory(bytes.data(), bytes.size(), 0, &m, nullptr, 0), 0);
+  ASSERT_EQ(vc_pvs_cell_count(m), r.cell_count());
+  for (uint32_t c = 0; c < r.cell_count(); ++c) EXPECT_EQ(r.bits(static_cast<int32_t>(c)), [&] {
+      std::vector<uint8_t> row(r.row_bytes());
+      vc_pvs_cell_bits(m, static_cast<int32_t>(c), row.data(), row.size());
+      return row;
+    }()) << "cell " << c;
+  vc_pvs_close(m);
+  char error[128] = "";
+  EXPECT_NE(vc_pvs_open_memory(nullptr, 0, 0, &m, error, sizeof error), 0);
+  EXPECT_EQ(m, nullptr);
+  EXPECT_NE(std::string(error).find("NULL"), std::string::npos) << error;
 }
 
 TEST(Runtime, LocatesLikeTheToolkitOnAndNearEveryPlane) {
@@ -219,6 +235,25 @@ int open_code(const std::string& path) {
   }
   EXPECT_EQ(codes[0], codes[1]) << "the compact handle answers otherwise for " << path;
   const int code = codes[0];
+  // The same bytes from memory (vc_pvs_open_memory) get the same answer, the message naming
+  // "(memory)".
+  std::error_code ec;
+  if (std::filesystem::is_regular_file(path, ec)) {
+    std::ifstream in(path, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (int compact : {0, 1}) {
+      vc_pvs* p = nullptr;
+      char error[256] = "untouched";
+      EXPECT_EQ(vc_pvs_open_memory(bytes.data(), bytes.size(), compact, &p, error, sizeof error), code)
+          << "from memory, " << path << ": " << error;
+      if (p) {
+        EXPECT_EQ(vc_pvs_is_compact(p), compact);
+        vc_pvs_close(p);
+      } else {
+        EXPECT_NE(std::string(error).find("(memory)"), std::string::npos) << error;
+      }
+    }
+  }
   return code;
 }
 

@@ -3,7 +3,6 @@
 #include "viewcells/core/cluster.h"
 
 #include <unistd.h>
-#include <zstd.h>
 
 #include <cstdio>
 #include <filesystem>
@@ -12,17 +11,11 @@
 #include <mutex>
 
 #include "viewcells/core/isa.h"
+#include "viewcells/format/container.h"
 
 namespace viewcells {
 
-uint64_t fnv1a64(const std::string& bytes) {
-  uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char c : bytes) {
-    h ^= c;
-    h *= 0x100000001b3ULL;
-  }
-  return h;
-}
+uint64_t fnv1a64(const std::string& bytes) { return format::fnv1a64(bytes); }
 
 namespace {
 
@@ -167,26 +160,14 @@ std::string read_file_bytes(const std::string& path) {
 }
 
 std::string container_image(const char (&magic)[5], uint32_t version, const std::string& payload) {
-  // Compressed into a buffer left uninitialised (the bound is about the payload's size, and
-  // zeroing it cost a pass over that much memory), then copied once behind the header.
-  const size_t bound = ZSTD_compressBound(payload.size());
-  const std::unique_ptr<char[]> compressed(new char[bound]);
-  const size_t csize = ZSTD_compress(compressed.get(), bound, payload.data(), payload.size(), /*level=*/1);
-  if (ZSTD_isError(csize)) throw Error(std::string("zstd: ") + ZSTD_getErrorName(csize));
-  ByteWriter header;
-  header.put<uint32_t>(0);  // placeholder replaced by the magic below
   // The version's third byte records the Embree ISA of the writing process (core/isa.h).
   VC_CHECK(version > 0 && version <= 0xffff);
-  header.put<uint32_t>(version | static_cast<uint32_t>(embree_isa_code(embree_isa())) << 16);
-  header.put<uint64_t>(payload.size());
-  header.put<uint64_t>(fnv1a64(payload));
-  header.put<uint64_t>(csize);
-  std::string file;
-  file.reserve(header.data().size() + csize);
-  file = header.data();
-  std::memcpy(file.data(), magic, 4);
-  file.append(compressed.get(), csize);
-  return file;
+  try {
+    return format::encode_container(magic, version | static_cast<uint32_t>(embree_isa_code(embree_isa())) << 16,
+                                    payload);
+  } catch (const format::FormatError& e) {
+    throw Error(e.what());
+  }
 }
 
 void write_container(const std::string& path, const char (&magic)[5], uint32_t version,
@@ -207,37 +188,17 @@ std::string read_container(const std::string& path, const char (&magic)[5], uint
     throw Error(path, 0, std::filesystem::exists(path, ec) ? "not a regular file" : "no such file");
   // Read in blocks, not through a character iterator (BENCHMARKS.md, "Decisions measured").
   const std::string file = read_file_bytes(path);
-  ByteReader r(file, path);
-  if (file.size() < 32) throw Error(path, 0, "not a " + std::string(magic) + " file (too short)");
-  if (std::memcmp(file.data(), magic, 4) != 0)
-    throw Error(path, 0, "not a " + std::string(magic) + " file (wrong magic)");
-  r.get<uint32_t>();
-  const uint32_t tagged_version = r.get<uint32_t>();
-  version = tagged_version & 0xffff;
-  if (isa) *isa = embree_isa_name(static_cast<uint8_t>(tagged_version >> 16));
-  if (tagged_version >> 24) throw Error(path, 0, "corrupt file: malformed version field");
-  if (version == 0 || version > max_version)
-    throw Error(path, 0, "format version " + std::to_string(version) + " is not supported (this build reads up to " +
-                             std::to_string(max_version) + ")");
-  const uint64_t raw_size = r.get<uint64_t>();
-  const uint64_t checksum = r.get<uint64_t>();
-  const uint64_t csize = r.get<uint64_t>();
-  if (csize != file.size() - 32)
-    throw Error(path, 0, "corrupt file: expected " + std::to_string(csize) + " compressed bytes, found " +
-                             std::to_string(file.size() - 32) + " (truncated?)");
-  const unsigned long long frame_size = ZSTD_getFrameContentSize(file.data() + 32, csize);
-  if (frame_size != raw_size) throw Error(path, 0, "corrupt file: compressed frame does not match header");
-  // zstd expands at most about 32,768-fold (a 128 KiB run-length block in 4 bytes): a larger
-  // claim is corrupt, and is refused before it is allocated.
-  if (raw_size > 65536 * (csize + 64))
-    throw Error(path, 0, "corrupt file: " + std::to_string(raw_size) + " bytes claimed from " + std::to_string(csize) +
-                             " compressed");
-  std::string payload(raw_size, '\0');
-  const size_t got = ZSTD_decompress(payload.data(), raw_size, file.data() + 32, csize);
-  if (ZSTD_isError(got) || got != raw_size)
-    throw Error(path, 0, "corrupt file: decompression failed");
-  if (fnv1a64(payload) != checksum) throw Error(path, 0, "corrupt file: checksum mismatch");
-  return payload;
+  try {
+    const format::ContainerHeader h = format::read_container_header(file, magic, magic);
+    version = h.version();
+    if (isa) *isa = embree_isa_name(h.isa_code());
+    if (version == 0 || version > max_version)
+      throw Error(path, 0, "format version " + std::to_string(version) + " is not supported (this build reads up to " +
+                               std::to_string(max_version) + ")");
+    return format::decode_container_payload(file, h);
+  } catch (const format::FormatError& e) {
+    throw Error(path, 0, e.what());
+  }
 }
 
 }  // namespace viewcells

@@ -2,6 +2,8 @@
 // (eval/validated_merge.h).
 #include "viewcells/eval/validated_merge.h"
 
+#include "eval/validated_merge_choice.h"
+
 #include <algorithm>
 #include <atomic>
 #include <cmath>

@@ -1,5 +1,7 @@
 #include "viewcells/pipeline/bake.h"
 
+#include "pipeline/measured_stop.h"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>

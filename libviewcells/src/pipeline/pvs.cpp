@@ -1,5 +1,7 @@
 #include "viewcells/pipeline/pvs.h"
 
+#include "pipeline/measured_stop.h"
+
 #include <cmath>
 #include <filesystem>
 

@@ -8,7 +8,7 @@
 #include "viewcells/bsp/bsp_io.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/binary_file.h"
-#include "id_lists.h"
+#include "viewcells/format/id_lists.h"
 
 namespace viewcells {
 
@@ -333,7 +333,9 @@ void write_pvs(const std::string& path, const PvsFile& f, uint32_t format) {
   write_container(path, kMagic, format, pvs_payload(f, format));
 }
 
-uint64_t pvs_file_bytes(const PvsFile& f) { return container_image(kMagic, kVersion, pvs_payload(f, kVersion)).size(); }
+std::string pvs_file_image(const PvsFile& f) { return container_image(kMagic, kVersion, pvs_payload(f, kVersion)); }
+
+uint64_t pvs_file_bytes(const PvsFile& f) { return pvs_file_image(f).size(); }
 
 PvsFile read_pvs(const std::string& path, uint32_t* format) {
   uint32_t version = 0;

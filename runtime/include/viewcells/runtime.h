@@ -40,6 +40,10 @@ int vc_pvs_open(const char* path, vc_pvs** out, char* error, size_t error_size);
  * root when asked for (vc_pvs_cell_objects_copy, _bits, _sees). A compact handle has no lists
  * to point at: vc_pvs_cell_objects and vc_pvs_locate_objects give NULL and 0 for it. */
 int vc_pvs_open_compact(const char* path, vc_pvs** out, char* error, size_t error_size);
+/* As vc_pvs_open (compact 0) or vc_pvs_open_compact (compact 1), from the `size` bytes of a
+ * .pvs file in memory (e.g. what vc_bake returns): validated as strictly; the handle keeps no
+ * pointer into them. Messages name the file "(memory)". */
+int vc_pvs_open_memory(const void* bytes, size_t size, int compact, vc_pvs** out, char* error, size_t error_size);
 void vc_pvs_close(vc_pvs* pvs);
 /* 1 for a handle from vc_pvs_open_compact, else 0. */
 int vc_pvs_is_compact(const vc_pvs* pvs);

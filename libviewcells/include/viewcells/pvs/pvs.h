@@ -40,7 +40,7 @@ PvsHierarchy compress_pvs(const MergeHistory& h, const std::vector<int32_t>& cel
 PvsHierarchy recompress_pvs(const PvsHierarchy& shape, const std::vector<std::vector<uint32_t>>& cell_pvs);
 
 /// Bytes of sorted id lists below `object_count` as the .pvs file codes them (binary
-/// interpolative coding, runtime/src/id_lists.h; before the container's zstd, which finds
+/// interpolative coding, format/include/viewcells/format/id_lists.h; before the container's zstd, which finds
 /// little more in them). Linear in the entries. `format` 1 gives what format 1 took (LEB128
 /// varints of the differences).
 uint64_t list_bytes(const std::vector<std::vector<uint32_t>>& lists, uint32_t object_count, uint32_t format = 2);
@@ -81,6 +81,8 @@ PvsFile make_pvs_file(const Subdivision& s, const std::vector<std::vector<uint32
 /// runtime reader predates it, format 1. Error when a kept list is not sorted ids below
 /// f.object_count.
 void write_pvs(const std::string& path, const PvsFile& f, uint32_t format = 2);
+/// The bytes write_pvs writes for `f` (format 2), in memory.
+std::string pvs_file_image(const PvsFile& f);
 /// The size in bytes of the file write_pvs writes for `f`, measured without writing it.
 uint64_t pvs_file_bytes(const PvsFile& f);
 /// Reads and validates a `.pvs` file of any format this build reads (1 and 2; `format`, when

@@ -1,14 +1,14 @@
 // The exact fallback of the orientation predicate (orientation.h): the determinant as an exact
-// integer sum. Compiled with -ffp-contract=off (runtime/CMakeLists.txt): rounded products and
+// integer sum. Compiled with -ffp-contract=off (format/CMakeLists.txt): rounded products and
 // sums, never fused ones.
-#include "orientation.h"
+#include "viewcells/format/orientation.h"
 
 #include <algorithm>
 #include <cstdint>
 #include <limits>
 #include <vector>
 
-namespace viewcells::runtime_detail {
+namespace viewcells::format {
 
 namespace {
 
@@ -134,4 +134,4 @@ int exact_det4_sign(const Vec* points[4]) {
   return sum.limbs.empty() ? 0 : (sum.negative ? -1 : 1);
 }
 
-}  // namespace viewcells::runtime_detail
+}  // namespace viewcells::format

@@ -1,13 +1,24 @@
 #pragma once
-// The orientation predicate the runtime locates points with against general (not axis-aligned)
-// planes: the sign CGAL's orientation(a, b, c, d) gives, exactly. A floating-point filter
+// The orientation predicate a reader of a .pvs file locates points with against its general
+// (not axis-aligned) planes, each stored as three points: the sign CGAL's orientation(a, b, c,
+// d) gives (the sign the toolkit's subdivision used), exactly. Part of the format: a reader that
+// rounds differently puts points near a plane into another cell. A floating-point filter
 // decides almost always (inline: it is on location's path); the exact integer determinant
 // (orientation.cpp) decides the rest.
 #include <cmath>
 
-#include "handle.h"
+namespace viewcells::format {
 
-namespace viewcells::runtime_detail {
+/// A point of the file, in double precision.
+struct Vec {
+  double v[3];
+};
+
+/// A general plane as the file stores it: the three points that define it (the toolkit's
+/// Plane::points).
+struct GeneralPlane {
+  Vec a, b, c;
+};
 
 /// The sign of det [a 1; b 1; c 1; d 1], exactly (orientation.cpp).
 int exact_det4_sign(const Vec* points[4]);
@@ -47,4 +58,4 @@ inline int orientation(const GeneralPlane& pl, const Vec& d) {
   return -exact_det4_sign(points);
 }
 
-}  // namespace viewcells::runtime_detail
+}  // namespace viewcells::format
