@@ -55,6 +55,19 @@ assert len(rooms) == 3 and all(c >= 0 and 0 < n <= objects for c, n in rooms), t
 assert rooms[0][1] < objects and rooms[2][1] < objects, text
 PY
 [ -z "$(ls -A "$work/empty")" ] || { echo "FAIL: bake_in_memory wrote $(ls "$work/empty")"; exit 1; }
+# The same level from C (vc_bake, then vc_pvs_open_memory): the same checks, nothing written.
+(cd "$work/empty" && "$work/consumer/bake_c" 3) > "$work/c.txt"
+python3 - "$work/c.txt" <<'PY'
+import re, sys
+text = open(sys.argv[1]).read()
+objects = int(re.search(r"level: (\d+) objects", text).group(1))
+assert re.search(r"^cells: 9,", text, re.M), text
+rooms = [(int(c), int(n)) for c, n in re.findall(r"cell (-?\d+) sees (\d+) objects", text)]
+assert len(rooms) == 3 and all(c >= 0 and 0 < n <= objects for c, n in rooms), text
+assert rooms[0][1] < objects and rooms[2][1] < objects, text
+PY
+[ -z "$(ls -A "$work/empty")" ] || { echo "FAIL: bake_c wrote $(ls "$work/empty")"; exit 1; }
+if "$work/consumer/bake_c" 0 2>/dev/null; then echo "FAIL: bake_c accepted 0 rooms"; exit 1; fi
 # The runtime library links nothing of the toolkit's dependencies.
 if ldd "$work/consumer/pvs_lookup" | grep -Ei "embree|tbb|cgal|gmp|boost|png"; then
   echo "FAIL: the runtime consumer links toolkit dependencies"; exit 1

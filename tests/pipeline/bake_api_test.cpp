@@ -1,0 +1,208 @@
+// vc_bake (cli/include/viewcells/bake.h): a scene in memory baked from C gives the file a bake
+// of the same scene from an OBJ gives, byte for byte; the runtime opens its bytes from memory;
+// see-through objects hide nothing; bad arguments get a message and a non-zero code, and a
+// failing bake leaves an earlier file as it was.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "support/test_scenes.h"
+#include "viewcells/bake.h"
+#include "viewcells/core/binary_file.h"
+#include "viewcells/pipeline/bake.h"
+#include "viewcells/runtime.h"
+#include "viewcells/scene/generators.h"
+
+namespace viewcells {
+namespace {
+
+/// A scene as an engine holds it: per object, its own vertices and triangles.
+struct Meshes {
+  std::vector<std::string> names;
+  std::vector<std::vector<double>> vertices;
+  std::vector<std::vector<uint32_t>> indices;
+  std::vector<int> see_through;
+  std::vector<vc_bake_object> objects() const {
+    std::vector<vc_bake_object> out;
+    for (size_t i = 0; i < names.size(); ++i)
+      out.push_back({names[i].c_str(), vertices[i].data(), static_cast<uint32_t>(vertices[i].size() / 3),
+                     indices[i].data(), static_cast<uint32_t>(indices[i].size() / 3), see_through[i]});
+    return out;
+  }
+  /// The same as an OBJ file: an `o` line per object, its vertices, its faces.
+  std::string obj() const {
+    std::string text;
+    size_t base = 1;
+    char line[128];
+    for (size_t i = 0; i < names.size(); ++i) {
+      text += "o " + names[i] + "\n";
+      for (size_t v = 0; v < vertices[i].size(); v += 3) {
+        std::snprintf(line, sizeof line, "v %.17g %.17g %.17g\n", vertices[i][v], vertices[i][v + 1], vertices[i][v + 2]);
+        text += line;
+      }
+      for (size_t t = 0; t < indices[i].size(); t += 3) {
+        std::snprintf(line, sizeof line, "f %zu %zu %zu\n", base + indices[i][t], base + indices[i][t + 1],
+                      base + indices[i][t + 2]);
+        text += line;
+      }
+      base += vertices[i].size() / 3;
+    }
+    return text;
+  }
+};
+
+/// The generated office split into its objects, each with the vertices its triangles use.
+Meshes office() {
+  const Scene s = generate_scene({GeneratorKind::kOffice, 1, 1});
+  Meshes m;
+  for (uint32_t o = 0; o < s.object_count(); ++o) {
+    m.names.push_back("object_" + std::to_string(o));
+    m.vertices.emplace_back();
+    m.indices.emplace_back();
+    m.see_through.push_back(0);
+    std::vector<int64_t> local(s.vertices.size(), -1);
+    for (size_t t = 0; t < s.triangles.size(); ++t) {
+      if (s.triangle_object[t] != o) continue;
+      for (uint32_t v : s.triangles[t]) {
+        if (local[v] < 0) {
+          local[v] = static_cast<int64_t>(m.vertices.back().size() / 3);
+          m.vertices.back().insert(m.vertices.back().end(), {s.vertices[v].x, s.vertices[v].y, s.vertices[v].z});
+        }
+        m.indices.back().push_back(static_cast<uint32_t>(local[v]));
+      }
+    }
+  }
+  return m;
+}
+
+const std::vector<std::string> kOptions = {"--cells", "12", "--samples", "20000", "--agvs-samples", "40000",
+                                           "--seed", "3", "--near-samples", "64"};
+
+int bake(const Meshes& m, const std::vector<std::string>& options, const char* output, vc_bake_result** out,
+         std::string* error = nullptr) {
+  std::vector<const char*> words;
+  for (const std::string& w : options) words.push_back(w.c_str());
+  words.push_back(nullptr);
+  const std::vector<vc_bake_object> objects = m.objects();
+  char message[512] = "";
+  const int code = vc_bake(objects.data(), objects.size(), words.data(), output, nullptr, nullptr, out, message,
+                           sizeof message);
+  if (error) *error = message;
+  return code;
+}
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+TEST(BakeApi, GivesTheBytesOfABakeOfTheSameSceneFromAFile) {
+  const Meshes m = office();
+  const std::string obj = test::temp_path("api_office.obj"), from_file = test::temp_path("api_file.pvs");
+  test::write_file(obj, m.obj());
+  std::vector<std::string> args = {obj, "-o", from_file};
+  args.insert(args.end(), kOptions.begin(), kOptions.end());
+  pipeline::bake(cli::bake_config_from_args(args), [](const std::string&) {});
+  const std::string want = file_bytes(from_file);
+  ASSERT_GT(want.size(), 32u);
+
+  vc_bake_result* r = nullptr;
+  std::string error;
+  const std::string written = test::temp_path("api_written.pvs");
+  ASSERT_EQ(bake(m, kOptions, written.c_str(), &r, &error), 0) << error;
+  size_t size = 0;
+  const char* bytes = static_cast<const char*>(vc_bake_result_bytes(r, &size));
+  EXPECT_EQ(std::string(bytes, size), want) << "vc_bake differs from the bake of the same scene as an OBJ";
+  EXPECT_EQ(file_bytes(written), want) << "the file vc_bake wrote differs from the bytes it returned";
+  EXPECT_EQ(vc_bake_result_cells(r), 12u);
+  const nlohmann::json report = nlohmann::json::parse(vc_bake_result_report(r));
+  EXPECT_EQ(report["cells"], 12);
+
+  // The runtime opens the bytes from memory: the same cells and objects.
+  vc_pvs* pvs = nullptr;
+  ASSERT_EQ(vc_pvs_open_memory(bytes, size, 0, &pvs, nullptr, 0), 0);
+  EXPECT_EQ(vc_pvs_cell_count(pvs), 12u);
+  EXPECT_EQ(vc_pvs_object_count(pvs), m.names.size());
+  EXPECT_STREQ(vc_pvs_object_name(pvs, 1), "object_1");
+  vc_pvs_close(pvs);
+  vc_bake_result_free(r);
+
+  // Without an output nothing is written, and the bytes are the same.
+  ASSERT_EQ(bake(m, kOptions, nullptr, &r, &error), 0) << error;
+  EXPECT_EQ(std::string(static_cast<const char*>(vc_bake_result_bytes(r, &size)), size), want);
+  vc_bake_result_free(r);
+}
+
+/// Two boxes with a pane between them, the view space on the left: the right box is seen only
+/// when the pane is see-through. (The opaque pane is seen. A see-through pane outside the view
+/// box is in no PVS today: the samplers record see-through objects only where a segment's
+/// viewpoint side reaches them; noted in issue 57, not asserted here.)
+TEST(BakeApi, SeeThroughObjectsHideNothing) {
+  Meshes m;
+  const std::vector<uint32_t> faces = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                                       1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+  for (double x : {0.0, 4.0}) {
+    m.names.push_back(x == 0 ? "left" : "right");
+    m.vertices.push_back({x, 0, 0, x + 1, 0, 0, x + 1, 1, 0, x, 1, 0, x, 0, 1, x + 1, 0, 1, x + 1, 1, 1, x, 1, 1});
+    m.indices.push_back(faces);
+    m.see_through.push_back(0);
+  }
+  m.names.push_back("glass");
+  m.vertices.push_back({2, -5, -5, 2, 6, -5, 2, 6, 6, 2, -5, 6});
+  m.indices.push_back({0, 1, 2, 0, 2, 3});
+  m.see_through.push_back(0);
+  const std::vector<std::string> options = {"--cells", "2", "--samples", "20000", "--agvs-samples", "20000",
+                                            "--view-box", "-1,-2,-1,1.9,3,2", "--near-samples", "0"};
+  for (int see_through : {0, 1}) {
+    m.see_through[2] = see_through;
+    vc_bake_result* r = nullptr;
+    std::string error;
+    ASSERT_EQ(bake(m, options, nullptr, &r, &error), 0) << error;
+    size_t size = 0;
+    const void* bytes = vc_bake_result_bytes(r, &size);
+    vc_pvs* pvs = nullptr;
+    ASSERT_EQ(vc_pvs_open_memory(bytes, size, 0, &pvs, nullptr, 0), 0);
+    bool right_seen = false, glass_seen = false;
+    for (uint32_t c = 0; c < vc_pvs_cell_count(pvs); ++c) {
+      right_seen |= vc_pvs_cell_sees(pvs, static_cast<int32_t>(c), 1) == 1;
+      glass_seen |= vc_pvs_cell_sees(pvs, static_cast<int32_t>(c), 2) == 1;
+    }
+    if (!see_through) EXPECT_TRUE(glass_seen);
+    EXPECT_EQ(right_seen, see_through == 1) << "see_through " << see_through;
+    vc_pvs_close(pvs);
+    vc_bake_result_free(r);
+  }
+}
+
+TEST(BakeApi, RefusesBadArgumentsWithAMessageAndKeepsEarlierFiles) {
+  Meshes m = office();
+  const std::string path = test::temp_path("api_kept.pvs");
+  test::write_file(path, "an earlier file");
+  vc_bake_result* r = reinterpret_cast<vc_bake_result*>(&m);  // must be reset to NULL
+  std::string error;
+  EXPECT_EQ(bake(m, {"--samples", "1000"}, path.c_str(), &r, &error), 2);
+  EXPECT_EQ(r, nullptr);
+  EXPECT_NE(error.find("budget"), std::string::npos) << error;
+  EXPECT_EQ(bake(m, {"--cells", "4", "--no-such-option"}, path.c_str(), &r, &error), 2);
+  EXPECT_NE(error.find("--no-such-option"), std::string::npos) << error;
+  EXPECT_EQ(bake(m, {"--cells", "4", "-o", "x.pvs"}, path.c_str(), &r, &error), 1);
+  EXPECT_NE(error.find("-o is not an option here"), std::string::npos) << error;
+  m.indices[2][4] = 1000;
+  EXPECT_EQ(bake(m, kOptions, path.c_str(), &r, &error), 2);
+  EXPECT_NE(error.find("object 2 (object_2): triangle 1 has vertex index 1000"), std::string::npos) << error;
+  m = office();
+  m.vertices[0][0] = std::nan("");
+  EXPECT_EQ(bake(m, kOptions, path.c_str(), &r, &error), 2);
+  EXPECT_NE(error.find("NaN"), std::string::npos) << error;
+  EXPECT_EQ(file_bytes(path), "an earlier file");
+  EXPECT_EQ(vc_bake(nullptr, 3, nullptr, nullptr, nullptr, nullptr, &r, nullptr, 0), 1);
+  char small[8];
+  EXPECT_EQ(vc_bake(nullptr, 0, nullptr, nullptr, nullptr, nullptr, nullptr, small, sizeof small), 1);
+  EXPECT_EQ(std::string(small), "vc_bake");  // truncated, NUL-terminated
+}
+
+}  // namespace
+}  // namespace viewcells
