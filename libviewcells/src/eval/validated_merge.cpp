@@ -179,6 +179,115 @@ std::vector<ChosenPiece> choose_merge_pieces(const std::vector<MergeStart>& cand
   return out;
 }
 
+namespace {
+
+/// The held-out random samples' leaf PVSs (their count into `drawn`): drawn and walked a
+/// million samples at a time (every leaf each segment has length in), so that the segments are
+/// never all held: the same lists as walking them at once.
+std::vector<std::vector<uint32_t>> held_out_leaf_pvs(const Scene& scene, const RayCaster& caster,
+                                                     const Subdivision& s, const ValidatedMergeConfig& config,
+                                                     uint64_t& drawn) {
+  SamplerConfig sc = *config.held_out_samples;
+  sc.show_progress = sc.show_progress && config.merge.show_progress;
+  EvaluationPvs gathered(s, scene.objects.size());
+  drawn = sample_in_chunks(scene, caster, sc, kHeldOutChunk, [&](const SegmentSet& chunk, uint64_t) {
+            gathered.add(chunk);
+          }).samples;
+  return gathered.take();
+}
+
+/// Where greedy merging may start: AV-S's cut at every halving of the L leaves, alone or held
+/// within its cuts at every quartering below; and, without a pixel term, refined at low counts:
+/// from AV-S's cut at `cells`, its cells are moved between the blocks of AV-S's cut at
+/// `barrier` (64 or 32 cells) where the merge PVSs say it lowers the cost; merging joins within
+/// those blocks down to `barrier`, and at every halving below, the cells of the count above are
+/// moved between the blocks greedy merging reaches, and merging goes on within them. The units
+/// moved are AV-S's cells at 4 to 64 per block: finer ones fit the merge PVSs' noise (on the
+/// office, refined histories from 2,500 and 5,000 cells scored 1-9% worse than AV-S on the
+/// held-out samples, from 312 cells 2-5% better). Blocks of 32 cells: the office's and the
+/// town's choice at low counts (docs/accuracy-vs-time.md, section 5).
+std::vector<MergeStart> candidate_starts(size_t L, const CostModel& model) {
+  std::vector<MergeStart> candidates;
+  for (size_t start = L; start >= 2; start /= 2) {
+    candidates.push_back({static_cast<uint32_t>(start), 0, 0.0, 0.0});
+    for (size_t barrier = start / 4; barrier >= 4; barrier /= 4)
+      candidates.push_back({static_cast<uint32_t>(start), static_cast<uint32_t>(barrier), 0.0, 0.0});
+  }
+  if (!model.pixel_term())
+    for (const uint32_t barrier : {64u, 32u})
+      for (size_t start = L; start >= 4 * barrier; start /= 2)
+        if (start <= 64 * barrier) candidates.push_back({static_cast<uint32_t>(start), barrier, 0.0, 0.0, true});
+  return candidates;
+}
+
+/// A refined candidate's history `h`, from its first merging on: at every halving below its
+/// barrier, the cells of the count above moved between the blocks merging reached, and merging
+/// gone on within them (`mc`: the merge's config; L leaves).
+MergeHistory refined_below_barrier(const Scene& scene, const CellPartition& partition, const CostModel& model,
+                                   const MergeConfig& mc, size_t L, const MergeStart& st, MergeHistory h) {
+  for (size_t up = st.barrier, k = up / 2; k >= 4 && h.min_cells() <= k; up = k, k /= 2) {
+    const Merges m = merges_by_least_leaf(h);
+    const std::vector<int32_t> blocks = cut_labels(m, L, L - k);
+    const std::vector<int32_t> refined = refine_blocks(scene, partition, model, cut_labels(m, L, L - up), blocks);
+    if (refined == blocks) continue;
+    MergeConfig c = mc;
+    c.prefix = least_leaf_merges_as_prefix(Merges(m.begin(), m.begin() + static_cast<std::ptrdiff_t>(L - up)), L);
+    c.barrier_cells = static_cast<uint32_t>(k);
+    c.block = refined;
+    const MergeStats before = h.stats;
+    h = merge_cells(scene, partition, model, c);
+    h.stats.evaluations += before.evaluations;
+    h.stats.stale += before.stale;
+  }
+  return h;
+}
+
+/// The chosen history's merges, piece by piece, named by least leaf; each piece recorded in
+/// `sum.chain`.
+Merges chosen_merges(const std::vector<ChosenPiece>& pieces, const std::vector<MergeStart>& candidates,
+                     const std::vector<Scored>& scored, const Merges& av_s_merges, size_t L, MergeSummary& sum) {
+  Merges chosen;
+  for (const ChosenPiece& p : pieces) {
+    const Merges& m = p.candidate < 0 ? av_s_merges : scored[static_cast<size_t>(p.candidate)].merges;
+    const MergeStart st =
+        p.candidate < 0 ? MergeStart{1, 0, 0.0, 0.0} : candidates[static_cast<size_t>(p.candidate)];
+    const size_t first = L - p.from, last = p.to ? L - p.to : m.size();
+    chosen.insert(chosen.end(), m.begin() + static_cast<std::ptrdiff_t>(std::min(first, m.size())),
+                  m.begin() + static_cast<std::ptrdiff_t>(std::min(last, m.size())));
+    sum.chain.push_back({st, p.from, p.to});
+  }
+  return chosen;
+}
+
+/// The chosen merges, replayed with every sample's PVSs (`out.history`): the same partition
+/// (cells and neighbours), each leaf's list united in place with both held-out sets' (`b_pvs`,
+/// and `c_pvs` when drawn), then moved out into `out.leaf_pvs`, per node.
+void replay_chosen(const Scene& scene, const Subdivision& s, const CostModel& model, const ValidatedMergeConfig& config,
+                   const Merges& chosen, const std::vector<std::vector<uint32_t>>& b_pvs,
+                   const std::vector<std::vector<uint32_t>>& c_pvs, MergeConfig mc, CellPartition& partition,
+                   LeafMerge& out) {
+  MergeSummary& sum = out.summary;
+  Stopwatch t;
+  const std::vector<int32_t> leaves = s.leaves();
+  tbb::parallel_for(size_t{0}, leaves.size(), [&](size_t i) {
+    std::vector<uint32_t>& l = partition.pvs[i];
+    l = unite_sorted(l, b_pvs[leaves[i]]);
+    if (config.held_out_samples) l = unite_sorted(l, c_pvs[leaves[i]]);
+  });
+  sum.neighbour_seconds += t.seconds();
+  t.restart();
+  mc.prefix = least_leaf_merges_as_prefix(chosen, s.leaf_count());
+  mc.barrier_cells = 0;
+  mc.block.clear();
+  mc.show_progress = config.merge.show_progress;
+  out.history = merge_cells(scene, partition, model, mc);
+  sum.merge_seconds += t.seconds();
+  out.leaf_pvs.assign(s.nodes.size(), {});
+  for (size_t i = 0; i < leaves.size(); ++i) out.leaf_pvs[leaves[i]] = std::move(partition.pvs[i]);
+}
+
+}  // namespace
+
 LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Subdivision& s,
                           std::vector<std::vector<uint32_t>> base, const CostModel& model,
                           const ValidatedMergeConfig& config) {
@@ -194,18 +303,7 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   sum.merge_agvs_samples = a.stats.samples;
   sum.validation_agvs_samples = b.stats.samples;
   std::vector<std::vector<uint32_t>> c_pvs;
-  if (config.held_out_samples) {
-    SamplerConfig sc = *config.held_out_samples;
-    sc.show_progress = sc.show_progress && config.merge.show_progress;
-    // Drawn and walked a million samples at a time (every leaf each segment has length in),
-    // so that the segments are never all held: the same lists as walking them at once.
-    EvaluationPvs gathered(s, scene.objects.size());
-    sum.held_out_samples =
-        sample_in_chunks(scene, caster, sc, kHeldOutChunk, [&](const SegmentSet& chunk, uint64_t) {
-          gathered.add(chunk);
-        }).samples;
-    c_pvs = gathered.take();
-  }
+  if (config.held_out_samples) c_pvs = held_out_leaf_pvs(scene, caster, s, config, sum.held_out_samples);
   sum.leaf_pvs_seconds = t.seconds();
 
   t.restart();
@@ -229,24 +327,7 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   mc.show_progress = false;
   // Every candidate start, scored in parallel (each is independent; the choice below is made
   // in a fixed order, so it does not depend on the thread count).
-  std::vector<MergeStart> candidates;
-  for (size_t start = L; start >= 2; start /= 2) {
-    candidates.push_back({static_cast<uint32_t>(start), 0, 0.0, 0.0});
-    for (size_t barrier = start / 4; barrier >= 4; barrier /= 4)
-      candidates.push_back({static_cast<uint32_t>(start), static_cast<uint32_t>(barrier), 0.0, 0.0});
-  }
-  // Refined at low counts: from AV-S's cut at `cells`, its cells are moved between the blocks
-  // of AV-S's cut at `barrier` (64 or 32 cells) where the merge PVSs say it lowers the cost;
-  // merging joins within those blocks down to `barrier`, and at every halving below, the cells
-  // of the count above are moved between the blocks greedy merging reaches, and merging goes on
-  // within them. The units moved are AV-S's cells at 4 to 64 per block: finer ones fit the
-  // merge PVSs' noise (on the office, refined histories from 2,500 and 5,000 cells scored 1-9%
-  // worse than AV-S on the held-out samples, from 312 cells 2-5% better). Blocks of 32 cells:
-  // the office's and the town's choice at low counts (docs/accuracy-vs-time.md, section 5).
-  if (!model.pixel_term())
-    for (const uint32_t barrier : {64u, 32u})
-      for (size_t start = L; start >= 4 * barrier; start /= 2)
-        if (start <= 64 * barrier) candidates.push_back({static_cast<uint32_t>(start), barrier, 0.0, 0.0, true});
+  std::vector<MergeStart> candidates = candidate_starts(L, model);
   // AV-S's replay on each held-out set, kept at every candidate's start (its first L - start
   // merges are AV-S's own), and AV-S's curves.
   std::vector<size_t> starts;
@@ -268,21 +349,7 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   // A refined candidate's history, from its first merging (config_for) on: at every halving
   // below its barrier, the cells of the count above moved between the blocks merging reached.
   auto refined_on = [&](const MergeStart& st, MergeHistory h) {
-    for (size_t up = st.barrier, k = up / 2; k >= 4 && h.min_cells() <= k; up = k, k /= 2) {
-      const Merges m = merges_by_least_leaf(h);
-      const std::vector<int32_t> blocks = cut_labels(m, L, L - k);
-      const std::vector<int32_t> refined = refine_blocks(scene, partition, model, cut_labels(m, L, L - up), blocks);
-      if (refined == blocks) continue;
-      MergeConfig c = mc;
-      c.prefix = least_leaf_merges_as_prefix(Merges(m.begin(), m.begin() + static_cast<std::ptrdiff_t>(L - up)), L);
-      c.barrier_cells = static_cast<uint32_t>(k);
-      c.block = refined;
-      const MergeStats before = h.stats;
-      h = merge_cells(scene, partition, model, c);
-      h.stats.evaluations += before.evaluations;
-      h.stats.stale += before.stale;
-    }
-    return h;
+    return refined_below_barrier(scene, partition, model, mc, L, st, std::move(h));
   };
   Progress progress("choosing where merging starts", candidates.size());
   std::atomic<uint64_t> evaluations{0}, stale{0};  // the candidates' pair costs, for the report
@@ -315,40 +382,11 @@ LeafMerge merge_validated(const Scene& scene, const RayCaster& caster, const Sub
   const std::vector<ChosenPiece> pieces =
       choose_merge_pieces(candidates, scores, counts, static_cast<uint32_t>(L), config.allowed, config.spread_margin);
 
-  // The chosen history's merges, piece by piece, named by least leaf.
-  Merges chosen;
-  for (const ChosenPiece& p : pieces) {
-    const Merges& m = p.candidate < 0 ? av_s_merges : scored[static_cast<size_t>(p.candidate)].merges;
-    const MergeStart st =
-        p.candidate < 0 ? MergeStart{1, 0, 0.0, 0.0} : candidates[static_cast<size_t>(p.candidate)];
-    const size_t first = L - p.from, last = p.to ? L - p.to : m.size();
-    chosen.insert(chosen.end(), m.begin() + static_cast<std::ptrdiff_t>(std::min(first, m.size())),
-                  m.begin() + static_cast<std::ptrdiff_t>(std::min(last, m.size())));
-    sum.chain.push_back({st, p.from, p.to});
-  }
+  const Merges chosen = chosen_merges(pieces, candidates, scored, av_s_merges, L, sum);
   sum.chosen = sum.chain.front().start;
   sum.merge_seconds = t.seconds();
 
-  // The chosen merges, replayed with every sample's PVSs: the same partition (cells and
-  // neighbours), each leaf's list united in place with both held-out sets'.
-  t.restart();
-  const std::vector<int32_t> leaves = s.leaves();
-  tbb::parallel_for(size_t{0}, leaves.size(), [&](size_t i) {
-    std::vector<uint32_t>& l = partition.pvs[i];
-    l = unite_sorted(l, b.pvs[leaves[i]]);
-    if (config.held_out_samples) l = unite_sorted(l, c_pvs[leaves[i]]);
-  });
-  sum.neighbour_seconds += t.seconds();
-  t.restart();
-  mc.prefix = least_leaf_merges_as_prefix(chosen, L);
-  mc.barrier_cells = 0;
-  mc.block.clear();
-  mc.show_progress = config.merge.show_progress;
-  out.history = merge_cells(scene, partition, model, mc);
-  sum.merge_seconds += t.seconds();
-  // The leaves' lists, per node, moved out of the partition.
-  out.leaf_pvs.assign(s.nodes.size(), {});
-  for (size_t i = 0; i < leaves.size(); ++i) out.leaf_pvs[leaves[i]] = std::move(partition.pvs[i]);
+  replay_chosen(scene, s, model, config, chosen, b.pvs, c_pvs, mc, partition, out);
   // The whole chosen history's held-out score, as the candidates were scored.
   held_out.summarise(held_out.score(scene, s, out.history, model), out.history.min_cells(), config.spread_margin,
                      sum.chosen);

@@ -224,9 +224,8 @@ ViewCellSet first_cut(const BakeConfig& c, const SubdivisionFile& file, const Lo
   return set;
 }
 
-}  // namespace
-
-BakeResult bake(const BakeConfig& c, const Log& log) {
+/// The settings a bake refuses, before any work.
+void check_bake(const BakeConfig& c) {
   if ((c.cells > 0) == (c.memory > 0)) throw Error("bake needs one budget: --cells N or --memory BYTES");
   if (!(c.measured_error >= 0) || !std::isfinite(c.measured_error))
     throw Error("the measured pixel error must be a finite number >= 0");
@@ -245,6 +244,179 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     throw Error("--cells " + std::to_string(c.cells) + " asks for more view cells than the " +
                 std::to_string(c.subdivision.max_cells) + " elementary cells of --max-cells: raise --max-cells or "
                 "lower --cells");
+}
+
+/// Frames as a sampler (BakeConfig::frame_samples), after AGVS: every object a frame shows
+/// joins its cell's PVS in `lists`.
+void frame_sample_rounds(const BakeConfig& c, const LoadedScene& loaded, const CellLocator& covered_cells,
+                         uint64_t sampling_frames, std::vector<std::vector<uint32_t>>& lists, BakeResult& out,
+                         const Log& log) {
+  // Frames where viewers are, from a seed of their own (the measuring cameras' is c.cameras.seed).
+  // After the first round, only the cells whose frames still added something get more: about
+  // as many frames again, drawn from the same distribution and kept where they land in those.
+  Stopwatch sw;
+  std::vector<uint8_t> active(lists.size(), 1);
+  std::string rule;
+  for (uint32_t round = 0; round < c.frame_rounds; ++round) {
+    const size_t n_active = static_cast<size_t>(std::count(active.begin(), active.end(), 1));
+    if (n_active == 0) break;
+    CameraConfig sc = c.cameras;
+    sc.count = static_cast<uint32_t>(std::min<uint64_t>(sampling_frames * lists.size() / n_active, 10'000'000));
+    sc.seed = c.cameras.seed + 0x5a3'0001 + round;
+    const CameraSet drawn = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), sc,
+                                         [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
+                                         &covered_cells);
+    rule = drawn.rule;
+    std::vector<Camera> kept;
+    std::vector<int32_t> kept_cells;
+    for (size_t i = 0; i < drawn.cameras.size() && kept.size() < sampling_frames; ++i)
+      if (drawn.cells[i] >= 0 && active[static_cast<size_t>(drawn.cells[i])]) {
+        kept.push_back(drawn.cameras[i]);
+        kept_cells.push_back(drawn.cells[i]);
+      }
+    std::vector<size_t> before(lists.size());
+    for (size_t i = 0; i < lists.size(); ++i) before[i] = lists[i].size();
+    const uint64_t added = add_frame_samples(*loaded.caster, kept, kept_cells, c.sample_frame, lists);
+    for (size_t i = 0; i < lists.size(); ++i) active[i] = active[i] && lists[i].size() > before[i];
+    out.frame_sample_cameras += kept.size();
+    out.frame_sample_entries += added;
+    if (c.frame_rounds > 1)
+      log("viewcells: bake: frame round " + std::to_string(round + 1) + ": " + std::to_string(kept.size()) +
+          " frames in " + std::to_string(n_active) + " cells added " + std::to_string(added) + " entries");
+  }
+  out.frame_sample_seconds = sw.seconds();
+  log("viewcells: bake: " + std::to_string(out.frame_sample_cameras) + " sampling frames of " +
+      std::to_string(c.sample_frame.width) + "x" + std::to_string(c.sample_frame.height) + " (" + rule +
+      ") added " + std::to_string(out.frame_sample_entries) + " PVS entries in " + fmt(out.frame_sample_seconds, 1) +
+      " s");
+}
+
+/// Near-object samples (BakeConfig::near), after AGVS and the frames, within the bake's time
+/// limit as measured by `total`.
+void near_object_samples(const BakeConfig& c, const LoadedScene& loaded, const CellLocator& covered_cells,
+                         const Stopwatch& total, std::vector<std::vector<uint32_t>>& lists, BakeResult& out,
+                         const Log& log) {
+  // Viewpoints where viewers are, from a seed of their own, grouped by cell.
+  Stopwatch sw;
+  CameraConfig ec = c.cameras;
+  ec.count = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{c.near_eyes} * lists.size(), 10'000'000));
+  ec.seed = c.cameras.seed + 0x6e65'0001;
+  // Bake's default: where no viewpoint can be placed (a view box inside solids, a map whose
+  // floors cannot be found), the bake goes on without them and says so.
+  CameraSet drawn;
+  try {
+    drawn = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), ec,
+                         [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); }, &covered_cells);
+  } catch (const Interrupted&) {
+    throw;
+  } catch (const Error& e) {
+    out.near_skipped = e.what();
+    log("viewcells: bake: near-object samples skipped: no viewpoints (" + out.near_skipped + ")");
+  }
+  std::vector<std::vector<Vec3>> eyes(lists.size());
+  for (size_t i = 0; i < drawn.cameras.size(); ++i)
+    if (drawn.cells[i] >= 0) eyes[static_cast<size_t>(drawn.cells[i])].push_back(drawn.cameras[i].eye);
+  NearSampleConfig nc = c.near;
+  nc.seed = c.agvs.seed;
+  if (c.max_seconds > 0) nc.max_seconds = std::max(c.max_seconds - total.seconds(), 1e-9);
+  out.near = add_near_samples(*loaded.scene, *loaded.caster, eyes, nc, lists);
+  out.near_eyes = drawn.cameras.size();
+  out.near_seconds = sw.seconds();
+  std::string rounds;
+  for (size_t i = 0; i < out.near.added_by_round.size() && out.near_skipped.empty(); ++i)
+    rounds += (rounds.empty() ? "" : ", ") + std::to_string(out.near.added_by_round[i]) +
+              (out.near.rays_by_round[i] < c.near.rays_per_object
+                   ? " (" + std::to_string(out.near.rays_by_round[i]) + " rays a candidate)"
+                   : std::string());
+  if (out.near_skipped.empty())
+    log("viewcells: bake: near-object samples (" + drawn.rule + ", " + std::to_string(out.near_eyes) +
+      " viewpoints; neighbours within " + fmt(out.near.distance, 3) + "): " + std::to_string(out.near.tested) +
+      " objects tested with " + std::to_string(out.near.rays) + " rays added " + std::to_string(out.near.added) +
+      " PVS entries (by round: " + rounds + ") in " + fmt(out.near_seconds, 2) + " s" +
+      (out.near.stopped_by_time ? " (stopped at the time limit)" : ""));
+}
+
+/// The view cells written, their PVSs and the file's bytes.
+struct Written {
+  ViewCellSet cells;
+  std::vector<std::vector<uint32_t>> lists;
+  CutBytes bytes;
+};
+
+/// The cut `set` with its PVSs `lists` written; under a memory budget that it exceeds, the
+/// largest coarser cut that fits, with the unions of the PVSs.
+Written fit_budget(const BakeConfig& c, const SubdivisionFile& file, const ViewCellSet& set,
+                   const std::vector<std::vector<uint32_t>>& lists, const Box3& written_box, const Log& log) {
+  const MergeHistory& h = *file.history;
+  Written w{set, lists, {}};
+  w.bytes = write_cut(c.output, file, set, &lists, true, written_box);
+  const uint64_t used = w.bytes.budgeted(c.memory_of_lists);
+  if (c.memory && used > c.memory) {
+    // AGVS found more than the construction samples: the largest coarser cut that fits, with
+    // the unions of the sampled PVSs.
+    log("viewcells: bake: " + std::to_string(used) + " bytes for " + std::to_string(set.cells.size()) +
+        " cells exceed the budget of " + std::to_string(c.memory) + ": coarsening");
+    const size_t n = largest_fitting(h.min_cells(), set.cells.size() - 1, c.memory, [&](size_t count) {
+      const ViewCellSet cut = extract_by_count(h, count);
+      const auto coarse = coarsen(h, set.cells, lists, cut.cells);
+      return write_cut(c.output, file, cut, &coarse, false, written_box).budgeted(c.memory_of_lists);
+    });
+    if (n == 0)
+      throw Error(c.output, 0, "not even " + std::to_string(h.min_cells()) + " view cell(s) fit in " +
+                                   std::to_string(c.memory) + " bytes");
+    w.cells = extract_by_count(h, n);
+    w.lists = coarsen(h, set.cells, lists, w.cells.cells);
+    w.bytes = write_cut(c.output, file, w.cells, &w.lists, true, written_box);
+  }
+  return w;
+}
+
+/// The PVSs written, measured by the cameras `cams` (again, unless AGVS's last measurement was
+/// of these very PVSs).
+void measure_written(const BakeConfig& c, const LoadedScene& loaded, const SubdivisionFile& file,
+                     const ViewCellSet& set, const Written& w, const Box3& written_box, const CameraSet& cams,
+                     BakeResult& out, const Log& log) {
+  if (w.cells.cells.size() == set.cells.size() && !out.measured_curve.empty() && !c.frame_samples && !c.near.rays_per_object) {
+    out.measured = out.measured_curve.back().measured;  // the PVSs written, measured last
+  } else {
+    // The cells written (coarser when the budget coarsened them): each camera's is found again.
+    CameraSet in_written = cams;
+    if (w.cells.cells.size() != set.cells.size()) {
+      PvsFile wf = pvs_file_for(file, w.cells);
+      wf.bsp.view_box = written_box;
+      const CellLocator located(wf.bsp, wf.leaf_cell, wf.pvs.cell_count);
+      for (size_t i = 0; i < in_written.cameras.size(); ++i)
+        in_written.cells[i] = located.cell_at(in_written.cameras[i].eye);
+    }
+    Stopwatch sw;
+    out.measured = measure_frames(*loaded.scene, *loaded.caster, in_written.cameras, in_written.cells,
+                                  GlobalPvs::from_lists(file.object_count, w.lists), c.frame);
+    out.measured->wrong.clear();
+    log("viewcells: bake: measured pixel error " + fmt(out.measured->pixels, 3) + " (median camera " +
+        fmt(out.measured->median_pixels, 3) + ") in " + fmt(sw.seconds(), 1) + " s");
+  }
+}
+
+/// The bake's last line.
+void log_bake(const BakeConfig& c, const BakeResult& out, const Log& log) {
+  const double err = out.pixel_error, bound = out.pixel_error_bound;
+  log("viewcells: bake: " + std::to_string(out.cells) + " view cells, mean PVS " + fmt(out.mean_pvs, 1) +
+      " objects, estimated pixel error " +
+      (!std::isnan(err)     ? fmt(err, 2)
+       : !std::isnan(bound) ? "below " + fmt(bound, 2) + " (90% bound)"
+                            : std::string("not known")) +
+      (out.measured ? ", measured " + fmt(out.measured->pixels, 2) + " (median camera " +
+                          fmt(out.measured->median_pixels, 2) + ")"
+                    : std::string()) +
+      " after " + std::to_string(out.agvs.samples) + " samples (" + out.agvs.stop_reason + "); " +
+      (c.output.empty() ? std::string("in memory") : c.output) + ": " +
+      std::to_string(out.file_bytes) + " bytes in " + fmt(out.seconds, 1) + " s");
+}
+
+}  // namespace
+
+BakeResult bake(const BakeConfig& c, const Log& log) {
+  check_bake(c);
   Stopwatch total;
   BakeResult out;
   out.config = c;
@@ -302,149 +474,20 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
         fmt(sw.seconds(), 2) + " s");
   }
   std::vector<std::vector<uint32_t>> lists = sample_pvs(run, loaded, sampled, cells, cams, out, log);
-  if (c.frame_samples) {
-    // Frames where viewers are, from a seed of their own (the measuring cameras' is c.cameras.seed).
-    // After the first round, only the cells whose frames still added something get more: about
-    // as many frames again, drawn from the same distribution and kept where they land in those.
-    Stopwatch sw;
-    std::vector<uint8_t> active(lists.size(), 1);
-    std::string rule;
-    for (uint32_t round = 0; round < c.frame_rounds; ++round) {
-      const size_t n_active = static_cast<size_t>(std::count(active.begin(), active.end(), 1));
-      if (n_active == 0) break;
-      CameraConfig sc = c.cameras;
-      sc.count = static_cast<uint32_t>(std::min<uint64_t>(sampling_frames * lists.size() / n_active, 10'000'000));
-      sc.seed = c.cameras.seed + 0x5a3'0001 + round;
-      const CameraSet drawn = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), sc,
-                                           [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
-                                           &covered_cells);
-      rule = drawn.rule;
-      std::vector<Camera> kept;
-      std::vector<int32_t> kept_cells;
-      for (size_t i = 0; i < drawn.cameras.size() && kept.size() < sampling_frames; ++i)
-        if (drawn.cells[i] >= 0 && active[static_cast<size_t>(drawn.cells[i])]) {
-          kept.push_back(drawn.cameras[i]);
-          kept_cells.push_back(drawn.cells[i]);
-        }
-      std::vector<size_t> before(lists.size());
-      for (size_t i = 0; i < lists.size(); ++i) before[i] = lists[i].size();
-      const uint64_t added = add_frame_samples(*loaded.caster, kept, kept_cells, c.sample_frame, lists);
-      for (size_t i = 0; i < lists.size(); ++i) active[i] = active[i] && lists[i].size() > before[i];
-      out.frame_sample_cameras += kept.size();
-      out.frame_sample_entries += added;
-      if (c.frame_rounds > 1)
-        log("viewcells: bake: frame round " + std::to_string(round + 1) + ": " + std::to_string(kept.size()) +
-            " frames in " + std::to_string(n_active) + " cells added " + std::to_string(added) + " entries");
-    }
-    out.frame_sample_seconds = sw.seconds();
-    log("viewcells: bake: " + std::to_string(out.frame_sample_cameras) + " sampling frames of " +
-        std::to_string(c.sample_frame.width) + "x" + std::to_string(c.sample_frame.height) + " (" + rule +
-        ") added " + std::to_string(out.frame_sample_entries) + " PVS entries in " + fmt(out.frame_sample_seconds, 1) +
-        " s");
-  }
-  if (c.near.rays_per_object) {
-    // Viewpoints where viewers are, from a seed of their own, grouped by cell.
-    Stopwatch sw;
-    CameraConfig ec = c.cameras;
-    ec.count = static_cast<uint32_t>(std::min<uint64_t>(uint64_t{c.near_eyes} * lists.size(), 10'000'000));
-    ec.seed = c.cameras.seed + 0x6e65'0001;
-    // Bake's default: where no viewpoint can be placed (a view box inside solids, a map whose
-    // floors cannot be found), the bake goes on without them and says so.
-    CameraSet drawn;
-    try {
-      drawn = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), ec,
-                           [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); }, &covered_cells);
-    } catch (const Interrupted&) {
-      throw;
-    } catch (const Error& e) {
-      out.near_skipped = e.what();
-      log("viewcells: bake: near-object samples skipped: no viewpoints (" + out.near_skipped + ")");
-    }
-    std::vector<std::vector<Vec3>> eyes(lists.size());
-    for (size_t i = 0; i < drawn.cameras.size(); ++i)
-      if (drawn.cells[i] >= 0) eyes[static_cast<size_t>(drawn.cells[i])].push_back(drawn.cameras[i].eye);
-    NearSampleConfig nc = c.near;
-    nc.seed = c.agvs.seed;
-    if (c.max_seconds > 0) nc.max_seconds = std::max(c.max_seconds - total.seconds(), 1e-9);
-    out.near = add_near_samples(*loaded.scene, *loaded.caster, eyes, nc, lists);
-    out.near_eyes = drawn.cameras.size();
-    out.near_seconds = sw.seconds();
-    std::string rounds;
-    for (size_t i = 0; i < out.near.added_by_round.size() && out.near_skipped.empty(); ++i)
-      rounds += (rounds.empty() ? "" : ", ") + std::to_string(out.near.added_by_round[i]) +
-                (out.near.rays_by_round[i] < c.near.rays_per_object
-                     ? " (" + std::to_string(out.near.rays_by_round[i]) + " rays a candidate)"
-                     : std::string());
-    if (out.near_skipped.empty())
-      log("viewcells: bake: near-object samples (" + drawn.rule + ", " + std::to_string(out.near_eyes) +
-        " viewpoints; neighbours within " + fmt(out.near.distance, 3) + "): " + std::to_string(out.near.tested) +
-        " objects tested with " + std::to_string(out.near.rays) + " rays added " + std::to_string(out.near.added) +
-        " PVS entries (by round: " + rounds + ") in " + fmt(out.near_seconds, 2) + " s" +
-        (out.near.stopped_by_time ? " (stopped at the time limit)" : ""));
-  }
+  if (c.frame_samples) frame_sample_rounds(c, loaded, covered_cells, sampling_frames, lists, out, log);
+  if (c.near.rays_per_object) near_object_samples(c, loaded, covered_cells, total, lists, out, log);
   out.agvs_cells = static_cast<uint32_t>(set.cells.size());
-  ViewCellSet written = set;
-  std::vector<std::vector<uint32_t>> written_lists = lists;
-  CutBytes bytes = write_cut(c.output, file, set, &lists, true, written_box);
-  const uint64_t used = bytes.budgeted(c.memory_of_lists);
-  if (c.memory && used > c.memory) {
-    // AGVS found more than the construction samples: the largest coarser cut that fits, with
-    // the unions of the sampled PVSs.
-    log("viewcells: bake: " + std::to_string(used) + " bytes for " + std::to_string(set.cells.size()) +
-        " cells exceed the budget of " + std::to_string(c.memory) + ": coarsening");
-    const size_t n = largest_fitting(h.min_cells(), set.cells.size() - 1, c.memory, [&](size_t count) {
-      const ViewCellSet cut = extract_by_count(h, count);
-      const auto coarse = coarsen(h, set.cells, lists, cut.cells);
-      return write_cut(c.output, file, cut, &coarse, false, written_box).budgeted(c.memory_of_lists);
-    });
-    if (n == 0)
-      throw Error(c.output, 0, "not even " + std::to_string(h.min_cells()) + " view cell(s) fit in " +
-                                   std::to_string(c.memory) + " bytes");
-    written = extract_by_count(h, n);
-    written_lists = coarsen(h, set.cells, lists, written.cells);
-    bytes = write_cut(c.output, file, written, &written_lists, true, written_box);
-  }
-  if (cams) {
-    if (written.cells.size() == set.cells.size() && !out.measured_curve.empty() && !c.frame_samples && !c.near.rays_per_object) {
-      out.measured = out.measured_curve.back().measured;  // the PVSs written, measured last
-    } else {
-      // The cells written (coarser when the budget coarsened them): each camera's is found again.
-      CameraSet in_written = *cams;
-      if (written.cells.size() != set.cells.size()) {
-        PvsFile wf = pvs_file_for(file, written);
-        wf.bsp.view_box = written_box;
-        const CellLocator located(wf.bsp, wf.leaf_cell, wf.pvs.cell_count);
-        for (size_t i = 0; i < in_written.cameras.size(); ++i)
-          in_written.cells[i] = located.cell_at(in_written.cameras[i].eye);
-      }
-      Stopwatch sw;
-      out.measured = measure_frames(*loaded.scene, *loaded.caster, in_written.cameras, in_written.cells,
-                                    GlobalPvs::from_lists(file.object_count, written_lists), c.frame);
-      out.measured->wrong.clear();
-      log("viewcells: bake: measured pixel error " + fmt(out.measured->pixels, 3) + " (median camera " +
-          fmt(out.measured->median_pixels, 3) + ") in " + fmt(sw.seconds(), 1) + " s");
-    }
-  }
-  out.file = bytes.pvs;
-  out.file_bytes = bytes.file;
-  out.list_bytes = bytes.lists;
-  out.cells = static_cast<uint32_t>(written.cells.size());
-  out.rule = written.rule + "; PVS by agvs";
-  for (const auto& l : written_lists) out.pvs_entries += l.size();
+  const Written w = fit_budget(c, file, set, lists, written_box, log);
+  if (cams) measure_written(c, loaded, file, set, w, written_box, *cams, out, log);
+  out.file = w.bytes.pvs;
+  out.file_bytes = w.bytes.file;
+  out.list_bytes = w.bytes.lists;
+  out.cells = static_cast<uint32_t>(w.cells.cells.size());
+  out.rule = w.cells.rule + "; PVS by agvs";
+  for (const auto& l : w.lists) out.pvs_entries += l.size();
   out.mean_pvs = static_cast<double>(out.pvs_entries) / out.cells;
   out.seconds = total.seconds();
-  const double err = out.pixel_error, bound = out.pixel_error_bound;
-  log("viewcells: bake: " + std::to_string(out.cells) + " view cells, mean PVS " + fmt(out.mean_pvs, 1) +
-      " objects, estimated pixel error " +
-      (!std::isnan(err)     ? fmt(err, 2)
-       : !std::isnan(bound) ? "below " + fmt(bound, 2) + " (90% bound)"
-                            : std::string("not known")) +
-      (out.measured ? ", measured " + fmt(out.measured->pixels, 2) + " (median camera " +
-                          fmt(out.measured->median_pixels, 2) + ")"
-                    : std::string()) +
-      " after " + std::to_string(out.agvs.samples) + " samples (" + out.agvs.stop_reason + "); " +
-      (c.output.empty() ? std::string("in memory") : c.output) + ": " +
-      std::to_string(out.file_bytes) + " bytes in " + fmt(out.seconds, 1) + " s");
+  log_bake(c, out, log);
   return out;
 }
 

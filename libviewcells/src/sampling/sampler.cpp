@@ -343,6 +343,74 @@ Box3 resolve_view_box(const Scene& scene, const SamplerConfig& config, bool& fro
 
 namespace {
 
+/// A batch's counts added to the run's.
+void add_batch_stats(SamplingStats& stats, const BatchOutput& out, uint64_t count) {
+  stats.samples += count;
+  stats.rays += out.rays;
+  stats.recast_rays += out.recast_rays;
+  stats.missed_both += out.missed_both;
+  stats.stuck_in_solid += out.stuck;
+  stats.outside_view_box += out.outside;
+  stats.two_sided_samples += out.two_sided;
+  stats.rejected_origins += out.rejected;
+  stats.see_through_rays += out.see_through_rays;
+  stats.see_through_segments += out.see_through_segments;
+}
+
+/// Sampling on several ranks: rounds of a fixed number of batches (not depending on the
+/// ranks); each rank samples the batches it owns, every rank receives all of them and hands
+/// them to `consume` in batch order (until `finished`), so every rank holds the same output,
+/// the one a single process makes.
+template <class Samplers, class Consume>
+void sample_on_ranks(const SamplerConfig& config, Samplers& samplers, size_t slots, uint64_t limit,
+                     const Box3& view_box, const bool& finished, Consume& consume) {
+  uint64_t next_batch = 0;
+  constexpr uint64_t kRoundBatches = 64;
+  SegmentSet batch_segs;
+  while (!finished) {
+    throw_if_interrupted("sampling");
+    const uint64_t first = next_batch;
+    uint64_t n = 0;
+    while (n < kRoundBatches && (first + n) * config.batch_size < limit) ++n;
+    if (n == 0) break;
+    std::vector<std::string> items(n);
+    tbb::parallel_for(uint64_t{0}, n, [&](uint64_t i) {
+      const uint64_t batch = first + i;
+      if (!cluster::mine(batch)) return;
+      SegmentSet scratch;
+      scratch.resize(slots);
+      BatchOutput out;
+      samplers.local().run(config.seed, config.first_batch + batch,
+                           std::min<uint64_t>(config.batch_size, limit - batch * config.batch_size), scratch, out, nullptr);
+      ByteWriter w;
+      w.put(out);
+      scratch.resize(out.valid);
+      put_segments(w, scratch);
+      items[i] = w.take();
+    });
+    cluster::share(items, first);  // item i is batch first + i, owned by mine(first + i)
+    for (uint64_t i = 0; i < n && !finished; ++i) {
+      const uint64_t batch = first + i;
+      ByteReader r(items[i], "a rank's sampling results");
+      BatchOutput out = r.get<BatchOutput>();
+      batch_segs.view_box = view_box;
+      get_segments(r, batch_segs, items[i].size());
+      consume(batch_segs, out, std::min<uint64_t>(config.batch_size, limit - batch * config.batch_size), nullptr);
+    }
+    next_batch = first + n;
+  }
+}
+
+/// Each object's segments (an end on it) into stats.segments_per_object.
+void count_segments_per_object(SamplingStats& stats, const SegmentSet& segs, size_t objects) {
+  stats.segments_per_object.assign(objects, 0);
+  for (size_t i = 0; i < segs.size(); ++i) {
+    if (segs.object_a[i] != kNoObject) ++stats.segments_per_object[segs.object_a[i]];
+    if (segs.object_b[i] != kNoObject && segs.object_b[i] != segs.object_a[i])
+      ++stats.segments_per_object[segs.object_b[i]];
+  }
+}
+
 /// The sampler; `logs`, when given, receives the rays of each batch in the output, in order.
 constexpr uint64_t kGiveUpSamples = 1'000'000;
 
@@ -399,59 +467,14 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
     }
     segs.append(batch_segs, 0, out.valid);
     if (logs) logs->push_back(std::move(*log));
-    stats.samples += count;
-    stats.rays += out.rays;
-    stats.recast_rays += out.recast_rays;
-    stats.missed_both += out.missed_both;
-    stats.stuck_in_solid += out.stuck;
-    stats.outside_view_box += out.outside;
-    stats.two_sided_samples += out.two_sided;
-    stats.rejected_origins += out.rejected;
-    stats.see_through_rays += out.see_through_rays;
-    stats.see_through_segments += out.see_through_segments;
+    add_batch_stats(stats, out, count);
     if (show) progress.advance(by_segments ? out.valid : count);
     // Nothing seen after a million samples: the target is out of reach, say so now.
     if (by_segments && segs.size() == 0 && stats.samples >= kGiveUpSamples) finished = true;
     if (finished) stop.store(true, std::memory_order_relaxed);
   };
   if (cluster::size() > 1 && !logs) {
-    // Several ranks: rounds of a fixed number of batches (not depending on the ranks); each rank
-    // samples the batches it owns, every rank receives all of them and consumes them in batch
-    // order, so every rank holds the same output, the one a single process makes.
-    constexpr uint64_t kRoundBatches = 64;
-    SegmentSet batch_segs;
-    while (!finished) {
-      throw_if_interrupted("sampling");
-      const uint64_t first = next_batch;
-      uint64_t n = 0;
-      while (n < kRoundBatches && (first + n) * config.batch_size < limit) ++n;
-      if (n == 0) break;
-      std::vector<std::string> items(n);
-      tbb::parallel_for(uint64_t{0}, n, [&](uint64_t i) {
-        const uint64_t batch = first + i;
-        if (!cluster::mine(batch)) return;
-        SegmentSet scratch;
-        scratch.resize(slots);
-        BatchOutput out;
-        samplers.local().run(config.seed, config.first_batch + batch, std::min<uint64_t>(config.batch_size, limit - batch * config.batch_size),
-                             scratch, out, nullptr);
-        ByteWriter w;
-        w.put(out);
-        scratch.resize(out.valid);
-        put_segments(w, scratch);
-        items[i] = w.take();
-      });
-      cluster::share(items, first);  // item i is batch first + i, owned by mine(first + i)
-      for (uint64_t i = 0; i < n && !finished; ++i) {
-        const uint64_t batch = first + i;
-        ByteReader r(items[i], "a rank's sampling results");
-        BatchOutput out = r.get<BatchOutput>();
-        batch_segs.view_box = segs.view_box;
-        get_segments(r, batch_segs, items[i].size());
-        consume(batch_segs, out, std::min<uint64_t>(config.batch_size, limit - batch * config.batch_size), nullptr);
-      }
-      next_batch = first + n;
-    }
+    sample_on_ranks(config, samplers, slots, limit, segs.view_box, finished, consume);
   } else {
     tbb::parallel_pipeline(
         token_count,
@@ -488,12 +511,7 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
   stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   if (show) progress.finish();
 
-  stats.segments_per_object.assign(scene.objects.size(), 0);
-  for (size_t i = 0; i < segs.size(); ++i) {
-    if (segs.object_a[i] != kNoObject) ++stats.segments_per_object[segs.object_a[i]];
-    if (segs.object_b[i] != kNoObject && segs.object_b[i] != segs.object_a[i])
-      ++stats.segments_per_object[segs.object_b[i]];
-  }
+  count_segments_per_object(stats, segs, scene.objects.size());
   return result;
 }
 
