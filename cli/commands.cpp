@@ -7,7 +7,7 @@
 #include <iostream>
 
 #include "options.h"
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/interrupt.h"
 #include "viewcells/core/isa.h"
@@ -61,7 +61,7 @@ int run(int argc, char** argv) {
       }
     // On a cluster every rank computes the same files; rank 0 installs them, the others'
     // staged copies go with their batch.
-    if (rc == 0 && cluster::writer()) outputs.commit();
+    if (rc == 0 && ranks::writer()) outputs.commit();
     return rc;
   } catch (const Interrupted& e) {
     std::cerr << "viewcells: " << e.what() << '\n';

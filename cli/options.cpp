@@ -7,18 +7,18 @@
 #include <iostream>
 #include <sstream>
 
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/binary_file.h"
 
 namespace viewcells::cli {
 
 void Common::log(const std::string& s) const {
-  if (!quiet && cluster::writer()) std::cerr << s << '\n';
+  if (!quiet && ranks::writer()) std::cerr << s << '\n';
 }
 
 pipeline::Log Common::logger() const {
-  const bool q = quiet || !cluster::writer();  // on a cluster, rank 0 speaks for the run
+  const bool q = quiet || !ranks::writer();  // on a cluster, rank 0 speaks for the run
   return [q](const std::string& s) {
     if (!q) std::cerr << s << '\n';
   };

@@ -16,7 +16,7 @@ test -f "$work/prefix/lib/cmake/viewcells/viewcellsConfig.cmake"
 test -f "$work/prefix/include/viewcells/runtime.h"
 # The stable headers are installed, the internals no stable header needs are not.
 test -f "$work/prefix/include/viewcells/pipeline/bake.h"
-for internal in core/parallel.h core/progress.h core/cluster.h vis/level_view.h; do
+for internal in core/parallel.h core/progress.h core/ranks.h vis/level_view.h; do
   if [ -e "$work/prefix/include/viewcells/$internal" ]; then echo "FAIL: installed an internal header, $internal"; exit 1; fi
 done
 cmake -S "$src/examples/consumer" -B "$work/consumer" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" \

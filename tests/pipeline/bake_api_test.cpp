@@ -170,7 +170,9 @@ TEST(BakeApi, SeeThroughObjectsHideNothing) {
       right_seen |= vc_pvs_cell_sees(pvs, static_cast<int32_t>(c), 1) == 1;
       glass_seen |= vc_pvs_cell_sees(pvs, static_cast<int32_t>(c), 2) == 1;
     }
-    if (!see_through) EXPECT_TRUE(glass_seen);
+    if (!see_through) {
+      EXPECT_TRUE(glass_seen);
+    }
     EXPECT_EQ(right_seen, see_through == 1) << "see_through " << see_through;
     vc_pvs_close(pvs);
     vc_bake_result_free(r);

@@ -95,8 +95,8 @@ void AgvsSolver::run() {
       m.stats.stop_reason = "reached " + std::to_string(c.max_samples) + " samples";
       break;
     }
-    // Clock decisions are rank 0's on a cluster (cluster::agree), so that all ranks stop together.
-    if (c.max_seconds > 0 && cluster::agree(seconds >= c.max_seconds)) {
+    // Clock decisions are rank 0's on a cluster (ranks::agree), so that all ranks stop together.
+    if (c.max_seconds > 0 && ranks::agree(seconds >= c.max_seconds)) {
       m.stats.stop_reason = "reached the time limit";
       break;
     }
@@ -139,7 +139,7 @@ void AgvsSolver::run() {
     for (size_t k = 0; k < m.references.size(); ++k) point.covered[k] = m.pvs.common_entries(m.references[k]);
     m.stats.curve.push_back(point);
     if (m.checkpoint && m.checkpoint_every > 0 &&
-        cluster::agree(std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count() >=
+        ranks::agree(std::chrono::duration<double>(std::chrono::steady_clock::now() - last_checkpoint).count() >=
                        m.checkpoint_every)) {
       m.sync();  // the state of every rank's rows
       m.checkpoint();

@@ -15,7 +15,7 @@
 #include <tuple>
 
 #include "viewcells/core/binary_file.h"
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 
 namespace viewcells {
 
@@ -25,7 +25,7 @@ namespace {
 /// sent); `take(reader, array)` gets what each other rank sent, in rank order.
 template <class T, class Take>
 void exchange_arrays(const std::vector<std::vector<T>>& out, const char* what, Take&& take) {
-  const size_t me = static_cast<size_t>(cluster::rank());
+  const size_t me = static_cast<size_t>(ranks::rank());
   std::vector<std::string> to(out.size());
   for (size_t q = 0; q < out.size(); ++q) {
     if (q == me) continue;
@@ -33,7 +33,7 @@ void exchange_arrays(const std::vector<std::vector<T>>& out, const char* what, T
     w.put_array(out[q]);
     to[q] = w.take();
   }
-  const std::vector<std::string> from = cluster::exchange(std::move(to));
+  const std::vector<std::string> from = ranks::exchange(std::move(to));
   std::vector<T> got;
   for (size_t q = 0; q < from.size(); ++q) {
     if (q == me) continue;
@@ -68,7 +68,7 @@ void AgvsSolver::Impl::insert_segments(const std::vector<BatchChunk>& chunks, st
     uint32_t gain = 0;
     uint8_t flags = 0;
   };
-  const uint64_t ranks = static_cast<uint64_t>(cluster::size());
+  const uint64_t ranks = static_cast<uint64_t>(ranks::size());
   const size_t parts = static_cast<size_t>(std::max(1, tbb::this_task_arena::max_concurrency()));
   const size_t n_chunks = chunks.size();
   std::vector<std::vector<std::vector<Pair>>> pairs(n_chunks, std::vector<std::vector<Pair>>(parts));
@@ -112,7 +112,7 @@ void AgvsSolver::Impl::return_outcomes(const std::vector<BatchChunk>& chunks, st
   // Several ranks, routed: each rank sends every segment's outcome in its cells (entries added,
   // flags) back to the segment's caster, which sums and ors them (an all-to-all of the
   // segments that touched anything new).
-  const size_t ranks = static_cast<size_t>(cluster::size());
+  const size_t ranks = static_cast<size_t>(ranks::size());
   struct Outcome {
     uint32_t segment;  ///< in the batch
     uint32_t gain;
@@ -150,7 +150,7 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
   std::vector<uint32_t> gains(total, 0);
   std::vector<uint8_t> flags(total, 0);  // contributed a, b; at origin a, b (REF: wrong ray)
   const bool ref = config.method == AgvsMethod::kRef;
-  const bool routed = cluster::size() > 1 && !ref;
+  const bool routed = ranks::size() > 1 && !ref;
   // REF: whether the sample's point lies on this segment: its own segment.
   auto on_segment = [&](const BatchChunk& c, size_t i, uint32_t sample) {
     const Vec3 a = c.segs.a(i), ab = c.segs.b(i) - a;
@@ -168,7 +168,7 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
         if (camera[sample] != 0 || !on_segment(c, i, sample)) continue;
         camera[sample] = 1;
         const int32_t cell = s.ref_cell[sample];
-        if (!cluster::mine(static_cast<uint64_t>(cell))) continue;
+        if (!ranks::mine(static_cast<uint64_t>(cell))) continue;
         const uint32_t object = c.segs.object_b[i];
         if (config.filter_statistics) count_hits(cell, object, kNoObject);
         if (object != kNoObject && pvs.insert(static_cast<uint32_t>(cell), object)) gains[k] = 1, flags[k] = 4;
@@ -180,8 +180,8 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
   if (routed) {
     return_outcomes(chunks, gains, flags);
   } else {
-    cluster::sum(gains);
-    cluster::bit_or(flags);
+    ranks::sum(gains);
+    ranks::bit_or(flags);
   }
   // Pass 2: what follows from the segments besides the table, at their caster. Per chunk in
   // parallel (a chunk holds its samples' every segment): the counts, the estimator's camera
@@ -236,7 +236,7 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
     std::vector<uint64_t> sums(counts.contribution, counts.contribution + kDists);
     sums.push_back(counts.vsd_rays);
     sums.push_back(counts.vsd_wrong);
-    cluster::sum(sums);
+    ranks::sum(sums);
     std::copy(sums.begin(), sums.begin() + kDists, counts.contribution);
     counts.vsd_rays = sums[kDists], counts.vsd_wrong = sums[kDists + 1];
   }
@@ -246,11 +246,11 @@ void AgvsSolver::Impl::apply_segments(const BatchSamples& s, const std::vector<B
     else
       add_candidates(chunks, gains, flags, radius);
   }
-  if (cluster::size() == 1) return;
+  if (ranks::size() == 1) return;
   // The table's size over all ranks' rows (for the mean PVS of the curve and the status).
   partitioned = true;
   std::vector<uint64_t> grown{pvs.entries() - synced_entries};
-  cluster::sum(grown);
+  ranks::sum(grown);
   global_entries = synced_entries + grown[0];
 }
 
@@ -260,8 +260,8 @@ void AgvsSolver::Impl::route_candidates(const std::vector<BatchChunk>& chunks, c
   // sample's lane (index in the batch modulo the lanes); every rank learns each lane's count
   // (a sum); each owner feeds its lanes in sample order (chunk, segment, end), in parallel.
   const auto clock_start = std::chrono::steady_clock::now();
-  const int me = cluster::rank();
-  const size_t ranks = static_cast<size_t>(cluster::size()), n_lanes = lanes.size();
+  const int me = ranks::rank();
+  const size_t ranks = static_cast<size_t>(ranks::size()), n_lanes = lanes.size();
   struct Routed {
     uint32_t chunk, segment, end, lane;
     Candidate candidate;
@@ -300,7 +300,7 @@ void AgvsSolver::Impl::route_candidates(const std::vector<BatchChunk>& chunks, c
   });
   std::vector<std::vector<uint32_t>> of_lane(n_lanes);
   for (uint32_t j = 0; j < mine.size(); ++j) of_lane[mine[j].lane].push_back(j);
-  cluster::sum(added);
+  ranks::sum(added);
   tbb::parallel_for(size_t{0}, n_lanes, [&](size_t l) {
     MutationLane& lane = lanes[l];
     for (uint32_t j : of_lane[l]) {
@@ -378,17 +378,17 @@ void AgvsSolver::Impl::sync() {
   const size_t words = pvs.words_per_row(), n_objects = pvs.object_count();
   std::vector<uint64_t>& bits = pvs.raw_bits();
   for (uint32_t c = 0; c < n_cells; ++c)
-    if (!cluster::mine(c)) std::fill(bits.begin() + c * words, bits.begin() + (c + 1) * words, 0);
-  cluster::bit_or(bits);
+    if (!ranks::mine(c)) std::fill(bits.begin() + c * words, bits.begin() + (c + 1) * words, 0);
+  ranks::bit_or(bits);
   pvs.recount();
   if (config.filter_statistics) {
     for (uint32_t c = 0; c < n_cells; ++c)
-      if (!cluster::mine(c)) {
+      if (!ranks::mine(c)) {
         cell_samples[c] = 0;
         std::fill(hit_counts.begin() + c * n_objects, hit_counts.begin() + (c + 1) * n_objects, 0);
       }
-    cluster::sum(cell_samples);
-    cluster::sum(hit_counts);
+    ranks::sum(cell_samples);
+    ranks::sum(hit_counts);
   }
   // The mutation lanes, each from its owner.
   std::vector<std::string> items(lanes.size());
@@ -398,7 +398,7 @@ void AgvsSolver::Impl::sync() {
       save_lane(w, lanes[l]);
       items[l] = w.take();
     }
-  cluster::share(items, [&](size_t l) { return lane_owner(l); });
+  ranks::share(items, [&](size_t l) { return lane_owner(l); });
   for (size_t l = 0; l < lanes.size(); ++l)
     if (!my_lane(l)) {
       ByteReader r(items[l], "a rank's mutation candidates");

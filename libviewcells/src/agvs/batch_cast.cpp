@@ -12,7 +12,7 @@
 #include <tuple>
 
 #include "viewcells/core/binary_file.h"
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 
 namespace viewcells {
 
@@ -122,9 +122,9 @@ std::vector<AgvsSolver::Impl::BatchChunk> AgvsSolver::Impl::cast_samples(BatchSa
     }
     c.pierced = c.pairs.size();
   };
-  if (cluster::size() > 1 && config.method == AgvsMethod::kRef) {
+  if (ranks::size() > 1 && config.method == AgvsMethod::kRef) {
     gather_chunks(chunks, cast_chunk);
-  } else if (cluster::size() > 1) {
+  } else if (ranks::size() > 1) {
     route_chunks(chunks, cast_chunk);
   } else {
     tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) { cast_chunk(chunks[k]); });
@@ -162,7 +162,7 @@ void AgvsSolver::Impl::gather_chunks(std::vector<BatchChunk>& chunks, const std:
   std::vector<std::string> items(chunks.size());
   auto owner = [&](size_t k) { return chunk_owner(chunks, k); };
   tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
-    if (owner(k) != cluster::rank()) return;
+    if (owner(k) != ranks::rank()) return;
     BatchChunk& c = chunks[k];
     cast_chunk(c);
     ByteWriter w;
@@ -171,7 +171,7 @@ void AgvsSolver::Impl::gather_chunks(std::vector<BatchChunk>& chunks, const std:
     put_segments(w, c.segs);
     items[k] = w.take();
   });
-  cluster::share(items, owner);
+  ranks::share(items, owner);
   for (size_t k = 0; k < chunks.size(); ++k) {
     BatchChunk& c = chunks[k];
     ByteReader r(items[k], "a rank's casting results");
@@ -188,7 +188,7 @@ int AgvsSolver::Impl::chunk_owner(const std::vector<BatchChunk>& chunks, size_t 
   // Numbered across batches, so that the work turns round the ranks; a chunk's owner may differ
   // between rank counts, its content does not. A mutation lane's chunks are its owner's, the
   // only rank that drew their points.
-  const uint64_t ranks = static_cast<uint64_t>(cluster::size());
+  const uint64_t ranks = static_cast<uint64_t>(ranks::size());
   return chunks[k].lane >= 0 ? lane_owner(static_cast<size_t>(chunks[k].lane))
                              : static_cast<int>((stats.batches * 4096 + k) % ranks);
 }
@@ -198,8 +198,8 @@ void AgvsSolver::Impl::route_chunks(std::vector<BatchChunk>& chunks, const std::
   // counts (a small allgather); the segments stay with their caster, and each (segment, cell)
   // pair goes only to the rank of its cell, with the segment's objects and camera cell (an
   // all-to-all), in segment order.
-  const int me = cluster::rank();
-  const size_t ranks = static_cast<size_t>(cluster::size());
+  const int me = ranks::rank();
+  const size_t ranks = static_cast<size_t>(ranks::size());
   std::vector<std::string> meta(chunks.size());
   std::vector<std::vector<std::vector<BatchChunk::RoutedPair>>> out(chunks.size());
   tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t k) {
@@ -222,7 +222,7 @@ void AgvsSolver::Impl::route_chunks(std::vector<BatchChunk>& chunks, const std::
     c.routed = std::move(out[k][static_cast<size_t>(me)]);
     c.pairs = {};
   });
-  cluster::share(meta, [&](size_t k) { return chunk_owner(chunks, k); });
+  ranks::share(meta, [&](size_t k) { return chunk_owner(chunks, k); });
   for (size_t k = 0; k < chunks.size(); ++k) {
     BatchChunk& c = chunks[k];
     if (chunk_owner(chunks, k) == me) continue;
@@ -246,7 +246,7 @@ void AgvsSolver::Impl::route_chunks(std::vector<BatchChunk>& chunks, const std::
     }
     to[q] = w.take();
   }
-  const std::vector<std::string> from = cluster::exchange(std::move(to));
+  const std::vector<std::string> from = ranks::exchange(std::move(to));
   const uint32_t n_cells = cells.cell_count(), n_objects = pvs.object_count();
   for (size_t q = 0; q < ranks; ++q) {
     if (q == static_cast<size_t>(me)) continue;
@@ -260,7 +260,7 @@ void AgvsSolver::Impl::route_chunks(std::vector<BatchChunk>& chunks, const std::
         const bool object_ok = (p.objects[0] == kNoObject || p.objects[0] < n_objects) &&
                                (p.objects[1] == kNoObject || p.objects[1] < n_objects);
         if (p.segment >= c.segment_count || p.cell < 0 || static_cast<uint32_t>(p.cell) >= n_cells ||
-            !cluster::mine(static_cast<uint64_t>(p.cell)) || !object_ok ||
+            !ranks::mine(static_cast<uint64_t>(p.cell)) || !object_ok ||
             (p.camera_cell != BatchChunk::kNotCamera && (p.camera_cell < -1 || p.camera_cell >= static_cast<int32_t>(n_cells))))
           r.fail("a routed segment is out of range");
       }

@@ -14,7 +14,7 @@
 #include <tuple>
 
 #include "viewcells/core/binary_file.h"
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 
 namespace viewcells {
 
@@ -94,7 +94,7 @@ uint32_t AgvsSolver::Impl::draw_mutations(uint64_t index, const uint32_t want[kD
     for (int m = 0; m < 2; ++m) ld.counts.samples[m] = ld.points[m].size();
     counts[l] = ld.counts;
   }
-  if (cluster::size() > 1) {
+  if (ranks::size() > 1) {
     std::vector<std::string> items(n_lanes);
     for (size_t l = 0; l < n_lanes; ++l)
       if (my_lane(l)) {
@@ -102,7 +102,7 @@ uint32_t AgvsSolver::Impl::draw_mutations(uint64_t index, const uint32_t want[kD
         w.put(counts[l]);
         items[l] = w.take();
       }
-    cluster::share(items, [&](size_t l) { return lane_owner(l); });
+    ranks::share(items, [&](size_t l) { return lane_owner(l); });
     for (size_t l = 0; l < n_lanes; ++l) {
       ByteReader r(items[l], "a rank's mutation draws");
       counts[l] = r.get<LaneCounts>();

@@ -15,7 +15,7 @@
 #include "candidates.h"
 #include "halton.h"
 #include "viewcells/agvs/agvs.h"
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/rng.h"
 #include "viewcells/sampling/sampler.h"
@@ -94,7 +94,7 @@ struct AgvsSolver::Impl {
   std::vector<uint64_t> cell_samples;
   std::vector<uint16_t> hit_counts;
   std::vector<GlobalPvs> references;  ///< for the curve's coverage only
-  // On several ranks (core/cluster.h) the cells are partitioned: rank r applies segments to
+  // On several ranks (core/ranks.h) the cells are partitioned: rank r applies segments to
   // the cells c with c mod ranks == r, so each rank's table is current in its own rows only
   // (`partitioned` is then true) until sync() combines them. Everything else is the same on
   // every rank: a segment's gain is summed and its flags or-ed over the ranks before they are
@@ -160,8 +160,8 @@ struct AgvsSolver::Impl {
   static constexpr size_t kLaneGroups = 64;
   size_t lane_group(size_t l) const { return l * kLaneGroups / lanes.size(); }
   /// The rank that draws and feeds mutation lane l.
-  int lane_owner(size_t l) const { return static_cast<int>(lane_group(l) % static_cast<size_t>(cluster::size())); }
-  bool my_lane(size_t l) const { return lane_owner(l) == cluster::rank(); }
+  int lane_owner(size_t l) const { return static_cast<int>(lane_group(l) % static_cast<size_t>(ranks::size())); }
+  bool my_lane(size_t l) const { return lane_owner(l) == ranks::rank(); }
   uint64_t mutation_candidates() const {
     uint64_t n = 0;
     for (const MutationLane& l : lanes) n += l.count;

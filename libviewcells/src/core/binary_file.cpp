@@ -1,6 +1,6 @@
 #include "viewcells/core/binary_file.h"
 
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 
 #include <unistd.h>
 
@@ -57,7 +57,7 @@ void install_file(const std::string& tmp, const std::string& path) {
       return;
     }
   }
-  if (!cluster::writer()) {  // on a cluster, rank 0 writes; the others hold the same result
+  if (!ranks::writer()) {  // on a cluster, rank 0 writes; the others hold the same result
     std::remove(tmp.c_str());
     return;
   }

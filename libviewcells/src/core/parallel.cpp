@@ -3,7 +3,7 @@
 #include <tbb/global_control.h>
 #include <tbb/info.h>
 
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 
 namespace viewcells {
 
@@ -26,7 +26,7 @@ int worker_threads() {
 }
 
 std::string workers_text() {
-  const int t = worker_threads(), r = cluster::size();
+  const int t = worker_threads(), r = ranks::size();
   const std::string threads = std::to_string(t) + (t == 1 ? " thread" : " threads");
   return r > 1 ? std::to_string(r) + " ranks of " + threads : threads;
 }

@@ -1,6 +1,6 @@
 #include "viewcells/core/progress.h"
 
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 
 #include <unistd.h>
 
@@ -11,7 +11,7 @@ namespace viewcells {
 Progress::Progress(std::string label, uint64_t total)
     : label_(std::move(label)),
       total_(total),
-      enabled_(isatty(STDERR_FILENO) == 1 && cluster::writer()),  // one bar per run, from rank 0
+      enabled_(isatty(STDERR_FILENO) == 1 && ranks::writer()),  // one bar per run, from rank 0
       start_(std::chrono::steady_clock::now()) {}
 
 Progress::~Progress() {

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <filesystem>
 
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 #include "viewcells/core/format.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
@@ -258,12 +258,12 @@ bool run_to_measured_error(AgvsSolver& solver, const AgvsConfig& a, const Measur
 
 std::vector<RankPhases> gather_phases(const AgvsStats& stats) {
   RankPhases mine{stats.draw_seconds, stats.mutation_seconds, stats.cast_seconds, stats.apply_seconds,
-                  cluster::traffic().seconds};
-  std::vector<std::string> items(static_cast<size_t>(cluster::size()));
+                  ranks::traffic().seconds};
+  std::vector<std::string> items(static_cast<size_t>(ranks::size()));
   ByteWriter w;
   w.put(mine);
-  items[static_cast<size_t>(cluster::rank())] = w.take();
-  cluster::share(items, [](size_t i) { return static_cast<int>(i); });
+  items[static_cast<size_t>(ranks::rank())] = w.take();
+  ranks::share(items, [](size_t i) { return static_cast<int>(i); });
   std::vector<RankPhases> all;
   for (const std::string& item : items) {
     ByteReader r(item, "a rank's phases");
@@ -324,7 +324,7 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
     // rank 0 alone on a cluster (every rank holds the same state).
     const uint64_t identity = pvs_state_identity(scenes.scene.fingerprint(), pf);
     solver->set_checkpoint(c.save_every, [&, identity] {
-      if (!cluster::writer()) return;
+      if (!ranks::writer()) return;
       UnbatchedWrites now;
       solver->save(c.save, identity);
     });

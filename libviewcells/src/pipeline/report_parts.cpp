@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 #include "viewcells/core/format.h"
 #include "viewcells/core/isa.h"
 #include "viewcells/core/binary_file.h"
@@ -23,9 +23,9 @@ json effect(bool enabled, const std::string& reason) { return {{"enabled", enabl
 std::string text(json j) {
   if (j.is_object()) {
     j["embree_isa"] = embree_isa();
-    if (cluster::size() > 1) {
-      const cluster::Traffic& t = cluster::traffic();
-      j["cluster"] = {{"ranks", cluster::size()},
+    if (ranks::size() > 1) {
+      const ranks::Traffic& t = ranks::traffic();
+      j["cluster"] = {{"ranks", ranks::size()},
                       {"exchanges", t.calls},
                       {"bytes_sent", t.bytes_sent},
                       {"bytes_received", t.bytes_received},

@@ -6,7 +6,7 @@
 
 #include <cmath>
 
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 #include "viewcells/core/format.h"
 #include "viewcells/core/isa.h"
 #include "viewcells/core/binary_file.h"

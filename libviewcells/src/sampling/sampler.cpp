@@ -13,7 +13,7 @@
 #include <cmath>
 
 #include "viewcells/core/binary_file.h"
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/interrupt.h"
 #include "viewcells/core/progress.h"
@@ -376,7 +376,7 @@ void sample_on_ranks(const SamplerConfig& config, Samplers& samplers, size_t slo
     std::vector<std::string> items(n);
     tbb::parallel_for(uint64_t{0}, n, [&](uint64_t i) {
       const uint64_t batch = first + i;
-      if (!cluster::mine(batch)) return;
+      if (!ranks::mine(batch)) return;
       SegmentSet scratch;
       scratch.resize(slots);
       BatchOutput out;
@@ -388,7 +388,7 @@ void sample_on_ranks(const SamplerConfig& config, Samplers& samplers, size_t slo
       put_segments(w, scratch);
       items[i] = w.take();
     });
-    cluster::share(items, first);  // item i is batch first + i, owned by mine(first + i)
+    ranks::share(items, first);  // item i is batch first + i, owned by mine(first + i)
     for (uint64_t i = 0; i < n && !finished; ++i) {
       const uint64_t batch = first + i;
       ByteReader r(items[i], "a rank's sampling results");
@@ -473,7 +473,7 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
     if (by_segments && segs.size() == 0 && stats.samples >= kGiveUpSamples) finished = true;
     if (finished) stop.store(true, std::memory_order_relaxed);
   };
-  if (cluster::size() > 1 && !logs) {
+  if (ranks::size() > 1 && !logs) {
     sample_on_ranks(config, samplers, slots, limit, segs.view_box, finished, consume);
   } else {
     tbb::parallel_pipeline(

@@ -5,6 +5,9 @@
 /// are checked against the bytes left before anything is allocated; a truncated file is an
 /// error, never a shorter or invented mesh. glTF 2.0 (.gltf, .glb), FBX and a few more formats
 /// of the tools artists use are read through Assimp, with the scene graph's nodes as objects.
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <istream>
 #include <functional>
 #include <string>
@@ -21,7 +24,11 @@ namespace viewcells {
 Scene load_scene(const std::string& path, ObjectGrouping grouping = ObjectGrouping::kAuto);
 
 /// The extension of `path` in lower case, with its dot ("" when it has none).
-std::string lower_extension(const std::string& path);
+inline std::string lower_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
 
 /// What becomes an object of a scene read through Assimp.
 enum class AssimpObjects {

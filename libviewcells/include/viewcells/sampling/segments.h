@@ -53,7 +53,7 @@ struct SegmentSet {
 std::vector<size_t> coherent_order(const SegmentSet& s, const Box3& box);
 
 /// What a segment file records besides the segments.
-/// The segment arrays of `s`, as a .vseg file and a message between ranks (core/cluster.h)
+/// The segment arrays of `s`, as a .vseg file and a message between ranks (core/ranks.h)
 /// hold them, and back: get_segments replaces the segments of `s` (its view box stays) and
 /// fails (ByteReader::fail) on arrays of different lengths or more than max_count elements.
 void put_segments(ByteWriter& w, const SegmentSet& s);

@@ -1,4 +1,4 @@
-#include "viewcells/core/cluster.h"
+#include "viewcells/core/ranks.h"
 
 #include <algorithm>
 #include <chrono>
@@ -13,7 +13,7 @@
 #include <mpi.h>
 #endif
 
-namespace viewcells::cluster {
+namespace viewcells::ranks {
 
 namespace {
 
@@ -224,4 +224,4 @@ bool agree(bool value) { return value; }
 #endif
 
 
-}  // namespace viewcells::cluster
+}  // namespace viewcells::ranks

@@ -1,5 +1,5 @@
 #pragma once
-/// The processes of one run on a cluster (MPI ranks, when viewcells is built with
+/// The ranks of one run: the processes on a cluster of machines (MPI ranks, when built with
 /// VIEWCELLS_MPI and started by mpirun or srun), and the few collective operations the stages
 /// need. Without MPI, or when not started by an MPI launcher, there is one process and every
 /// operation is local. No MPI type appears here.
@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-namespace viewcells::cluster {
+namespace viewcells::ranks {
 
 /// While alive, the process is part of the run's ranks: initialises MPI when viewcells was
 /// built with it and an MPI launcher started the process (mpirun, srun), finalises it after.
@@ -69,4 +69,4 @@ struct Traffic {
 };
 const Traffic& traffic();
 
-}  // namespace viewcells::cluster
+}  // namespace viewcells::ranks
