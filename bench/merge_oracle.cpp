@@ -26,7 +26,7 @@
 #include <string>
 #include <vector>
 
-#include "viewcells/bsp/cost_model.h"
+#include "viewcells/scene/cost_model.h"
 #include "viewcells/core/error.h"
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/eval/evaluate.h"

@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "bsp/subdivision_parts.h"
-#include "viewcells/bsp/cost_model.h"
+#include "viewcells/scene/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/scene/scene.h"

@@ -11,7 +11,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "viewcells/bsp/cost_model.h"
+#include "viewcells/scene/cost_model.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/eval/evaluate.h"

@@ -17,7 +17,7 @@
 #include <tuple>
 #include <vector>
 
-#include "viewcells/bsp/cost_model.h"
+#include "viewcells/scene/cost_model.h"
 #include "viewcells/bsp/plane.h"
 #include "viewcells/bsp/polyhedron.h"
 #include "viewcells/sampling/segments.h"

@@ -7,7 +7,7 @@
 #include <memory>
 #include <vector>
 
-#include "viewcells/bsp/cost_model.h"
+#include "viewcells/scene/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/merge/merge.h"
 #include "viewcells/sampling/segments.h"

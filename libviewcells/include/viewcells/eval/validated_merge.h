@@ -29,7 +29,7 @@
 #include <vector>
 
 #include "viewcells/agvs/agvs.h"
-#include "viewcells/bsp/cost_model.h"
+#include "viewcells/scene/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/merge/merge.h"
 #include "viewcells/raycast/ray_caster.h"

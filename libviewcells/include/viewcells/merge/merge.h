@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "viewcells/bsp/cost_model.h"
+#include "viewcells/scene/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/core/vec3.h"
 #include "viewcells/sampling/segments.h"

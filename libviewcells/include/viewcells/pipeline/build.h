@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "viewcells/bsp/cost_model.h"
+#include "viewcells/scene/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/eval/validated_merge.h"

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "viewcells/bsp/cost_model.h"
+#include "viewcells/scene/cost_model.h"
 #include "viewcells/cells/view_cells.h"
 #include "viewcells/eval/frames.h"
 #include "viewcells/pipeline/sampling.h"

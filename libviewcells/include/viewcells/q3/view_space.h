@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "viewcells/bsp/cost_model.h"
+#include "viewcells/scene/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/scene/scene.h"

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "viewcells/bsp/cost_model.h"
+#include "viewcells/scene/cost_model.h"
 #include "viewcells/pvs/pvs.h"
 #include "viewcells/scene/scene.h"
 

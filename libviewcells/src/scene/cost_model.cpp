@@ -1,4 +1,4 @@
-#include "viewcells/bsp/cost_model.h"
+#include "viewcells/scene/cost_model.h"
 
 #include <algorithm>
 #include <cmath>
