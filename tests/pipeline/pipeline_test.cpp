@@ -63,6 +63,70 @@ TEST(Pipeline, BuildWritesWhatItReturnsAndReportsIt) {
   EXPECT_EQ(j["counts"]["valid_segments"], r.sampling.result.stats.valid_segments);
 }
 
+/// A kind of level the pipeline has never seen: viewers in the lower half of the scene's box,
+/// each cell weighing half its volume. Nothing in the pipeline changes for it.
+class LowerHalf final : public ViewSpace {
+ public:
+  explicit LowerHalf(const Box3& bounds) : box_(bounds) { box_.hi.z = 0.5 * (bounds.lo.z + bounds.hi.z); }
+  std::string describe() const override { return "the lower half"; }
+  std::string box_rule() const override { return "the lower half's box"; }
+  void restrict(SamplerConfig& config) const override {
+    const double top = box_.hi.z;
+    config.view_space = [top](const Vec3& p) { return p.z <= top; };
+    if (config.view_box.empty()) config.view_box = box_;
+  }
+  std::function<void(Subdivision&)> weigher(const Box3&) const override {
+    return [](Subdivision& s) {
+      for (BspNode& n : s.nodes) n.weight = 0.5 * n.volume;
+    };
+  }
+  std::string weight_rule() const override { return "half their volume"; }
+
+ protected:
+  CameraSet place_cameras(const Scene&, const RayCaster&, const CameraConfig&,
+                          const std::function<int32_t(const Vec3&)>&, const CellLocator*) const override {
+    return {};
+  }
+
+ private:
+  Box3 box_;
+};
+
+TEST(Pipeline, AViewSpaceOfItsOwnChangesNothingInThePipeline) {
+  pipeline::BuildConfig c = small_build("");
+  c.merge = false;
+  // The scene's own view space (the whole box): cells weigh their volume.
+  const pipeline::BuildResult plain = pipeline::build(c, pipeline::load_scene_for_rays(c.scene, quiet), quiet);
+  const Box3 bounds = plain.sampling.loaded.scene->bounds;
+  for (const BspNode& n : plain.file.subdivision.nodes) EXPECT_DOUBLE_EQ(n.weight, n.volume);
+  EXPECT_EQ(plain.sampling.result.segments.view_box, bounds);
+  // The same build asking another view space: its box, its origins, its weights, its words.
+  pipeline::LoadedScene loaded = pipeline::load_scene_for_rays(c.scene, quiet);
+  const auto lower = std::make_shared<const LowerHalf>(loaded.scene->bounds);
+  loaded.view_space = lower;
+  const pipeline::BuildResult r = pipeline::build(c, std::move(loaded), quiet);
+  Box3 expected = bounds;
+  expected.hi.z = 0.5 * (bounds.lo.z + bounds.hi.z);
+  EXPECT_EQ(r.sampling.result.segments.view_box, expected);
+  for (const BspNode& n : r.file.subdivision.nodes) EXPECT_DOUBLE_EQ(n.weight, 0.5 * n.volume);
+  const auto j = nlohmann::json::parse(pipeline::report_json(r));
+  EXPECT_EQ(j["settings"]["view_space"], "the lower half");
+  EXPECT_EQ(j["settings"]["view_box_source"], "the lower half's box");
+  // It knows no players: play cameras and --play-space are refused, naming it.
+  CameraConfig play;
+  play.placement = CameraPlacement::kPlay;
+  try {
+    lower->check_cameras(play);
+    ADD_FAILURE() << "play cameras accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("the lower half"), std::string::npos) << e.what();
+  }
+  CameraConfig none;
+  none.count = 0;
+  EXPECT_THROW(lower->check_cameras(none), Error);
+  EXPECT_EQ(lower->play_space(*r.sampling.loaded.scene, *r.sampling.loaded.caster), nullptr);
+}
+
 TEST(Pipeline, PlaySpaceNeedsAMapAndIsTheOnlyDensity) {
   pipeline::BuildConfig c = small_build("");
   c.subdivision.play_space = true;
@@ -97,9 +161,8 @@ TEST(Pipeline, PlaySpaceWeighsCellsWherePlayersAreAndAgvsDrawsThere) {
   pipeline::LoadedScene& loaded = r.sampling.loaded;
   const PlaySpace play = q3_play_space(*loaded.map, *loaded.scene, *loaded.caster, PlaySpaceConfig{});
   // The build kept the play space it found, for AGVS to share (a bake finds it once).
-  ASSERT_TRUE(loaded.play);
-  EXPECT_EQ(loaded.play->leaves, play.leaves);
-  const PlaySpace* found = loaded.play.get();
+  const std::shared_ptr<const ViewSpace> found = pipeline::play_view_space(loaded);
+  EXPECT_EQ(found->viewpoint_rule(), play.rule);
   const Subdivision& s = r.file.subdivision;
   double total = 0;
   for (int32_t l : s.leaves()) total += s.nodes[l].weight;
@@ -108,9 +171,9 @@ TEST(Pipeline, PlaySpaceWeighsCellsWherePlayersAreAndAgvsDrawsThere) {
   // AGVS's points: in the play space's leaves, uniform over them by volume (the share in the
   // leaves west of the middle against their share of the volume, within 5 sigma).
   AgvsConfig a;
-  pipeline::use_play_view_space(loaded, a);
+  pipeline::play_view_space(loaded)->restrict(a);
   ASSERT_TRUE(a.view_point_map && a.view_space);
-  EXPECT_EQ(loaded.play.get(), found) << "the play space was found again";
+  EXPECT_EQ(pipeline::play_view_space(loaded), found) << "the play space was found again";
   const Q3Map& map = *loaded.map;
   const Subdivision q3 = q3_subdivision(map, q3_view_box(map));
   const size_t inner = map.nodes.size();

@@ -98,8 +98,7 @@ std::vector<std::vector<uint32_t>> sample_pvs(const BakeConfig& c, LoadedScene& 
                                               const CellLocator& cells, const std::optional<CameraSet>& cams,
                                               BakeResult& out, const Log& log) {
   AgvsConfig agvs = c.agvs;
-  use_map_view_space(loaded.map, agvs);
-  if (c.subdivision.play_space) use_play_view_space(loaded, agvs);
+  (c.subdivision.play_space ? play_view_space(loaded) : loaded.view_space)->restrict(agvs);
   out.agvs_in_view_space = static_cast<bool>(agvs.view_space);
   AgvsSolver solver(*loaded.scene, *loaded.caster, cells, agvs);
   const uint64_t identity = pvs_state_identity(loaded.scene->fingerprint(), pf);
@@ -263,7 +262,7 @@ void frame_sample_rounds(const BakeConfig& c, const LoadedScene& loaded, const C
     CameraConfig sc = c.cameras;
     sc.count = static_cast<uint32_t>(std::min<uint64_t>(sampling_frames * lists.size() / n_active, 10'000'000));
     sc.seed = c.cameras.seed + 0x5a3'0001 + round;
-    const CameraSet drawn = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), sc,
+    const CameraSet drawn = loaded.view_space->cameras(*loaded.scene, *loaded.caster, sc,
                                          [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
                                          &covered_cells);
     rule = drawn.rule;
@@ -305,7 +304,7 @@ void near_object_samples(const BakeConfig& c, const LoadedScene& loaded, const C
   // floors cannot be found), the bake goes on without them and says so.
   CameraSet drawn;
   try {
-    drawn = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), ec,
+    drawn = loaded.view_space->cameras(*loaded.scene, *loaded.caster, ec,
                          [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); }, &covered_cells);
   } catch (const Interrupted&) {
     throw;
@@ -456,9 +455,9 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     check_frame_budget(sampling_frames * std::max(c.frame_rounds, 1u), c.sample_frame.width, c.sample_frame.height);
   const PvsFile sampled = pvs_file_for(file, set);
   const CellLocator cells(sampled.bsp, sampled.leaf_cell, sampled.pvs.cell_count);
-  // The file's cells cover every point of a map's non-solid space (covered_view_box), and the
+  // The file's cells cover every point where a viewer can be (ViewSpace::covered_box), and the
   // cameras are located in them as an engine would.
-  const Box3 written_box = covered_view_box(loaded.map.get(), sampled.bsp.view_box);
+  const Box3 written_box = loaded.view_space->covered_box(sampled.bsp.view_box);
   Subdivision covered_bsp = sampled.bsp;
   covered_bsp.view_box = written_box;
   const CellLocator covered_cells(std::move(covered_bsp), sampled.leaf_cell, sampled.pvs.cell_count);
@@ -467,7 +466,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     Stopwatch sw;
     CameraConfig cc = c.cameras;
     cc.count = c.measure_cameras;
-    cams = draw_cameras(*loaded.scene, *loaded.caster, loaded.map.get(), cc,
+    cams = loaded.view_space->cameras(*loaded.scene, *loaded.caster, cc,
                         [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); }, &covered_cells);
     out.camera_rule = cams->rule;
     log("viewcells: bake: " + std::to_string(cams->cameras.size()) + " measuring cameras (" + cams->rule + ") in " +

@@ -1,8 +1,5 @@
 #include "viewcells/pipeline/build.h"
 
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <optional>
 
@@ -11,8 +8,6 @@
 #include "viewcells/core/progress.h"
 #include "viewcells/eval/validated_merge.h"
 #include "viewcells/merge/merge.h"
-#include "viewcells/q3/play.h"
-#include "viewcells/q3/view_space.h"
 
 namespace viewcells::pipeline {
 
@@ -31,41 +26,7 @@ void write_views(const Subdivision& s, const Scene* scene, const ViewsConfig& vi
 
 namespace {
 
-/// Points drawn in the play space for --play-space.
-constexpr uint32_t kPlayViewpoints = 200000;
-
-/// `count` points uniform in the leaves of `q3` (a q3_subdivision) that weigh something, by
-/// volume: a leaf drawn by weight, a point of its bounds until it lies in the leaf (after 1,000
-/// misses, a leaf that fills under 0.1% of its bounds, the bounds' centre stands for it).
-std::vector<Vec3> uniform_points(const Subdivision& q3, const Q3Map& map, uint32_t count, uint64_t seed) {
-  const int32_t inner = static_cast<int32_t>(map.nodes.size());
-  std::vector<std::pair<double, int32_t>> by_weight;  // (weight so far, leaf)
-  double total = 0;
-  for (int32_t l = 0; l < static_cast<int32_t>(map.leaves.size()); ++l)
-    if (q3.nodes[inner + l].weight > 0) by_weight.emplace_back(total += q3.nodes[inner + l].weight, l);
-  if (by_weight.empty()) throw Error(map.path, 0, "the play space is empty: no leaf a player's eye can be in");
-  std::vector<Vec3> points(count);
-  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, count, 1024), [&](const tbb::blocked_range<uint32_t>& r) {
-    for (uint32_t i = r.begin(); i < r.end(); ++i) {
-      Rng rng(seed, i);
-      const auto it = std::lower_bound(by_weight.begin(), by_weight.end(), std::make_pair(rng.uniform() * total, 0));
-      const int32_t l = (it == by_weight.end() ? by_weight.back() : *it).second;
-      const Box3 b = q3.cells[inner + l].bounds();
-      Vec3 p = b.center();
-      for (int tries = 0; tries < 1000; ++tries) {
-        const Vec3 q{rng.uniform(b.lo.x, b.hi.x), rng.uniform(b.lo.y, b.hi.y), rng.uniform(b.lo.z, b.hi.z)};
-        if (map.leaf_at(q) == l) {
-          p = q;
-          break;
-        }
-      }
-      points[i] = p;
-    }
-  });
-  return points;
-}
-
-/// Subdivides the sampled view space (AV-S), weighting cells by a map's view space (with
+/// Subdivides the sampled view space (AV-S), weighting cells by the scene's view space (with
 /// --play-space, its play space; `play_rule` says what that was).
 Subdivision subdivide_sampled(SamplingRun& s, const CostModel& model, SubdivisionConfig& config,
                               std::string& play_rule, const Log& log) {
@@ -74,28 +35,25 @@ Subdivision subdivide_sampled(SamplingRun& s, const CostModel& model, Subdivisio
   log("viewcells: subdividing to at most " + std::to_string(config.max_cells) + " cells; geometry-aligned candidates " +
       ga_reason);
   log("viewcells: pixel cost term " + model.describe_pixel_term());
-  std::optional<Subdivision> play_q3;
+  // With --play-space, the play space is the division's viewpoint density, and its volume in
+  // each cell the cell's weight afterwards; otherwise the scene's view space weighs the cells.
+  std::shared_ptr<const ViewSpace> space = s.loaded.view_space;
   if (config.play_space) {
-    // The play space's leaves weigh the cells: points uniform in them are the division's
-    // viewpoint density, and their volume in each cell its weight afterwards.
-    const Q3Map& map = *s.loaded.map;
-    const PlaySpace& play = play_space(s.loaded);  // kept there: a bake's AGVS shares it
-    play_q3 = q3_subdivision(map, s.result.segments.view_box);
-    keep_leaf_weights(*play_q3, map, play.leaves);
-    config.viewpoints = std::make_shared<const std::vector<Vec3>>(
-        uniform_points(*play_q3, map, kPlayViewpoints, config.seed + 0x5eed'0001));
-    play_rule = play.rule;
+    space = play_view_space(s.loaded);  // kept by the scene's view space: a bake's AGVS shares it
+    space->set_viewpoints(config, s.result.segments.view_box);
+    play_rule = space->viewpoint_rule();
     log("viewcells: viewpoint density: " + play_rule);
   }
   Subdivision sub = subdivide(*s.loaded.scene, s.result.segments, model, config);
   log("viewcells: " + std::to_string(sub.leaf_count()) + " cells in " + fmt(sub.stats.seconds, 2) +
       " s, render cost " + fmt(sub.initial_cost, 1) + " -> " + fmt(sub.cost(), 1) + " (" + sub.stats.stop_reason +
       ")");
-  if (s.loaded.map && !config.density.enabled) {
-    // p(i) over the map's non-solid (or play) space: merging, extraction and the file use these weights.
-    weight_by_view_space(sub, play_q3 ? *play_q3 : q3_subdivision(*s.loaded.map, sub.view_box));
-    log(std::string("viewcells: cells weighted by their volume in the map's ") +
-        (play_q3 ? "play space" : "non-solid space"));
+  if (!config.density.enabled) {
+    // p(i) over the view space: merging, extraction and the file use these weights.
+    if (const std::function<void(Subdivision&)> weigh = space->weigher(sub.view_box)) {
+      weigh(sub);
+      log("viewcells: cells weighted by " + space->weight_rule());
+    }
   }
   return sub;
 }
@@ -139,9 +97,6 @@ namespace {
 
 /// What the scene must be for the settings, checked before loading and sampling.
 void check_for_scene(const BuildConfig& config) {
-  if (config.subdivision.play_space && !is_q3_map(config.scene.path))
-    throw Error(config.scene.path + ": --play-space needs a Quake 3 map (.bsp): other scenes have no spawn points "
-                "and floors to find it from");
   if (config.subdivision.play_space && config.subdivision.density.enabled)
     throw Error("--play-space and --density-band are two viewpoint densities: give one");
   if (config.subdivision.play_space && !config.sampling.view_box.empty())
@@ -159,6 +114,7 @@ BuildResult build(const BuildConfig& config, const Log& log) {
 BuildResult build(const BuildConfig& config, LoadedScene loaded, const Log& log) {
   config.model.validate();
   check_for_scene(config);
+  if (config.subdivision.play_space) play_view_space(loaded);  // before sampling: Error when there is none
   BuildResult out;
   out.model = config.model;
   out.merge = config.merge;

@@ -10,7 +10,6 @@
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/binary_file.h"
 #include "viewcells/pipeline/report.h"
-#include "viewcells/q3/view_space.h"
 
 namespace viewcells::pipeline {
 
@@ -202,25 +201,20 @@ CompareRunResult compare(const CompareRunConfig& c, const Log& log) {
       throw Error(c.scene.path, 0, "the map has no visibility data: there are no q3map2 clusters to compare with");
     if (config.max_cells == 0) config.max_cells = 3 * static_cast<uint32_t>(out.loaded.map->cluster_count);
   }
-  // On a map the view space is its non-solid space, for both samplers and the cells' weights.
-  std::optional<Subdivision> map_bsp;
-  if (out.loaded.map) {
-    use_map_view_space(out.loaded, config.construction);
+  // The scene's view space (on a map its non-solid space), for both samplers and the cells' weights.
+  out.loaded.view_space->restrict(config.construction);
+  if (config.construction.view_space) {
     config.evaluation.view_space = config.construction.view_space;
     config.evaluation.view_box = config.construction.view_box;
-    if (!with_q3) {
-      map_bsp = q3_subdivision(*out.loaded.map, config.construction.view_box);
-      config.prepare = [&map_bsp](Subdivision& s) { weight_by_view_space(s, *map_bsp); };
-    }
   }
+  if (!with_q3) config.prepare = out.loaded.view_space->weigher(config.construction.view_box);
   log("viewcells: comparing " + method_list + " up to " + std::to_string(config.max_cells) + " cells; " +
       std::to_string(config.construction.samples) + " construction samples (seed " +
       std::to_string(config.construction.seed) + "), " + std::to_string(config.evaluation.samples) +
       " evaluation samples (seed " + std::to_string(config.evaluation.seed) + "); view space " +
-      out.loaded.view_space);
+      out.loaded.view_space->describe());
   if (with_q3) out.q3 = compare_with_q3map2(*out.loaded.scene, *out.loaded.map, *out.loaded.caster, config);
   else out.plain = compare_methods(*out.loaded.scene, *out.loaded.caster, config);
-  config.prepare = nullptr;  // it points at map_bsp, which ends here
   write_curves(out, c.output_dir + "/curves.csv");
   write_histograms(out.comparison(), c.output_dir + "/histogram.csv");
   if (out.q3) write_q3(out, c.output_dir, log);

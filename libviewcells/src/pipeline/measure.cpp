@@ -67,52 +67,6 @@ void frame_costs(const Scene& scene, const GlobalPvs& pvs, const std::vector<int
 
 }  // namespace
 
-CameraSet draw_cameras(const Scene& scene, const RayCaster& caster, const Q3Map* map, const CameraConfig& c,
-                       const std::function<int32_t(const Vec3&)>& cell_at, const CellLocator* locator) {
-  if (c.count == 0) throw Error("measure: the number of cameras must be positive");
-  const CameraPlacement placement =
-      c.placement == CameraPlacement::kAuto ? (map ? CameraPlacement::kPlay : CameraPlacement::kViewBox) : c.placement;
-  if (placement == CameraPlacement::kPlay && !map)
-    throw Error("play cameras need a Quake 3 map (.bsp): players' floors and spawn points come from it");
-  CameraSet out;
-  if (placement == CameraPlacement::kPlay) {
-    PlayCameraConfig pc = c.play;
-    pc.count = c.count;
-    pc.seed = c.seed;
-    PlayCameras play = q3_play_cameras(*map, scene, caster, pc);
-    out.cameras = std::move(play.cameras);
-    out.rule = play.rule;
-    out.points_drawn = play.points_drawn;
-    // A player's eye in no view cell is kept, and measured as a failure (measure_frames: an
-    // engine gets no PVS there): the frame a player would see, not a reason to stop.
-    for (const Camera& cam : out.cameras) out.cells.push_back(cell_at(cam.eye));
-  } else if (map) {
-    // Uniform random points of the map's non-solid space (solid space sees nothing a player could).
-    Rng rng(c.seed, 93);
-    const Box3 box = q3_view_box(*map);
-    const uint64_t max_draws = 100000 + uint64_t{1000} * c.count;
-    while (out.cameras.size() < c.count) {
-      if (++out.points_drawn > max_draws)
-        throw Error(map->path, 0, "measure: too few camera positions in the map's non-solid space");
-      const Vec3 eye{rng.uniform(box.lo.x, box.hi.x), rng.uniform(box.lo.y, box.hi.y), rng.uniform(box.lo.z, box.hi.z)};
-      const Camera cam = camera_looking_anywhere(eye, rng);
-      if (!q3_in_view_space(*map, eye)) continue;
-      const int32_t cell = cell_at(eye);
-      if (cell < 0) continue;
-      out.cameras.push_back(cam);
-      out.cells.push_back(cell);
-    }
-    out.rule = "uniform random points of the map's non-solid space, looking anywhere";
-  } else {
-    if (!locator) throw Error("view-box cameras need the view cells");
-    const bool closed = decide_empty_space(scene, EmptySpaceMode::kAuto).enabled;
-    out.cameras = view_box_cameras(caster, *locator, c.count, c.seed, closed, out.cells);
-    out.rule = std::string("uniform random points of the view box") + (closed ? " outside the solids" : "") +
-               ", looking anywhere";
-  }
-  return out;
-}
-
 MeasureResult measure(const MeasureConfig& c, const Log& log) {
   Stopwatch total;
   check_frame_budget(c.cameras.count, c.frame.width, c.frame.height);  // before any work
@@ -122,10 +76,9 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
   const bool map_scene = is_q3_map(c.scene.path);
   if (c.pvs_path.empty() && !map_scene)
     throw Error("measure needs a .pvs file to measure (only a Quake 3 map brings its own PVS)");
-  if (c.cameras.placement == CameraPlacement::kPlay && !map_scene)
-    throw Error("play cameras need a Quake 3 map (.bsp): players' floors and spawn points come from it");
 
   LoadedScene loaded = load_scene_for_rays(c.scene, log);
+  loaded.view_space->check_cameras(c.cameras);  // before the PVS is read
   const Scene& scene = *loaded.scene;
   Measured m;
   if (!c.pvs_path.empty()) {
@@ -158,7 +111,7 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
   out.pvs_entries = m.pvs.entries();
 
   Stopwatch sw;
-  const CameraSet cams = draw_cameras(scene, *loaded.caster, loaded.map.get(), c.cameras, m.cell_at, m.locator.get());
+  const CameraSet cams = loaded.view_space->cameras(scene, *loaded.caster, c.cameras, m.cell_at, m.locator.get());
   const auto uncovered = std::count(cams.cells.begin(), cams.cells.end(), -1);
   if (uncovered)
     log("viewcells: warning: " + std::to_string(uncovered) + " of " + std::to_string(cams.cameras.size()) +

@@ -111,11 +111,11 @@ void add_references(const PvsConfig& c, const PvsFile& pf, AgvsSolver& solver) {
 
 /// The cameras that measure the pixel error: player eyes on a Quake 3 map, else random points
 /// of the view box (as the estimator's cameras).
-CameraSet measuring_cameras(const PvsConfig& c, const Scenes& s, const Q3Map* map, const CellLocator& cells) {
+CameraSet measuring_cameras(const PvsConfig& c, const Scenes& s, const ViewSpace& space, const CellLocator& cells) {
   CameraConfig cc;
   cc.count = c.measure_cameras;
   cc.seed = c.agvs.seed + 17;
-  return draw_cameras(s.scene, *s.caster, map, cc, [&cells](const Vec3& p) { return cells.cell_at(p); }, &cells);
+  return space.cameras(s.scene, *s.caster, cc, [&cells](const Vec3& p) { return cells.cell_at(p); }, &cells);
 }
 
 FrameConfig measuring_frame(const PvsConfig& c, const PvsResult& out) {
@@ -301,19 +301,19 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
   out.cells = cells.cell_count();
   log("viewcells: " + std::to_string(cells.cell_count()) + " view cells (" + set.rule + "), PVS by " +
       to_string(c.agvs.method) + " until " + describe_stop(c) + ", on " + workers_text());
-  // On a Quake 3 map, AGVS's points are drawn in its non-solid space, and cameras stand where players do.
-  std::shared_ptr<const Q3Map> map;
-  if (is_q3_map(c.scene_path)) map = std::make_shared<const Q3Map>(read_q3bsp(c.scene_path));
-  use_map_view_space(map, out.agvs);
-  // The file's cells cover every point of a map's non-solid space (covered_view_box): the
+  // AGVS's points are drawn in the scene's view space (on a Quake 3 map its non-solid space),
+  // and cameras stand where it places them (on a map, where players do).
+  const std::shared_ptr<const ViewSpace> space = view_space_of(map_of(c.scene_path));
+  space->restrict(out.agvs);
+  // The file's cells cover every point where a viewer can be (ViewSpace::covered_box): the
   // cameras are located in them as an engine would.
-  const Box3 written_box = covered_view_box(map.get(), pf.bsp.view_box);
+  const Box3 written_box = space->covered_box(pf.bsp.view_box);
   Subdivision covered_bsp = pf.bsp;
   covered_bsp.view_box = written_box;
   const CellLocator covered_cells(std::move(covered_bsp), pf.leaf_cell, pf.pvs.cell_count);
   std::optional<CameraSet> cams;
   if (c.measure_cameras) {
-    cams = measuring_cameras(c, scenes, map.get(), covered_cells);
+    cams = measuring_cameras(c, scenes, *space, covered_cells);
     out.camera_rule = cams->rule;
   }
   std::optional<AgvsSolver> solver;

@@ -81,7 +81,7 @@ json sampling_effects(const SamplingRun& s) {
                             " objects are seen through (water, glass, fog): they stop no ray, and every segment "
                             "crossing one sees it"
                       : std::string("every object occludes"))},
-          {"restricted_view_space", effect(static_cast<bool>(s.config.view_space), s.loaded.view_space)}};
+          {"restricted_view_space", effect(static_cast<bool>(s.config.view_space), s.loaded.view_space->describe())}};
 }
 
 json sampling_counts(const SamplingRun& s) {
@@ -122,9 +122,9 @@ json sampling_report(const SamplingRun& s) {
                         {"object_grouping", to_string(s.loaded.scene->grouping)},
                         {"view_box", to_json(st.view_box)},
                         {"view_box_source", st.view_box_from_scene ? "scene bounds"
-                                            : (s.loaded.map && !s.view_box_given ? "the map's non-solid leaves"
-                                                                                 : "user (--view-box)")},
-                        {"view_space", s.loaded.view_space},
+                                            : (!s.view_box_given ? s.loaded.view_space->box_rule()
+                                                                 : std::string("user (--view-box)"))},
+                        {"view_space", s.loaded.view_space->describe()},
                         {"ray_caster", s.loaded.caster->name()},
                         {"max_recasts", c.max_recasts},
                         {"batch_size", c.batch_size}};

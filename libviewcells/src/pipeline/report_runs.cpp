@@ -121,7 +121,7 @@ std::string report_json(const CompareRunResult& r) {
        {{"empty_space_detection", effect(cmp.construction.empty_space.enabled, cmp.construction.empty_space.reason)},
         {"pixel_cost_term", effect(false, "c = 0: the comparison uses r(o) = max(a, b t)")}}},
       {"methods", compare_methods_json(cmp)},
-      {"view_space", r.loaded.view_space},
+      {"view_space", r.loaded.view_space->describe()},
       {"timings",
        {{"load_seconds", r.loaded.load_seconds},
         {"bvh_build_seconds", r.loaded.bvh_seconds},

@@ -5,7 +5,8 @@
 /// from that PVS). Any .pvs file of the scene can be measured, and on a Quake 3 map also the
 /// map's own PVS (q3map2's cluster rows: visible clusters -> their leaves -> their surfaces),
 /// so both sides of a comparison are measured alike. On a map the cameras stand where players
-/// do (q3/play.h); elsewhere at random points of the view box, looking anywhere.
+/// do (the scene's view space places them: eval/view_space.h); elsewhere at random points of
+/// the view box, looking anywhere.
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -16,35 +17,16 @@
 #include "viewcells/cells/view_cells.h"
 #include "viewcells/eval/frames.h"
 #include "viewcells/pipeline/sampling.h"
-#include "viewcells/q3/play.h"
+#include "viewcells/eval/view_space.h"
 
 namespace viewcells::pipeline {
 
-enum class CameraPlacement { kAuto, kPlay, kViewBox };
+// Cameras are the view space's (eval/view_space.h): CameraPlacement, CameraConfig, CameraSet.
+using viewcells::CameraConfig;
+using viewcells::CameraPlacement;
+using viewcells::CameraSet;
 /// Parses "auto", "play", "view-box" (Error otherwise).
 CameraPlacement parse_camera_placement(const std::string& name);
-
-struct CameraConfig {
-  CameraPlacement placement = CameraPlacement::kAuto;  ///< auto: play on a map, view box otherwise
-  uint32_t count = 5000;
-  uint64_t seed = 1;
-  PlayCameraConfig play;  ///< count and seed come from above
-};
-
-/// Cameras for measuring frames, and the view cell of each.
-struct CameraSet {
-  std::vector<Camera> cameras;
-  std::vector<int32_t> cells;
-  std::string rule;  ///< how they were placed, in words
-  uint64_t points_drawn = 0;
-};
-
-/// Draws the cameras (serially: reproducible). `map`: the scene's Quake 3 map or null;
-/// `cell_at`: the view cell of a point (-1: none; a play camera in none keeps cell -1, which
-/// measure_frames counts as a failure); `locator`: the view cells, needed for view-box cameras on scenes
-/// that are not maps.
-CameraSet draw_cameras(const Scene& scene, const RayCaster& caster, const Q3Map* map, const CameraConfig& config,
-                       const std::function<int32_t(const Vec3&)>& cell_at, const CellLocator* locator);
 
 struct MeasureConfig {
   SceneSource scene;

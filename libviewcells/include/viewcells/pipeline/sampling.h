@@ -10,14 +10,11 @@
 #include <string>
 
 #include "viewcells/agvs/agvs.h"
+#include "viewcells/eval/view_space.h"
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
 #include "viewcells/scene/scene.h"
-
-namespace viewcells {
-struct PlaySpace;
-}
 
 namespace viewcells::pipeline {
 
@@ -36,6 +33,12 @@ struct SceneSource {
 /// True for a Quake 3 map (.bsp).
 bool is_q3_map(const std::string& path);
 
+/// What a scene file brings besides its geometry: its Quake 3 map (.bsp; null for other files).
+std::shared_ptr<const Q3Map> map_of(const std::string& path);
+/// The view space a scene brings (eval/view_space.h): a Quake 3 map's (`map` not null), else
+/// the whole view box. The one place that picks a view space by the kind of scene.
+std::shared_ptr<const ViewSpace> view_space_of(const std::shared_ptr<const Q3Map>& map);
+
 /// A scene ready for rays. The scene is held by pointer: the caster refers to it, so it must
 /// not move when the LoadedScene does.
 struct LoadedScene {
@@ -43,33 +46,19 @@ struct LoadedScene {
   std::unique_ptr<const Scene> scene;
   std::unique_ptr<RayCaster> caster;
   std::shared_ptr<const Q3Map> map;  ///< the Quake 3 map, when the scene is one
-  /// The map's play space (q3_play_space with its defaults), once play_space() has found it:
-  /// the division, merging and AGVS of one bake share it.
-  std::shared_ptr<const PlaySpace> play;
+  /// Where viewpoints can be (view_space_of): the pipeline asks it, never the kind of scene. It
+  /// keeps its play space once found, so that the division, merging and AGVS of one bake share it.
+  std::shared_ptr<const ViewSpace> view_space = box_view_space();
   double load_seconds = 0, bvh_seconds = 0;
-  std::string view_space = "the whole view box";  ///< where sample origins are drawn, in words
 };
 
 /// Loads the scene and builds its ray caster.
 LoadedScene load_scene_for_rays(const SceneSource& source, const Log& log);
 
-/// A Quake 3 map's view space is its non-solid space: sample origins are drawn there, and the
-/// view box defaults to the bounds of its non-solid leaves. Nothing for other scenes.
-void use_map_view_space(LoadedScene& loaded, SamplerConfig& config);
-
-/// On a Quake 3 map (`map` not null), AGVS draws its points in the map's non-solid space too.
-void use_map_view_space(const std::shared_ptr<const Q3Map>& map, AgvsConfig& config);
-/// The view box a written .pvs gives its cells: `box`, and on a Quake 3 map (`map` not null)
-/// every point of its non-solid space (q3_cover_box), so that an engine finds a cell wherever
-/// a player can stand. The BSP's cells at the rim reach out to it; nothing else changes.
-Box3 covered_view_box(const Q3Map* map, const Box3& box);
-/// The play space of a Quake 3 map (q3_play_space with its defaults), found the first time
-/// and kept in `loaded.play`. Error for other scenes.
-const PlaySpace& play_space(LoadedScene& loaded);
-
-/// On a Quake 3 map, AGVS draws its points in the play space's leaves (play_space()), so that
-/// its pixel error estimate is that of cameras where players are (with --play-space).
-void use_play_view_space(LoadedScene& loaded, AgvsConfig& config);
+/// The part of the scene's view space where players stand (ViewSpace::play_space: on a Quake 3
+/// map, the leaves a player's eye can reach), found once. Error when the view space knows no
+/// players.
+std::shared_ptr<const ViewSpace> play_view_space(const LoadedScene& loaded);
 
 /// Loading and sampling, with what a report needs.
 struct SamplingRun {

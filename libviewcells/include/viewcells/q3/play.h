@@ -8,23 +8,14 @@
 #include <vector>
 
 #include "viewcells/eval/frames.h"
+#include "viewcells/eval/view_space.h"
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/scene/scene.h"
 
 namespace viewcells {
 
-/// Quake 3's player: a box 56 units tall whose origin is 24 units above its feet, the eye 26
-/// above the origin (DEFAULT_VIEWHEIGHT); floors up to 45.6 degrees steep are walkable
-/// (MIN_WALK_NORMAL 0.7).
-struct PlayCameraConfig {
-  uint32_t count = 5000;
-  uint64_t seed = 1;
-  double eye_height = 50;      ///< above the floor
-  double player_height = 56;   ///< free space needed above the floor
-  double walk_normal = 0.7;    ///< least z of a walkable floor's unit normal
-  double max_pitch_degrees = 30;  ///< pitch uniform in [-max, max], yaw uniform
-};
+/// PlayCameraConfig (eval/view_space.h) holds the player's body: Quake 3's by default.
 
 struct PlayCameras {
   std::vector<Camera> cameras;
