@@ -1,3 +1,5 @@
+/// Neighbouring leaves of the view space BSP, the merge candidates (view-cell-construction paper,
+/// section 4.3).
 #include "viewcells/bsp/adjacency.h"
 
 #include <tbb/parallel_for.h>

@@ -1,3 +1,4 @@
+/// A BSP's planes and view box on disk, shared by .vcells and .pvs.
 #include "viewcells/bsp/bsp_io.h"
 
 #include <cmath>

@@ -1,3 +1,5 @@
+/// Convex polyhedra, the cells of the view space BSP: split by a plane, volume, containment,
+/// clipping (exact sides).
 #include "viewcells/bsp/polyhedron.h"
 
 #include <algorithm>

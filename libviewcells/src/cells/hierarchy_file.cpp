@@ -1,3 +1,5 @@
+/// The built hierarchy on disk (.vcells): planes, nodes, split order, leaf PVSs and the merge
+/// history.
 #include "viewcells/cells/hierarchy_file.h"
 
 #include <algorithm>

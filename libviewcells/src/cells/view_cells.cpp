@@ -1,3 +1,5 @@
+/// Point location: which view cell holds a point, for .pvs files, the AGVS solver and any
+/// subdivision.
 #include "viewcells/cells/view_cells.h"
 
 #include <algorithm>

@@ -1,3 +1,4 @@
+/// The toolkit's versioned, checksummed, zstd-compressed binary container.
 #include "viewcells/core/binary_file.h"
 
 #include "viewcells/core/ranks.h"

@@ -1,3 +1,4 @@
+/// The one exception type for bad input, naming the file and line.
 #include "viewcells/core/error.h"
 
 #include <stdexcept>

@@ -1,3 +1,4 @@
+/// Ctrl-C and SIGTERM as a stop that long loops poll, so that no file is left half written.
 #include "viewcells/core/interrupt.h"
 
 #include <atomic>

@@ -1,3 +1,4 @@
+/// Which Embree instruction set ray casting uses (recorded in every report and file header).
 #include "viewcells/core/isa.h"
 
 #include <cstdlib>

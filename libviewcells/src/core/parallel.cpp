@@ -1,3 +1,4 @@
+/// Thread control: how many cores stages use (never what they compute).
 #include "viewcells/core/parallel.h"
 
 #include <tbb/global_control.h>

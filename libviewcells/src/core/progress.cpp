@@ -1,3 +1,4 @@
+/// Progress bars on stderr for long stages, thread-safe and silent off a terminal.
 #include "viewcells/core/progress.h"
 
 #include "viewcells/core/ranks.h"

@@ -1,3 +1,5 @@
+/// The ranks of a run on a cluster (MPI when built with it, else one process) and their
+/// collectives.
 #include "viewcells/core/ranks.h"
 
 #include <algorithm>

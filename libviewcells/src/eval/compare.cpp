@@ -1,3 +1,4 @@
+/// Construction methods compared on the same samples (view-cell-construction paper, section 6.3).
 #include "viewcells/eval/compare.h"
 
 #include <chrono>

@@ -1,3 +1,5 @@
+/// The evaluator (view-cell-construction paper, section 6.1): c(S) at every cell count from
+/// independent samples.
 #include "viewcells/eval/evaluate.h"
 
 #include <tbb/blocked_range.h>

@@ -1,3 +1,5 @@
+/// `viewcells bake`: sample, subdivide and merge, cut under the budget, AGVS to the error asked
+/// for, write the .pvs (both papers end to end).
 #include "viewcells/pipeline/bake.h"
 
 #include "pipeline/measured_stop.h"

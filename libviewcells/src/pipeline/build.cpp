@@ -1,3 +1,5 @@
+/// `viewcells build`: sample, subdivide (AV-S, paper 4.2), weigh the cells by the view space, merge
+/// (4.3), write the .vcells.
 #include "viewcells/pipeline/build.h"
 
 #include <algorithm>

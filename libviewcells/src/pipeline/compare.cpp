@@ -1,3 +1,5 @@
+/// `viewcells compare`: methods built from the same samples and scored on independent ones
+/// (view-cell-construction paper, section 6).
 #include "viewcells/pipeline/compare.h"
 
 #include <algorithm>

@@ -1,3 +1,5 @@
+/// `viewcells extract` and `compress`: view cells cut from the merge history, and their PVSs
+/// compressed through it (view-cell-construction paper, 5.1-5.2).
 #include "viewcells/pipeline/cut.h"
 
 #include <filesystem>

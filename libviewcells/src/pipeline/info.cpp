@@ -1,3 +1,4 @@
+/// `viewcells info`: what a scene file holds, and on a Quake 3 map what the map brings besides.
 #include "viewcells/pipeline/info.h"
 
 #include "viewcells/io/scene_io.h"

@@ -1,3 +1,5 @@
+/// `viewcells measure`: a shipped PVS measured by frames a viewer sees (render cost and wrong
+/// pixels per camera).
 #include "viewcells/pipeline/measure.h"
 
 #include <algorithm>

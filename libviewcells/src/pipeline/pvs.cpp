@@ -1,3 +1,5 @@
+/// `viewcells pvs`: the view cells' PVSs by AGVS, SGVS or REF (adaptive-global-visibility-sampling
+/// paper), resumable, measured by cameras.
 #include "viewcells/pipeline/pvs.h"
 
 #include "pipeline/measured_stop.h"

@@ -1,3 +1,5 @@
+/// The pipeline's first stages: load a scene with the view space it brings, build its ray caster,
+/// sample visibility segments (paper 4.1).
 #include "viewcells/pipeline/sampling.h"
 
 #include <cctype>

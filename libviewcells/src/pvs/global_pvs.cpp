@@ -1,3 +1,5 @@
+/// Every view cell's PVS at once as bit rows over the objects: what global visibility sampling
+/// fills.
 #include "viewcells/pvs/global_pvs.h"
 
 #include <algorithm>

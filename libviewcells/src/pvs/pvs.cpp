@@ -1,3 +1,5 @@
+/// PVS compression through the view cell hierarchy (view-cell-construction paper, section 5.2) and
+/// the .pvs file.
 #include "viewcells/pvs/pvs.h"
 
 #include <algorithm>

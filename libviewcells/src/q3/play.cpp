@@ -1,3 +1,5 @@
+/// Where players stand on a Quake 3 map: the play space (reachable leaves near walkable floors) and
+/// player cameras.
 #include "viewcells/q3/play.h"
 
 #include <tbb/blocked_range.h>

@@ -1,3 +1,5 @@
+/// A Quake 3 map's non-solid space and its BSP as a Subdivision, so q3map2's clusters are scored as
+/// our cells are.
 #include "viewcells/q3/view_space.h"
 
 #include <tbb/parallel_for.h>

@@ -1,3 +1,4 @@
+/// Visibility segments (view-cell-construction paper, section 4.1) as arrays, and the .vseg file.
 #include "viewcells/sampling/segments.h"
 
 #include <algorithm>

@@ -1,3 +1,5 @@
+/// The render-cost model r(o) = max(a, b t_o, c p_o) and c(S) (view-cell-construction paper,
+/// section 3.3).
 #include "viewcells/scene/cost_model.h"
 
 #include <algorithm>

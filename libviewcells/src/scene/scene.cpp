@@ -1,3 +1,5 @@
+/// The scene: objects from triangles, their bounds, areas and closedness (the precondition of empty
+/// view space detection, paper 4.1).
 #include "viewcells/scene/scene.h"
 
 #include <algorithm>

@@ -1,3 +1,5 @@
+/// Pictures of view cells: a PLY mesh of the cells and a PNG slice, coloured by render cost or
+/// merged cell.
 #include "viewcells/vis/cell_views.h"
 
 #include <png.h>

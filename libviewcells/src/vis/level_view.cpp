@@ -1,3 +1,5 @@
+/// View cells and their PVSs as glTF 2.0 and as the static web page (three.js) for people to look
+/// at.
 #include "viewcells/vis/level_view.h"
 
 #include <algorithm>
