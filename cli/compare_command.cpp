@@ -9,47 +9,28 @@ namespace viewcells::cli {
 
 namespace {
 
+/// `compare`'s options: those that are a field of the run's config bind to `bound`; the scene,
+/// sampling and merge options are shared with other commands, and the method list and the cell
+/// count have defaults that depend on the scene (decided when the command runs).
 struct CompareArgs {
+  pipeline::CompareRunConfig bound;
   SamplingOptions sampling;
   std::string methods = "av-m,av-m-samples,av-s,kd-casm,kd-lasm,kd-vt,kd-vt-star,bsp";
   bool methods_given = false;
   uint32_t max_cells = 1000;
   bool max_cells_given = false;
-  uint64_t eval_samples = 0;
-  uint64_t eval_seed = 0;
-  uint32_t eval_sets = 1;
-  uint32_t histogram_cells = 0;
-  double cost_a = 100, cost_b = 1;
-  bool no_ga = false;
-  uint32_t axis_candidates = 200;
-  bool exact_candidates = false;
-  double min_reduction = 1e-6;
-  uint32_t ga_candidates = 150;
   MergeOptions merge;
-  std::string output;
 };
 
 int run_compare(const CompareArgs& a, const Common& c) {
-  check_files({a.sampling.scene}, {}, {a.output});
+  check_files({a.sampling.scene}, {}, {a.bound.output_dir});
   ThreadLimit threads(c.threads);
-  pipeline::CompareRunConfig config;
+  pipeline::CompareRunConfig config = a.bound;
   config.scene = a.sampling.source();
   if (a.methods_given || !pipeline::is_q3_map(a.sampling.scene)) config.methods = split_list(a.methods);
   config.max_cells = a.max_cells_given ? a.max_cells : 0;
   config.construction = a.sampling.sampler(c);
-  config.evaluation_samples = a.eval_samples;
-  config.evaluation_seed = a.eval_seed;
-  config.evaluation_sets = a.eval_sets;
-  config.histogram_cells = a.histogram_cells;
-  config.model.a = a.cost_a;
-  config.model.b = a.cost_b;
-  config.subdivision.max_axis_candidates = a.axis_candidates;
-  config.subdivision.exact_candidates = a.exact_candidates;
-  config.subdivision.min_reduction = a.min_reduction;
-  config.subdivision.ga_candidates = a.ga_candidates;
-  config.geometry_aligned_off = a.no_ga;
   config.merge_agvs = a.merge.agvs(c, config.construction.seed, config.construction.samples);
-  config.output_dir = a.output;
   pipeline::compare(config, c.logger());
   return 0;
 }
@@ -71,33 +52,33 @@ void add_compare_command(CLI::App& app, const Common& common, Commands& commands
       ->capture_default_str()
       ->check(positive())
       ->each([a](const std::string&) { a->max_cells_given = true; });
-  cm->add_option("--eval-samples", a->eval_samples, "Evaluation samples (default: 4 x --samples)")
+  cm->add_option("--eval-samples", a->bound.evaluation_samples, "Evaluation samples (default: 4 x --samples)")
       ->check(whole(1, kMaxSamples));
-  cm->add_option("--eval-seed", a->eval_seed, "Evaluation seed (default: --seed + 1000003)");
-  cm->add_option("--eval-sets", a->eval_sets,
+  cm->add_option("--eval-seed", a->bound.evaluation_seed, "Evaluation seed (default: --seed + 1000003)");
+  cm->add_option("--eval-sets", a->bound.evaluation_sets,
                  "Independent evaluation sets, each of --eval-samples (set K has seed --eval-seed + K - 1); every "
                  "method is scored on each, in curves.csv's cost and cost_2, cost_3, ... columns. Their "
                  "disagreement is the evaluator's own noise")
       ->capture_default_str()
       ->check(whole(1, 16));
-  cm->add_option("--histogram-cells", a->histogram_cells, "Cell count of the cost histograms (default: --max-cells)");
-  cm->add_option("--cost-a", a->cost_a, "Render cost model: minimum cost of an object")->capture_default_str();
-  cm->add_option("--cost-b", a->cost_b, "Render cost model: cost per triangle")->capture_default_str();
-  cm->add_flag("--no-ga", a->no_ga, "AV-S/AV-M without geometry-aligned candidates");
-  cm->add_option("--axis-candidates", a->axis_candidates, "AV-S/AV-M: axis-aligned positions per axis and cell")
+  cm->add_option("--histogram-cells", a->bound.histogram_cells, "Cell count of the cost histograms (default: --max-cells)");
+  cm->add_option("--cost-a", a->bound.model.a, "Render cost model: minimum cost of an object")->capture_default_str();
+  cm->add_option("--cost-b", a->bound.model.b, "Render cost model: cost per triangle")->capture_default_str();
+  cm->add_flag("--no-ga", a->bound.geometry_aligned_off, "AV-S/AV-M without geometry-aligned candidates");
+  cm->add_option("--axis-candidates", a->bound.subdivision.max_axis_candidates, "AV-S/AV-M: axis-aligned positions per axis and cell")
       ->capture_default_str()
       ->check(positive());
-  cm->add_flag("--exact-candidates", a->exact_candidates, std::string("AV-S/AV-M: ") + kExactCandidatesHelp);
-  cm->add_option("--min-reduction", a->min_reduction,
+  cm->add_flag("--exact-candidates", a->bound.subdivision.exact_candidates, std::string("AV-S/AV-M: ") + kExactCandidatesHelp);
+  cm->add_option("--min-reduction", a->bound.subdivision.min_reduction,
                  "AV-S/AV-M: stop when splits reduce the cost by less than this share of the initial cost for 50 "
                  "splits running (0: always reach --max-cells)")
       ->capture_default_str()
       ->check(non_negative());
-  cm->add_option("--ga-candidates", a->ga_candidates, "AV-S/AV-M: geometry-aligned planes per cell")
+  cm->add_option("--ga-candidates", a->bound.subdivision.ga_candidates, "AV-S/AV-M: geometry-aligned planes per cell")
       ->capture_default_str()
       ->check(positive());
   add_merge_options(cm, a->merge);
-  cm->add_option("-o,--output", a->output, "Directory for curves.csv, histogram.csv, summary.json")->required();
+  cm->add_option("-o,--output", a->bound.output_dir, "Directory for curves.csv, histogram.csv, summary.json")->required();
   commands.push_back({cm, [a, &common] { return run_compare(*a, common); }});
 }
 

@@ -17,24 +17,15 @@ namespace viewcells::cli {
 
 namespace {
 
-/// When AGVS stops, and how it samples.
+/// When AGVS stops, and how it samples: the options bind to `bound`'s fields (its defaults are
+/// the command line's); the method's name is parsed when the command runs.
 struct AgvsOptions {
-  double pixel_error = 0, seconds = 0;
-  uint64_t samples = 0, seed = 1;
-  uint32_t batch = 20000, lanes = 1;
-  double min_share = 0.25;
+  AgvsConfig bound;
   std::string method = "agvs";
 
   AgvsConfig config(const Common& c) const {
-    AgvsConfig a;
+    AgvsConfig a = bound;
     a.method = parse_agvs_method(method);
-    a.seed = seed;
-    a.batch_size = batch;
-    a.mutation_lanes = lanes;
-    a.min_share = min_share;
-    a.max_samples = samples;
-    a.max_seconds = seconds;
-    a.pixel_error = pixel_error;
     a.show_progress = !c.quiet;
     return a;
   }
@@ -42,81 +33,58 @@ struct AgvsOptions {
 
 void add_agvs_options(CLI::App* cmd, AgvsOptions& a, bool with_method, const std::string& samples_name,
                       const std::string& time_name = "--time") {
-  cmd->add_option("--pixel-error", a.pixel_error,
+  cmd->add_option("--pixel-error", a.bound.pixel_error,
                   "Stop when the estimated pixel error (pixels of a 1024x1024 image that differ) is at most this")
       ->check(positive());
-  cmd->add_option(time_name, a.seconds, "Stop AGVS after this many seconds of sampling")->check(positive());
-  cmd->add_option(samples_name, a.samples,
+  cmd->add_option(time_name, a.bound.max_seconds, "Stop AGVS after this many seconds of sampling")->check(positive());
+  cmd->add_option(samples_name, a.bound.max_samples,
                   "Stop after this many AGVS samples (checked between batches: a run may pass it by less than a batch)")
       ->check(whole(1, kMaxSamples));
   if (with_method)
     cmd->add_option("--method", a.method, "agvs (adaptive mixture), sgvs (view space-direction only) or ref (per cell)")
         ->capture_default_str();
-  cmd->add_option("--batch", a.batch, "Samples per batch")->capture_default_str()->check(whole(1, 100'000'000));
-  cmd->add_option("--mutation-lanes", a.lanes,
+  cmd->add_option("--batch", a.bound.batch_size, "Samples per batch")->capture_default_str()->check(whole(1, 100'000'000));
+  cmd->add_option("--mutation-lanes", a.bound.mutation_lanes,
                   "AGVS: independent lanes of mutation candidates, each with its own random stream and its share of "
                   "the buffer. Lanes are drawn and fed in parallel, on a cluster each by its own rank: give at least "
                   "as many as the cores of all nodes for a bake that scales. The result depends on it, not on the "
                   "threads or ranks")
       ->capture_default_str()
       ->check(whole(1, 65536));
-  cmd->add_option("--min-share", a.min_share,
+  cmd->add_option("--min-share", a.bound.min_share,
                   "AGVS: share of every batch kept for view space-direction samples whatever their weight; they are "
                   "the pixel error estimator's camera rays (more: a finer estimate, fewer samples for the mutations)")
       ->capture_default_str()
       ->check(in_range(0.0, 1.0));
 }
 
+/// `pvs`'s options: bound to the fields of `config` (what the library runs), but for the few
+/// that are parsed or shared when the command runs.
 struct PvsArgs {
-  std::string input, scene, output, report, objects = "auto";
-  uint32_t cells = 0;
+  pipeline::PvsConfig config;
+  std::string report, objects = "auto";
   AgvsOptions agvs;
   bool fast = false;
-  uint32_t measure_cameras = 0;
-  uint32_t measure_size = 1024;
-  std::vector<uint64_t> measure_at;
-  double measured_error = 0;
-  std::string save, resume, edited_from;
-  double save_every = 0;
-  std::vector<std::string> references;
-  bool filter = false;
-  double filter_k = 1.0;
-  uint32_t filter_neighbours = 0;
 };
 
-int run_pvs(const PvsArgs& a, const Common& c) {
+int run_pvs(const PvsArgs& args, const Common& c) {
+  const pipeline::PvsConfig& a = args.config;
   {
     // --save may be the --resume state (continue and keep it up to date); nothing else may meet.
     std::error_code ec;
     const bool save_is_resume = !a.save.empty() && !a.resume.empty() &&
                                 (a.save == a.resume || std::filesystem::equivalent(a.save, a.resume, ec));
-    std::vector<std::string> inputs = {a.input, a.scene, a.edited_from, save_is_resume ? "" : a.resume};
+    std::vector<std::string> inputs = {a.hierarchy_path, a.scene_path, a.edited_from, save_is_resume ? "" : a.resume};
     inputs.insert(inputs.end(), a.references.begin(), a.references.end());
-    check_files(inputs, {a.output, a.report, a.save});
+    check_files(inputs, {a.output, args.report, a.save});
   }
   ThreadLimit threads(c.threads);
-  pipeline::PvsConfig config;
-  config.hierarchy_path = a.input;
-  config.scene_path = a.scene;
-  config.grouping = parse_grouping(a.objects);
-  config.robust = !a.fast;
-  config.cells = a.cells;
-  config.agvs = a.agvs.config(c);
-  config.filter.k = a.filter_k;
-  config.filter.view_neighbours = a.filter_neighbours;
-  config.filter_object_space = a.filter;
-  config.measure_cameras = a.measure_cameras;
-  config.measure_size = a.measure_size;
-  config.measure_at = a.measure_at;
-  config.measured_error = a.measured_error;
-  config.save = a.save;
-  config.save_every = a.save_every;
-  config.resume = a.resume;
-  config.edited_from = a.edited_from;
-  config.references = a.references;
-  config.output = a.output;
+  pipeline::PvsConfig config = a;
+  config.grouping = parse_grouping(args.objects);
+  config.robust = !args.fast;
+  config.agvs = args.agvs.config(c);
   const pipeline::PvsResult result = pipeline::compute_pvs(config, c.logger());
-  write_report_to(a.report, result, c);
+  write_report_to(args.report, result, c);
   return 0;
 }
 
@@ -125,82 +93,77 @@ void add_pvs_command(CLI::App& app, const Common& common, Commands& commands) {
   auto* pv = app.add_subcommand("pvs",
                                 "Compute the view cells' PVSs by adaptive global visibility sampling (AGVS) and write "
                                 "them, compressed, as a .pvs file");
-  pv->add_option("cells", a->input, "Hierarchy file (.vcells, built with merging)")->required();
-  pv->add_option("--scene", a->scene, "The scene the hierarchy was built from")->required();
+  pv->add_option("cells", a->config.hierarchy_path, "Hierarchy file (.vcells, built with merging)")->required();
+  pv->add_option("--scene", a->config.scene_path, "The scene the hierarchy was built from")->required();
   pv->add_option("--objects", a->objects, "Object grouping used when building")->capture_default_str();
-  pv->add_option("--cells", a->cells, "View cells cut from the merge history (default: every elementary cell)")
+  pv->add_option("--cells", a->config.cells, "View cells cut from the merge history (default: every elementary cell)")
       ->check(whole(1, kMaxCells));
   add_agvs_options(pv, a->agvs, true, "--samples");
-  pv->add_option("--seed", a->agvs.seed, "Random seed")->capture_default_str();
+  pv->add_option("--seed", a->agvs.bound.seed, "Random seed")->capture_default_str();
   pv->add_flag("--fast", a->fast, "Embree without robust mode");
-  pv->add_option("--measure-cameras", a->measure_cameras,
+  pv->add_option("--measure-cameras", a->config.measure_cameras,
                  "Also measure the pixel error: render this many cameras by ray casting and count the pixels whose "
                  "object is missing from the PVS (cameras at random points of the view box looking anywhere; on a "
                  "Quake 3 map, player eyes above floors reachable from the spawn points, as `measure` places them)")
       ->check(whole(1, 1'000'000));
-  auto* save = pv->add_option("--save", a->save,
+  auto* save = pv->add_option("--save", a->config.save,
                                "Write the solver's state here at the end, to continue later with --resume");
-  pv->add_option("--save-every", a->save_every,
+  pv->add_option("--save-every", a->config.save_every,
                  "With --save: also write the state every this many seconds (a checkpoint a cut-off run resumes "
                  "from, with any number of ranks)")
       ->needs(save)
       ->check(positive());
-  pv->add_option("--resume", a->resume,
+  pv->add_option("--resume", a->config.resume,
                  "Continue from a state written by --save (same scene, cells, method, seed and batch); --samples "
                  "and --time count from the start of the computation, the saved part included");
-  pv->add_flag("--filter", a->filter,
+  pv->add_flag("--filter", a->config.filter_object_space,
                "Write PVSs extended by the object space visibility filter: objects near the PVS's objects, within "
                "a distance that shrinks as the sampling gets denser (sampling itself goes on unfiltered)");
-  pv->add_option("--filter-k", a->filter_k, "The filter's factor k: larger is more conservative")
+  pv->add_option("--filter-k", a->config.filter.k, "The filter's factor k: larger is more conservative")
       ->capture_default_str();
-  pv->add_option("--filter-neighbours", a->filter_neighbours,
+  pv->add_option("--filter-neighbours", a->config.filter.view_neighbours,
                  "View space filter: merge each cell's PVS with those of this many neighbouring cells with the most "
                  "similar PVSs");
-  pv->add_option("--edited-from", a->edited_from,
+  pv->add_option("--edited-from", a->config.edited_from,
                  "Dynamic edit: --scene is an edited version of this scene (the one the hierarchy and the --resume "
                  "state were computed on). Objects are matched by name and geometry; deleted ones leave the PVSs, "
                  "and what inserted ones may hide is removed before sampling resumes");
-  pv->add_option("--reference", a->references,
+  pv->add_option("--reference", a->config.references,
                  "A .pvs of the same cells (another method's result; up to 2): the report's curve counts the "
                  "entries found so far that it has too")
       ->expected(1, AgvsPoint::kReferences)
       ->check(CLI::ExistingFile);
-  pv->add_option("--measure-at", a->measure_at,
+  pv->add_option("--measure-at", a->config.measure_at,
                  "With --measure-cameras: also measure the PVSs after these sample counts (increasing), with the same "
                  "cameras, for a convergence curve by measured error (the report's measured_curve; the solver's "
                  "clock stops while measuring)")
       ->check(whole(1, kMaxSamples));
-  pv->add_option("--measured-error", a->measured_error,
+  pv->add_option("--measured-error", a->config.measured_error,
                  "With --measure-cameras: stop when the measured pixel error (the cameras' mean wrong pixels of "
                  "1024x1024) is at most this. The PVSs are measured after one batch and at every doubling of the "
                  "samples (each measurement in the report's measured_curve), so a run may sample up to twice what "
                  "it needed; other limits still apply")
       ->check(non_negative());
-  pv->add_option("--measure-size", a->measure_size, "Width and height of the measuring cameras, in pixels")
+  pv->add_option("--measure-size", a->config.measure_size, "Width and height of the measuring cameras, in pixels")
       ->capture_default_str()
       ->check(whole(1, 2048));
-  pv->add_option("-o,--output", a->output, "The .pvs file to write")->required();
+  pv->add_option("-o,--output", a->config.output, "The .pvs file to write")->required();
   pv->add_option("--report", a->report, "JSON report: samples, rays, mean PVS size, estimated pixel error, curve");
   commands.push_back({pv, [a, &common] { return run_pvs(*a, common); }});
 }
 
+/// `bake`'s options: those that are a field of the bake's config bind to `bound` (whose defaults
+/// are the command line's); the rest are parsed, shared with other commands, or decide a default
+/// from what else was given, when the command runs (bake_config).
 struct BakeArgs {
+  pipeline::BakeConfig bound;
   SamplingOptions sampling;
   CellOptions cells;
-  uint32_t view_cells = 0;
   std::string memory, memory_of = "file";
   AgvsOptions agvs;
   MergeOptions merge;
-  uint64_t agvs_seed = 1;
-  std::string output, report, work;
-  double checkpoint = 60;
-  double measured_error = 0;
-  uint32_t measure_cameras = 0;
-  double seconds = 0;  ///< --time: the whole bake
+  std::string report;
   std::string holes, measure_size, frame_size = "256x192";
-  uint32_t frame_samples = 0, frame_rounds = 1;
-  uint32_t near_samples = 2048, near_rounds = 4, near_eyes = 512;
-  double near_distance = 0;
 };
 
 /// "1%" or "1" (percent) -> 0.01.
@@ -216,51 +179,38 @@ double parse_percent(const std::string& text, const std::string& option) {
 /// The bake the options ask for, with the command line's defaults (also what bindings that
 /// bake from code run: bake_config_from_args).
 pipeline::BakeConfig bake_config(BakeArgs a, const Common& c) {
-  pipeline::BakeConfig config;
+  pipeline::BakeConfig config = a.bound;
   config.model = a.cells.model();
   config.subdivision = a.cells.subdivision(c, a.sampling);
   config.scene = a.sampling.source();
   config.sampling = a.sampling.sampler(c);
   config.merge_agvs = a.merge.agvs(c, a.sampling.seed, config.sampling.samples);
-  config.cells = a.view_cells;
   config.memory = a.memory.empty() ? 0 : parse_bytes(a.memory);
   if (!a.memory.empty() && config.memory == 0) throw Error("--memory must be above 0 bytes (got '" + a.memory + "')");
   if (a.memory_of != "file" && a.memory_of != "lists") throw Error("--memory-of is file or lists, not '" + a.memory_of + "'");
   config.memory_of_lists = a.memory_of == "lists";
   config.holes = a.holes.empty() ? 0.0 : parse_percent(a.holes, "--holes");
-  if (!a.agvs.samples && !(a.agvs.seconds > 0) && !(a.agvs.pixel_error > 0) && !(a.measured_error > 0) &&
-      !(a.seconds > 0) && !(config.holes > 0))
-    a.agvs.pixel_error = 10;
-  config.max_seconds = a.seconds;
-  config.measured_error = a.measured_error;
+  if (!a.agvs.bound.max_samples && !(a.agvs.bound.max_seconds > 0) && !(a.agvs.bound.pixel_error > 0) &&
+      !(config.measured_error > 0) && !(config.max_seconds > 0) && !(config.holes > 0))
+    a.agvs.bound.pixel_error = 10;
   // Holes are what a player sees at the resolution played: 1,000 frames of 1024x768 by
   // default; a mean error alone keeps 5,000 frames of 64x48 (its estimator's cost).
   const bool by_holes = config.holes > 0;
-  config.measure_cameras =
-      a.measure_cameras ? a.measure_cameras : by_holes ? 1000 : a.measured_error > 0 ? 5000 : 0;
+  if (!config.measure_cameras) config.measure_cameras = by_holes ? 1000 : config.measured_error > 0 ? 5000 : 0;
   if (!a.measure_size.empty()) {
     std::tie(config.frame.width, config.frame.height) = parse_size(a.measure_size, "--measure-size", 2048);
   } else if (by_holes) {
     config.frame.width = 1024;
     config.frame.height = 768;
   }
-  config.frame_samples = a.frame_samples;
-  config.frame_rounds = a.frame_rounds;
   std::tie(config.sample_frame.width, config.sample_frame.height) = parse_size(a.frame_size, "--frame-size", 2048);
-  config.near.rays_per_object = a.near_samples;
-  config.near.rounds = a.near_rounds;
-  config.near.distance = a.near_distance;
-  config.near_eyes = a.near_eyes;
   config.agvs = a.agvs.config(c);
   config.agvs.seed = a.sampling.seed;
-  config.output = a.output;
-  config.work_dir = a.work;
-  config.checkpoint_seconds = a.checkpoint;
   return config;
 }
 
 int run_bake(const BakeArgs& a, const Common& c) {
-  check_files({a.sampling.scene}, {a.output, a.report}, {a.work});
+  check_files({a.sampling.scene}, {a.bound.output, a.report}, {a.bound.work_dir});
   ThreadLimit threads(c.threads);
   const pipeline::BakeConfig config = bake_config(a, c);
   const pipeline::BakeResult result = pipeline::bake(config, c.logger());
@@ -279,7 +229,7 @@ std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, 
       "The whole chain in one command: sample, subdivide and merge, cut view cells under the budget, compute "
       "their PVSs by AGVS to the pixel error asked for, compress and write a .pvs file for the engine");
   add_sampling_options(bk, a->sampling);
-  auto* cells = bk->add_option("--cells", a->view_cells, "Budget: this many view cells")->check(whole(1, kMaxCells));
+  auto* cells = bk->add_option("--cells", a->bound.cells, "Budget: this many view cells")->check(whole(1, kMaxCells));
   bk->add_option("--memory", a->memory,
                  "Budget: a .pvs file of at most this many bytes (K, M, G allowed); the file written is measured, "
                  "and the cells are merged further until it fits")
@@ -295,21 +245,21 @@ std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, 
   add_cell_options(bk, a->cells, "");
   add_merge_options(bk, a->merge);
   add_agvs_options(bk, a->agvs, false, "--agvs-samples", "--agvs-time");
-  bk->add_option("--time", a->seconds,
+  bk->add_option("--time", a->bound.max_seconds,
                  "Bound the whole bake to this many seconds: each of the merge's two AGVS runs stops at a quarter of "
                  "it, the PVSs' AGVS at three quarters of what is left, the near-object samples when it runs out (a "
                  "hierarchy that uses it all up is an error, and with --work is kept for a rerun). --agvs-time bounds "
                  "the PVSs' AGVS alone")
       ->check(positive());
-  bk->add_option("--work", a->work,
+  bk->add_option("--work", a->bound.work_dir,
                  "Work directory: keeps the hierarchy and the AGVS state, so that a rerun with the same scene and "
                  "settings skips the hierarchy and continues sampling (e.g. with a smaller --pixel-error)");
-  bk->add_option("--checkpoint", a->checkpoint,
+  bk->add_option("--checkpoint", a->bound.checkpoint_seconds,
                  "With --work: save the AGVS state this often, in seconds, so that a bake cut off continues from "
                  "there when run again (0: only at the end)")
       ->capture_default_str()
       ->check(non_negative());
-  bk->add_option("--measured-error", a->measured_error,
+  bk->add_option("--measured-error", a->bound.measured_error,
                  "Stop AGVS once cameras measure at most this many wrong pixels per 1024x1024 frame (mean over the "
                  "cameras), instead of trusting the estimate: measured after one batch and at every doubling of the "
                  "samples (a run may sample up to twice what it needed; --time and the other limits still apply)")
@@ -320,18 +270,18 @@ std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, 
                  "(by default 1,000 cameras of 1024x768, placed as `viewcells measure` places them), each "
                  "measurement logged with an estimate of the time left; with --measured-error both must hold; "
                  "--time still bounds the bake");
-  bk->add_option("--frame-samples", a->frame_samples,
+  bk->add_option("--frame-samples", a->bound.frame_samples,
                  "After AGVS, frames as a sampler: this many cameras per view cell on average, placed as measuring "
                  "cameras are (on a Quake 3 map player eyes, pitch within 30 degrees) but from a seed of their own, "
                  "render --frame-size frames, and every object a frame shows joins its cell's PVS (0: none)")
       ->check(whole(0, 100000));
   bk->add_option("--frame-size", a->frame_size, "Frames of --frame-samples, WIDTHxHEIGHT")->capture_default_str();
-  bk->add_option("--frame-rounds", a->frame_rounds,
+  bk->add_option("--frame-rounds", a->bound.frame_rounds,
                  "Rounds of --frame-samples: after the first, only the cells whose frames still added an object get "
                  "about as many frames again")
       ->capture_default_str()
       ->check(whole(1, 64));
-  bk->add_option("--near-samples", a->near_samples,
+  bk->add_option("--near-samples", a->bound.near.rays_per_object,
                  "After AGVS, near-object samples: every view cell tests each object whose box lies within "
                  "--near-distance of an object of its PVS and that it lacks, with this many rays from its viewpoints "
                  "(placed as measuring cameras are, --near-eyes a cell on average, a seed of their own) to random "
@@ -340,31 +290,31 @@ std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, 
                  "cost; at most 2^31 rays in all (fewer a candidate on scenes with more). 0: none")
       ->capture_default_str()
       ->check(whole(0, 4096));
-  bk->add_option("--near-rounds", a->near_rounds,
+  bk->add_option("--near-rounds", a->bound.near.rounds,
                  "Rounds of --near-samples: each round tests the neighbours of what the last one added")
       ->capture_default_str()
       ->check(whole(1, 64));
-  bk->add_option("--near-eyes", a->near_eyes, "Viewpoints a cell has on average for --near-samples")
+  bk->add_option("--near-eyes", a->bound.near_eyes, "Viewpoints a cell has on average for --near-samples")
       ->capture_default_str()
       ->check(whole(1, 100000));
-  bk->add_option("--near-distance", a->near_distance,
+  bk->add_option("--near-distance", a->bound.near.distance,
                  "Objects are neighbours for --near-samples when their boxes are at most this far apart (default "
                  "1/1000 of the scene's bounding box diagonal)")
       ->check(non_negative());
   bk->add_option("--measure-size", a->measure_size,
                  "Frames of the measuring cameras, WIDTHxHEIGHT (default 1024x768 with --holes, else 64x48)");
-  bk->add_option("--measure-cameras", a->measure_cameras,
+  bk->add_option("--measure-cameras", a->bound.measure_cameras,
                  "Cameras that measure the PVSs, placed and counted as `viewcells measure` does (on a Quake 3 map "
                  "player eyes above floors reachable from the spawn points, else random points of the view box; "
                  "64x48 pixels, seed 1): the report gives the written file's measured pixel error (default: 5000 "
                  "with --measured-error, else none)")
       ->check(whole(1, 1'000'000));
-  bk->add_option("-o,--output", a->output, "The .pvs file to write")->required();
+  bk->add_option("-o,--output", a->bound.output, "The .pvs file to write")->required();
   bk->add_option("--report", a->report, "JSON report: budget, cells, file bytes, pixel error, samples, timings");
   bk->footer("Without --pixel-error, --measured-error, --time, --agvs-time or --agvs-samples, AGVS runs to an "
              "estimated pixel error of 10 (of 1024x1024).");
   commands.push_back({bk, [a, &common] {
-                        if (a->view_cells == 0 && a->memory.empty())
+                        if (a->bound.cells == 0 && a->memory.empty())
                           throw Error("bake needs a budget: --cells N or --memory BYTES");
                         return run_bake(*a, common);
                       }});
@@ -373,31 +323,25 @@ std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, 
 
 }  // namespace
 
+/// `measure`'s options, bound to the fields of `config` (the command line's default is 1,000
+/// cameras); the grouping, the placement and robust mode are parsed when it runs.
 struct MeasureArgs {
-  std::string scene, pvs, objects = "auto", cameras = "auto", report;
-  uint32_t count = 1000, width = 1024, height = 768;
-  double fov = 90, cost_a = CostModel{}.a, cost_b = CostModel{}.b, max_pitch = 30;
-  uint64_t seed = 1;
+  pipeline::MeasureConfig config = [] {
+    pipeline::MeasureConfig m;
+    m.cameras.count = 1000;
+    return m;
+  }();
+  std::string objects = "auto", cameras = "auto", report;
   bool fast = false;
 };
 
 int run_measure(const MeasureArgs& a, const Common& c) {
-  check_files({a.scene, a.pvs}, {a.report});
+  check_files({a.config.scene.path, a.config.pvs_path}, {a.report});
   ThreadLimit threads(c.threads);
-  pipeline::MeasureConfig config;
-  config.scene.path = a.scene;
+  pipeline::MeasureConfig config = a.config;
   config.scene.grouping = parse_grouping(a.objects);
   config.scene.robust = !a.fast;
-  config.pvs_path = a.pvs;
   config.cameras.placement = pipeline::parse_camera_placement(a.cameras);
-  config.cameras.count = a.count;
-  config.cameras.seed = a.seed;
-  config.frame.width = a.width;
-  config.frame.height = a.height;
-  config.frame.fov_degrees = a.fov;
-  config.cameras.play.max_pitch_degrees = a.max_pitch;
-  config.model.a = a.cost_a;
-  config.model.b = a.cost_b;
   config.model.validate();
   const pipeline::MeasureResult result = pipeline::measure(config, c.logger());
   write_report_to(a.report, result, c);
@@ -413,28 +357,28 @@ void add_measure_command(CLI::App& app, const Common& common, Commands& commands
       "draws (the PVS of the camera's view cell: render cost, triangles, objects) and the pixels it gets wrong "
       "(objects shown but missing from that PVS). Without a .pvs, a Quake 3 map's own PVS (q3map2's vis rows) is "
       "measured, so both sides of a comparison meet the same cameras");
-  ms->add_option("scene", a->scene, "The scene (a Quake 3 map .bsp, or any scene file)")->required();
-  ms->add_option("pvs", a->pvs, "A .pvs file made for the scene (from bake, pvs or compress)");
+  ms->add_option("scene", a->config.scene.path, "The scene (a Quake 3 map .bsp, or any scene file)")->required();
+  ms->add_option("pvs", a->config.pvs_path, "A .pvs file made for the scene (from bake, pvs or compress)");
   ms->add_option("--objects", a->objects, "Object grouping used when the .pvs file was made")->capture_default_str();
   ms->add_option("--cameras", a->cameras,
                  "Where cameras stand: play (a Quake 3 map: player eyes 50 units above walkable floors reachable "
                  "from the spawn points, any yaw, pitch within --max-pitch), view-box (uniform random points of the "
                  "view space, looking anywhere) or auto (play on a map)")
       ->capture_default_str();
-  ms->add_option("--count", a->count, "Number of cameras")->capture_default_str()->check(whole(1, 10'000'000));
-  ms->add_option("--width", a->width,
+  ms->add_option("--count", a->config.cameras.count, "Number of cameras")->capture_default_str()->check(whole(1, 10'000'000));
+  ms->add_option("--width", a->config.frame.width,
                  "Frame width in pixels (what players see; wrong pixels are reported per 1024x1024 frame whatever "
                  "the size). Cameras x width x height may not exceed 2^32 rays")
       ->capture_default_str()
       ->check(whole(1, 2048));
-  ms->add_option("--height", a->height, "Frame height in pixels")->capture_default_str()->check(whole(1, 2048));
-  ms->add_option("--fov", a->fov, "Horizontal field of view in degrees")->capture_default_str()->check(in_range(1.0, 179.0));
-  ms->add_option("--max-pitch", a->max_pitch, "Play cameras: largest pitch up or down, in degrees")
+  ms->add_option("--height", a->config.frame.height, "Frame height in pixels")->capture_default_str()->check(whole(1, 2048));
+  ms->add_option("--fov", a->config.frame.fov_degrees, "Horizontal field of view in degrees")->capture_default_str()->check(in_range(1.0, 179.0));
+  ms->add_option("--max-pitch", a->config.cameras.play.max_pitch_degrees, "Play cameras: largest pitch up or down, in degrees")
       ->capture_default_str()
       ->check(in_range(0.0, 89.0));
-  ms->add_option("--seed", a->seed, "Random seed of the cameras")->capture_default_str();
-  ms->add_option("--cost-a", a->cost_a, "Render cost model: r = max(a, b * triangles)")->capture_default_str();
-  ms->add_option("--cost-b", a->cost_b, "Render cost model: cost per triangle")->capture_default_str();
+  ms->add_option("--seed", a->config.cameras.seed, "Random seed of the cameras")->capture_default_str();
+  ms->add_option("--cost-a", a->config.model.a, "Render cost model: r = max(a, b * triangles)")->capture_default_str();
+  ms->add_option("--cost-b", a->config.model.b, "Render cost model: cost per triangle")->capture_default_str();
   ms->add_flag("--fast", a->fast, "Embree without robust mode");
   ms->add_option("--report", a->report, "JSON report (default: printed)");
   commands.push_back({ms, [a, &common] { return run_measure(*a, common); }});
@@ -455,7 +399,7 @@ pipeline::BakeConfig bake_config_from_args(const std::vector<std::string>& args,
     throw Error(std::string("bake: ") + e.what());
   }
   check_no_empty_values(*commands.front().app);
-  if (a->view_cells == 0 && a->memory.empty()) throw Error("bake needs a budget: cells or memory");
+  if (a->bound.cells == 0 && a->memory.empty()) throw Error("bake needs a budget: cells or memory");
   return bake_config(*a, common);
 }
 
