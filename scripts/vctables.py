@@ -7,11 +7,13 @@ into the numbers of BENCHMARKS.md and docs/.
 Usage: vctables.py COMMAND ARGS...   (vctables.py --help lists the commands)
 """
 import csv
+import datetime
 import glob
 import json
 import subprocess
 import math
 import os
+import platform
 import re
 import statistics
 import sys
@@ -951,7 +953,7 @@ def maps(*args):
     if failed:
         lines.append("Failed: " + "; ".join(f"{n} ({e})" for n, e in failed) + "\n")
     lines.append("Per map in docs/results/q3-maps.csv.\n")
-    open("docs/results/q3-maps.md", "w").write("\n".join(lines))
+    write_generated("docs/results/q3-maps.md", lines)
 
 
 @command("OUT_DIR PIXEL_ERROR SECONDS")
@@ -1063,7 +1065,7 @@ def shipped(out, err, secs):
     if failed:
         lines.append("Failed: " + "; ".join(f"{n} ({e})" for n, e in failed) + "\n")
     lines.append("Per map in docs/results/q3-shipped.csv.\n")
-    open("docs/results/q3-shipped.md", "w").write("\n".join(lines))
+    write_generated("docs/results/q3-shipped.md", lines)
 
 
 def _measured_points(path):
@@ -1487,21 +1489,107 @@ def shipped_leaf(out, path, err, secs, play=None, *check):
                      f"with the {before} that met it before, {before + met} of {len(table)} maps** (cost at most half of "
                      "q3map2's per frame, median camera at most 1 wrong pixel, lists within the bytes).\n")
     lines.append(f"Per map in docs/results/q3-shipped-{kind}.csv.\n")
-    open(f"docs/results/q3-shipped-{kind}.md", "w").write("\n".join(lines))
+    write_generated(f"docs/results/q3-shipped-{kind}.md", lines)
+
+
+def machine():
+    """This machine in words: its cores and CPU model (from /proc/cpuinfo where there is one)."""
+    model = platform.processor() or platform.machine()
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    return f"{os.cpu_count()} cores, {model}"
+
+
+def provenance(path):
+    """Where a table is made: the date (UTC), the commit of the repository holding PATH (marked
+    when the tree has uncommitted changes) and the machine."""
+    where = os.path.dirname(os.path.abspath(path))
+    def git(*args):
+        return subprocess.run(["git", "-C", where, *args], capture_output=True, text=True).stdout.strip()
+    sha = git("rev-parse", "--short", "HEAD") or "unknown"
+    if git("status", "--porcelain", "--untracked-files=no"):
+        sha += " with uncommitted changes"
+    date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d")
+    return f"Made {date} at commit {sha} on {machine()}."
+
+
+def write_generated(path, lines):
+    """Writes a generated Markdown table file, ending with its command (PATH's .command file, which
+    the scripts that make it write) and the date, commit and machine it was made on."""
+    command_file = os.path.splitext(path)[0] + ".command"
+    cmd = open(command_file).read().strip() if os.path.exists(command_file) else "scripts/vctables.py"
+    open(path, "w").write("\n".join(lines + [f"Command: `{cmd}`. {provenance(path)}\n"]))
 
 
 @command("FILE NAME COMMAND TABLE_FILE")
 def replace_section(path, name, cmd, table_file):
     """Replaces the text between <!-- NAME:begin --> and <!-- NAME:end --> in a Markdown file by
-    "Command: `COMMAND`", a blank line, and the contents of TABLE_FILE."""
+    "Command: `COMMAND`", the date, commit and machine it was made on, a blank line, and the
+    contents of TABLE_FILE."""
     table = open(table_file).read()
     text = open(path).read()
     begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
     if begin not in text or end not in text:
         raise SystemExit(f"vctables: {path} has no {begin} ... {end} section")
-    block = f"{begin}\nCommand: `{cmd}`\n\n{table}{end}"
+    block = f"{begin}\nCommand: `{cmd}`\n{provenance(path)}\n\n{table}{end}"
     text = re.sub(re.escape(begin) + ".*?" + re.escape(end), lambda m: block, text, flags=re.S)
     open(path, "w").write(text)
+
+
+@command("MARKDOWN...")
+def stamp_history(*paths):
+    """Gives every generated section of the files that says no date and commit the newest commit
+    that changed its table rows (or any line, without rows), from git history (machine not
+    recorded): for tables made before sections were stamped (replace-section stamps them since)."""
+    for path in paths:
+        lines = open(path).read().split("\n")
+        where = os.path.dirname(os.path.abspath(path))
+        blame = subprocess.run(["git", "-C", where, "blame", "--line-porcelain", "--", os.path.abspath(path)],
+                               capture_output=True, text=True, check=True).stdout.split("\n")
+        line_commit, info, commit = [], {}, None
+        for b in blame:
+            m = re.match(r"^([0-9a-f]{40}) \d+ \d+", b)
+            if m:
+                commit = m.group(1)
+            elif b.startswith("committer-time "):
+                info[commit] = int(b.split()[1])
+            elif b.startswith("\t"):
+                line_commit.append(commit)
+        out, i = [], 0
+        while i < len(lines):
+            out.append(lines[i])
+            m = re.match(r"^<!-- (\S+):begin -->$", lines[i])
+            if m and i + 1 < len(lines) and lines[i + 1].startswith("Command:") and not (
+                    i + 2 < len(lines) and lines[i + 2].startswith(("Made ", "Recorded "))):
+                j = i + 1
+                while j < len(lines) and lines[j] != f"<!-- {m.group(1)}:end -->":
+                    j += 1
+                # The table's rows date it (prose beside them may have been edited since); else any line.
+                rows = [k for k in range(i + 1, min(j, len(line_commit))) if lines[k].startswith("|")]
+                newest = max(rows or range(i + 1, min(j, len(line_commit))), key=lambda k: info.get(line_commit[k], 0))
+                c = line_commit[newest]
+                date = datetime.datetime.fromtimestamp(info[c], datetime.timezone.utc).strftime("%Y-%m-%d")
+                out.append(lines[i + 1])
+                out.append(f"Recorded {date} in commit {c[:7]} (from git history; the machine was not recorded).")
+                i += 2
+                continue
+            i += 1
+        if not any(re.match(r"^<!-- \S+:begin -->$", l) for l in lines) and not any(
+                l.startswith(("Made ", "Recorded ", "Command: ")) for l in lines):
+            # A whole generated file (docs/results/*.md): one line at its end.
+            rows = [k for k in range(min(len(lines), len(line_commit))) if lines[k].startswith("|")]
+            if rows:
+                c = line_commit[max(rows, key=lambda k: info.get(line_commit[k], 0))]
+                date = datetime.datetime.fromtimestamp(info[c], datetime.timezone.utc).strftime("%Y-%m-%d")
+                while out and out[-1] == "":
+                    out.pop()
+                out += [f"Recorded {date} in commit {c[:7]} (from git history; the machine was not recorded).", ""]
+        open(path, "w").write("\n".join(out))
 
 
 @command("SIDE SAMPLE_JSON BUILD_JSON [PVS_JSON]")

@@ -7,6 +7,7 @@ import io
 import json
 import math
 import os
+import subprocess
 import sys
 import tempfile
 import unittest
@@ -90,9 +91,43 @@ class Tables(unittest.TestCase):
         open(md, "w").write("head\n<!-- x:begin -->\nold\n<!-- x:end -->\ntail\n")
         open(table, "w").write("| new |\n")
         run("replace-section", md, "x", "cmd 1", table)
-        self.assertEqual(open(md).read(), "head\n<!-- x:begin -->\nCommand: `cmd 1`\n\n| new |\n<!-- x:end -->\ntail\n")
+        text = open(md).read()
+        self.assertTrue(text.startswith("head\n<!-- x:begin -->\nCommand: `cmd 1`\nMade "), text)
+        self.assertTrue(text.endswith("\n\n| new |\n<!-- x:end -->\ntail\n"), text)
+        # The date, the commit and the machine it was made on.
+        stamp = text.split("\n")[3]
+        self.assertRegex(stamp, r"^Made \d{4}-\d{2}-\d{2} at commit \S+.* on \d+ cores, .+\.$")
         with self.assertRaises(SystemExit):
             run("replace-section", md, "missing", "c", table)
+
+    def test_stamp_history_dates_unstamped_sections_from_git(self):
+        repo = f"{self.d}/repo"
+        os.makedirs(repo)
+        git = lambda *a: subprocess.run(["git", "-C", repo, *a], check=True, capture_output=True)
+        git("init", "-q")
+        git("config", "user.email", "t@t")
+        git("config", "user.name", "t")
+        md = f"{repo}/b.md"
+        open(md, "w").write("<!-- x:begin -->\nCommand: `c`\n\n| 1 |\n<!-- x:end -->\n"
+                            "<!-- y:begin -->\nCommand: `d`\nMade 2026-01-01 at commit abc on 2 cores, x.\n<!-- y:end -->\n")
+        whole = f"{repo}/w.md"
+        open(whole, "w").write("Some maps.\n\n| a |\n| --- |\n| 1 |\n")
+        git("add", "b.md", "w.md")
+        git("commit", "-q", "-m", "m")
+        sha = subprocess.run(["git", "-C", repo, "rev-parse", "--short=7", "HEAD"], capture_output=True,
+                             text=True).stdout.strip()
+        run("stamp-history", md)
+        lines = open(md).read().split("\n")
+        self.assertRegex(lines[2], rf"^Recorded \d{{4}}-\d{{2}}-\d{{2}} in commit {sha} \(from git history")
+        self.assertEqual(lines[3], "")
+        self.assertEqual(lines.count("Made 2026-01-01 at commit abc on 2 cores, x."), 1)  # stamped already: kept
+        self.assertEqual(sum(l.startswith("Recorded") for l in lines), 1)
+        # A whole generated file gets one line at its end, once.
+        run("stamp-history", whole)
+        run("stamp-history", whole)
+        text = open(whole).read()
+        self.assertEqual(text.count("Recorded "), 1)
+        self.assertRegex(text, rf"\| 1 \|\nRecorded \S+ in commit {sha} ")
 
     def test_sampling_medians_and_ratios_to_half_raw(self):
         for name in ["scene-bounds", "street-band"]:
