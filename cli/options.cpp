@@ -274,8 +274,7 @@ SubdivisionConfig CellOptions::subdivision(const Common& c, const SamplingOption
   config.exact_candidates = exact_candidates;
   config.min_reduction = min_reduction;
   config.density = parse_density_band(density_band);
-  config.play_space = play_space || (play_space_by_default && !no_play_space && density_band.empty() &&
-                                      s.view_box.empty() && pipeline::is_q3_map(s.scene));
+  config.play_space = play_space;
   config.seed = s.seed;
   config.show_progress = !c.quiet;
   return config;

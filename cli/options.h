@@ -110,12 +110,13 @@ struct CellOptions {
   double fov = 90;
   std::string density_band;
   bool play_space = false, no_play_space = false;
-  /// bake: the play space is on for a Quake 3 map unless --no-play-space, --density-band or
-  /// --view-box says otherwise (a map's frames are seen from where players are).
+  /// bake: the play space is on where the scene's view space knows players (a Quake 3 map)
+  /// unless --no-play-space, --density-band or --view-box says otherwise
+  /// (BakeConfig::play_space_where_known).
   bool play_space_by_default = false;
 
   CostModel model() const;
-  /// Seed and scene (for the play space's default) from the sampling options.
+  /// The seed from the sampling options.
   SubdivisionConfig subdivision(const Common& c, const SamplingOptions& s) const;
 };
 /// `max_cells_help` empty: no --max-cells option.

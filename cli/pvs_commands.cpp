@@ -182,6 +182,7 @@ pipeline::BakeConfig bake_config(BakeArgs a, const Common& c) {
   pipeline::BakeConfig config = a.bound;
   config.model = a.cells.model();
   config.subdivision = a.cells.subdivision(c, a.sampling);
+  config.play_space_where_known = a.cells.play_space_by_default && !a.cells.no_play_space;
   config.scene = a.sampling.source();
   config.sampling = a.sampling.sampler(c);
   config.merge_agvs = a.merge.agvs(c, a.sampling.seed, config.sampling.samples);

@@ -432,6 +432,9 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   log("viewcells: bake on " + workers_text());
   const uint32_t max_cells = c.subdivision.max_cells ? c.subdivision.max_cells : (c.cells ? 4 * c.cells : 4096);
   LoadedScene loaded = load_scene_for_rays(c.scene, log);
+  if (c.play_space_where_known && !c.subdivision.density.enabled && c.sampling.view_box.empty() &&
+      loaded.view_space->knows_players())
+    run.subdivision.play_space = out.config.subdivision.play_space = true;
   SubdivisionFile file = hierarchy(run, loaded, max_cells, out, log);
   const MergeHistory& h = *file.history;
   out.hierarchy_seconds = total.seconds();

@@ -24,6 +24,11 @@ struct BakeConfig {
   SamplerConfig sampling;          ///< construction samples
   CostModel model;
   SubdivisionConfig subdivision;   ///< max_cells 0: derived from the budget
+  /// Weigh cells and draw AGVS's points where players are (subdivision.play_space) whenever the
+  /// scene's view space knows them (a Quake 3 map), unless subdivision.density or
+  /// sampling.view_box says where viewers are: the command line's default, since a map's frames
+  /// are seen from where players stand. The report's settings give what was decided.
+  bool play_space_where_known = false;
   std::optional<AgvsConfig> merge_agvs;  ///< as BuildConfig::merge_agvs
   uint32_t cells = 0;              ///< budget: this many view cells ...
   uint64_t memory = 0;             ///< ... or a .pvs file of at most this many bytes
