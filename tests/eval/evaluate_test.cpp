@@ -12,8 +12,8 @@
 #include "viewcells/core/error.h"
 #include "viewcells/eval/compare.h"
 #include "viewcells/eval/evaluate.h"
-#include "viewcells/eval/validated_merge.h"
-#include "eval/validated_merge_choice.h"  // libviewcells/src: the choice inside it
+#include "viewcells/validated/merge.h"
+#include "validated/merge_choice.h"  // libviewcells/src: the choice inside it
 #include "viewcells/merge/merge.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
@@ -366,7 +366,7 @@ TEST(Evaluate, ReportCellCounts) {
 namespace viewcells {
 namespace {
 
-/// The validated merge's chosen history, piece by piece (eval/validated_merge.h): pieces
+/// The validated merge's chosen history, piece by piece (validated/merge.h): pieces
 /// follow one another from the leaves down, each one ends at its barrier, where the written
 /// history's cut is exactly the subdivision's own, and the whole history scores on the held-out
 /// run at least as well as the best single candidate, each count within the allowance.

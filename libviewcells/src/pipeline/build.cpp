@@ -8,7 +8,7 @@
 #include "viewcells/core/format.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/progress.h"
-#include "viewcells/eval/validated_merge.h"
+#include "viewcells/validated/merge.h"
 #include "viewcells/merge/merge.h"
 
 namespace viewcells::pipeline {

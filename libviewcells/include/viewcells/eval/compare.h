@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "viewcells/eval/evaluate.h"
-#include "viewcells/eval/validated_merge.h"
+#include "viewcells/validated/merge.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
 
@@ -34,7 +34,7 @@ struct CompareConfig {
   /// weight_by_view_space, when the view space is not the whole box).
   std::function<void(Subdivision&)> prepare;
   /// AV-M: merging validated by AGVS runs over the leaves with this config
-  /// (eval/validated_merge.h). Unset: AV-M is greedy merging of the leaves on the construction
+  /// (validated/merge.h). Unset: AV-M is greedy merging of the leaves on the construction
   /// samples' PVSs alone, which av-m-samples always is.
   std::optional<AgvsConfig> merge_agvs;
   /// Samples of an evaluation set drawn at a time: each chunk is walked down every tree and

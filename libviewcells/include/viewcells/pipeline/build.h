@@ -9,7 +9,7 @@
 #include "viewcells/scene/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
 #include "viewcells/cells/hierarchy_file.h"
-#include "viewcells/eval/validated_merge.h"
+#include "viewcells/validated/merge.h"
 #include "viewcells/vis/cell_views.h"
 #include "viewcells/pipeline/sampling.h"
 
@@ -34,7 +34,7 @@ struct BuildConfig {
   CostModel model;
   SubdivisionConfig subdivision;
   bool merge = true;
-  /// Merging validated by AGVS runs over the leaves with this config (eval/validated_merge.h);
+  /// Merging validated by AGVS runs over the leaves with this config (validated/merge.h);
   /// unset: greedy merging of the leaves on the construction samples' PVSs.
   std::optional<AgvsConfig> merge_agvs;
   std::string hierarchy_path;  ///< .vcells to write; empty: none

@@ -5,7 +5,7 @@
 /// from that PVS). Any .pvs file of the scene can be measured, and on a Quake 3 map also the
 /// map's own PVS (q3map2's cluster rows: visible clusters -> their leaves -> their surfaces),
 /// so both sides of a comparison are measured alike. On a map the cameras stand where players
-/// do (the scene's view space places them: eval/view_space.h); elsewhere at random points of
+/// do (the scene's view space places them: viewspace/view_space.h); elsewhere at random points of
 /// the view box, looking anywhere.
 #include <cstdint>
 #include <functional>
@@ -17,11 +17,11 @@
 #include "viewcells/cells/view_cells.h"
 #include "viewcells/eval/frames.h"
 #include "viewcells/pipeline/sampling.h"
-#include "viewcells/eval/view_space.h"
+#include "viewcells/viewspace/view_space.h"
 
 namespace viewcells::pipeline {
 
-// Cameras are the view space's (eval/view_space.h): CameraPlacement, CameraConfig, CameraSet.
+// Cameras are the view space's (viewspace/view_space.h): CameraPlacement, CameraConfig, CameraSet.
 using viewcells::CameraConfig;
 using viewcells::CameraPlacement;
 using viewcells::CameraSet;

@@ -10,7 +10,7 @@
 #include <string>
 
 #include "viewcells/agvs/agvs.h"
-#include "viewcells/eval/view_space.h"
+#include "viewcells/viewspace/view_space.h"
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
@@ -35,7 +35,7 @@ bool is_q3_map(const std::string& path);
 
 /// What a scene file brings besides its geometry: its Quake 3 map (.bsp; null for other files).
 std::shared_ptr<const Q3Map> map_of(const std::string& path);
-/// The view space a scene brings (eval/view_space.h): a Quake 3 map's (`map` not null), else
+/// The view space a scene brings (viewspace/view_space.h): a Quake 3 map's (`map` not null), else
 /// the whole view box. The one place that picks a view space by the kind of scene.
 std::shared_ptr<const ViewSpace> view_space_of(const std::shared_ptr<const Q3Map>& map);
 

@@ -8,14 +8,14 @@
 #include <vector>
 
 #include "viewcells/eval/frames.h"
-#include "viewcells/eval/view_space.h"
+#include "viewcells/viewspace/view_space.h"
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/scene/scene.h"
 
 namespace viewcells {
 
-/// PlayCameraConfig (eval/view_space.h) holds the player's body: Quake 3's by default.
+/// PlayCameraConfig (viewspace/view_space.h) holds the player's body: Quake 3's by default.
 
 struct PlayCameras {
   std::vector<Camera> cameras;

@@ -1,6 +1,6 @@
 /// The view space interface's shared part, and the whole view box as a view space
-/// (eval/view_space.h).
-#include "viewcells/eval/view_space.h"
+/// (viewspace/view_space.h).
+#include "viewcells/viewspace/view_space.h"
 
 #include "viewcells/core/error.h"
 

@@ -1,10 +1,10 @@
 #pragma once
-// Inside merge_validated (eval/validated_merge.h): which pieces of the candidate histories it
+// Inside merge_validated (validated/merge.h): which pieces of the candidate histories it
 // takes, and how it walks the held-out samples. Private to the library (the tests see it).
 #include <cstdint>
 #include <vector>
 
-#include "viewcells/eval/validated_merge.h"
+#include "viewcells/validated/merge.h"
 
 namespace viewcells {
 

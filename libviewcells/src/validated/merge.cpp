@@ -1,8 +1,8 @@
 // Merging decided on AGVS's PVSs and started where held-out samples say it pays
-// (eval/validated_merge.h).
-#include "viewcells/eval/validated_merge.h"
+// (validated/merge.h).
+#include "viewcells/validated/merge.h"
 
-#include "eval/validated_merge_choice.h"
+#include "validated/merge_choice.h"
 
 #include <algorithm>
 #include <atomic>
