@@ -11,6 +11,7 @@
 #include <atomic>
 
 #include <cmath>
+#include <limits>
 
 #include "viewcells/core/binary_file.h"
 #include "viewcells/core/ranks.h"
@@ -75,10 +76,14 @@ struct BatchOutput {
 
 class BatchSampler {
  public:
+  /// `beyond`: a distance from any point of the box past which no object lies (for lines of
+  /// sight that see nothing at one end).
   BatchSampler(const RayCaster& caster, const RayCaster* see_through, const Box3& box,
-               const std::function<bool(const Vec3&)>& view_space, bool esd, int max_recasts, double recast_eps)
+               const std::function<bool(const Vec3&)>& view_space, bool esd, int max_recasts, double recast_eps,
+               double beyond)
       : caster_(caster),
         see_through_(see_through),
+        beyond_(beyond),
         box_(box),
         view_space_(view_space),
         esd_(esd),
@@ -112,6 +117,7 @@ class BatchSampler {
   /// Casts the samples in points_, dirs_.
   void cast_drawn(size_t count, SegmentSet& segs, BatchOutput& out, std::vector<Ray>* log) {
     segs_ = &segs;
+    sights_.clear();
     hits_.resize(2 * count);
     caster_.intersect_pairs(points_, dirs_, hits_);
     if (log) {
@@ -174,29 +180,49 @@ class BatchSampler {
     if (see_through_) add_see_through(out);
   }
 
-  /// Every see-through object a segment of this batch crosses is seen from all of it: one
-  /// more segment, the same line with that object at both ends.
+  /// Every see-through object a segment's line of sight crosses is seen from all of the
+  /// segment: one more segment, the same line with that object at both ends. The line of sight
+  /// runs between the objects its ends see (to infinity past an end that sees nothing), also
+  /// where it lies outside the view box: a pane beyond the box is seen through from inside it.
   void add_see_through(BatchOutput& out) {
-    constexpr int kMaxCrossings = 64;
     const size_t primary = out.valid;
     for (size_t i = 0; i < primary; ++i) {
-      const Vec3 a = segs_->a(i), d = segs_->b(i) - a;
+      const Sight& s = sights_[i];
+      // Along the line from its near end: the object seen there, or, when that end sees
+      // nothing, a point beyond every object; in world units along a unit direction (a caller's
+      // directions need not be unit). One scan, as many rays as crossings plus one.
+      const double len = length(s.dir);
+      if (!(len > 0)) continue;
+      const Vec3 u = s.dir / len;
+      const Vec3 a = segs_->a(i);
+      const bool near_hit = std::isfinite(s.t0);
+      const Vec3 start = near_hit ? s.origin + s.dir * s.t0 : a - u * beyond_;
+      const double t_start = near_hit ? s.t0 : dot(start - s.origin, u) / len;  // in units of dir
+      crossings_.clear();
+      // Past each crossing by 1e-7 of the segment's length in the box, as the samplers always stepped.
+      cross(start, u, 0.0, std::isfinite(s.t1) ? (s.t1 - t_start) * len : s.t1, 1e-7 * length(segs_->b(i) - a), out);
+      std::sort(crossings_.begin(), crossings_.end());
       crossed_.clear();
-      double t0 = 0;
-      for (int k = 0; k < kMaxCrossings; ++k) {
-        const Hit h = see_through_->intersect(Ray{a, d, t0, 1.0});
-        ++out.see_through_rays;
-        if (!h.hit()) break;
-        if (std::find(crossed_.begin(), crossed_.end(), h.object) == crossed_.end()) crossed_.push_back(h.object);
-        t0 = h.t + 1e-7;  // t in units of the segment: past this crossing
-        if (!(t0 < 1.0)) break;  // a crossing at the far end: nothing left of the segment
-      }
+      for (const auto& [t, o] : crossings_)
+        if (std::find(crossed_.begin(), crossed_.end(), o) == crossed_.end()) crossed_.push_back(o);
       for (uint32_t o : crossed_) {
         if (out.valid >= segs_->size()) segs_->resize(2 * segs_->size() + 16);
         segs_->set(out.valid++, a, segs_->b(i), o, o, kNoObject, kNoObject);
         if (sample_of_) sample_of_->push_back((*sample_of_)[i]);
         ++out.see_through_segments;
       }
+    }
+  }
+
+  /// Adds to crossings_ (t, object) for the see-through objects that o + t d crosses for t in
+  /// [from, to] (to may be infinite), in order, each `step` past the last: at most 64 crossings.
+  void cross(const Vec3& o, const Vec3& d, double from, double to, double step, BatchOutput& out) {
+    for (int k = 0; k < 64 && from < to; ++k) {
+      const Hit h = see_through_->intersect(Ray{o, d, from, to});
+      ++out.see_through_rays;
+      if (!h.hit()) return;
+      crossings_.emplace_back(h.t, h.object);
+      from = h.t + step;  // past this crossing
     }
   }
 
@@ -219,6 +245,13 @@ class BatchSampler {
     int depth;
     uint32_t sample;  ///< index of the sample in its batch
   };
+  /// A valid segment's whole line of sight, o + t d for t in [t0, t1] (infinite past an end
+  /// that sees nothing), before clipping to the box: where see-through objects are looked for.
+  struct Sight {
+    Vec3 origin, dir;
+    double t0, t1;
+  };
+  std::vector<Sight> sights_;  ///< per valid segment of the batch, when the scene sees through
   uint32_t current_ = 0;                        ///< the sample being emitted
   std::vector<uint32_t>* sample_of_ = nullptr;  ///< when set: the sample of each segment
 
@@ -236,6 +269,7 @@ class BatchSampler {
       if (box_.contains(a, eps_) && box_.contains(b, eps_)) {
         segs_->set(out.valid++, clamp_to_box(a, box_), clamp_to_box(b, box_), o0, o1, tri0, tri1);
         if (sample_of_) sample_of_->push_back(current_);
+        if (see_through_) sights_.push_back({o, d, t0, t1});
         return;
       }
     }
@@ -251,11 +285,14 @@ class BatchSampler {
     const Vec3 b = clamp_to_box(o + d * std::min(t1, c1), box_);
     segs_->set(out.valid++, a, b, o0, o1, tri0, tri1);
     if (sample_of_) sample_of_->push_back(current_);
+    if (see_through_) sights_.push_back({o, d, t0, t1});
   }
 
   const RayCaster& caster_;
   const RayCaster* see_through_;  ///< see-through triangles, or null when the scene has none
+  double beyond_;
   std::vector<uint32_t> crossed_;
+  std::vector<std::pair<double, uint32_t>> crossings_;
   Box3 box_;
   const std::function<bool(const Vec3&)>& view_space_;
   bool esd_;
@@ -273,6 +310,14 @@ class BatchSampler {
 /// Embree's float resolution in its local frame and well below the generators' 2 mm gaps.
 double recast_epsilon(const Scene& scene, const Box3& view_box) {
   return 1e-6 * std::max(scene.bounds.diagonal(), view_box.diagonal());
+}
+
+/// A distance from any point of `box` past which no object of `scene` lies: the diagonal of
+/// both together, and one more unit.
+double beyond(const Scene& scene, const Box3& box) {
+  Box3 all = box;
+  all.extend(scene.bounds);
+  return length(all.extent()) + 1.0;
 }
 
 /// Objects one sees through (water, glass) do not stop rays: where segments cross them is found
@@ -388,7 +433,7 @@ SamplingResult sample_impl(const Scene& scene, const RayCaster& caster, const Sa
   std::unique_ptr<RayCaster> see_through = make_see_through_caster(scene, &stats.see_through_objects);
   tbb::enumerable_thread_specific<BatchSampler> samplers(
       [&] { return BatchSampler(caster, see_through.get(), stats.view_box, config.view_space,
-                                stats.empty_space.enabled, config.max_recasts, eps); });
+                                stats.empty_space.enabled, config.max_recasts, eps, beyond(scene, stats.view_box)); });
   const bool by_segments = config.target_segments > 0;
   Progress progress(by_segments ? "segments" : "sampling", by_segments ? config.target_segments : config.samples);
   const bool show = config.show_progress;
@@ -530,8 +575,8 @@ struct SegmentCaster::Impl {
   Impl(const Scene& scene, const RayCaster& caster, const Box3& box, EmptySpaceMode mode, int max_recasts)
       : see_through(make_see_through_caster(scene, nullptr)),
         esd(decide_empty_space(scene, mode)),
-        samplers([this, &caster, box, max_recasts, eps = recast_epsilon(scene, box)] {
-          return BatchSampler(caster, see_through.get(), box, no_view_space, esd.enabled, max_recasts, eps);
+        samplers([this, &caster, box, max_recasts, eps = recast_epsilon(scene, box), far = beyond(scene, box)] {
+          return BatchSampler(caster, see_through.get(), box, no_view_space, esd.enabled, max_recasts, eps, far);
         }) {}
 };
 
