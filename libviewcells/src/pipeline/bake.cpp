@@ -264,9 +264,9 @@ void frame_sample_rounds(const BakeConfig& c, const LoadedScene& loaded, const C
     CameraConfig sc = c.cameras;
     sc.count = static_cast<uint32_t>(std::min<uint64_t>(sampling_frames * lists.size() / n_active, 10'000'000));
     sc.seed = c.cameras.seed + 0x5a3'0001 + round;
-    const CameraSet drawn = loaded.view_space->cameras(*loaded.scene, *loaded.caster, sc,
-                                         [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
-                                         &covered_cells);
+    const CameraSet drawn = loaded.view_space->cameras(
+        *loaded.scene, *loaded.caster, sc, [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
+        &covered_cells);
     rule = drawn.rule;
     std::vector<Camera> kept;
     std::vector<int32_t> kept_cells;
@@ -307,7 +307,8 @@ void near_object_samples(const BakeConfig& c, const LoadedScene& loaded, const C
   CameraSet drawn;
   try {
     drawn = loaded.view_space->cameras(*loaded.scene, *loaded.caster, ec,
-                         [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); }, &covered_cells);
+                                       [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
+                                       &covered_cells);
   } catch (const Interrupted&) {
     throw;
   } catch (const Error& e) {
@@ -472,7 +473,8 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     CameraConfig cc = c.cameras;
     cc.count = c.measure_cameras;
     cams = loaded.view_space->cameras(*loaded.scene, *loaded.caster, cc,
-                        [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); }, &covered_cells);
+                                      [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
+                                      &covered_cells);
     out.camera_rule = cams->rule;
     log("viewcells: bake: " + std::to_string(cams->cameras.size()) + " measuring cameras (" + cams->rule + ") in " +
         fmt(sw.seconds(), 2) + " s");

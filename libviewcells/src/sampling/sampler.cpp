@@ -198,13 +198,10 @@ class BatchSampler {
       const bool near_hit = std::isfinite(s.t0);
       const Vec3 start = near_hit ? s.origin + s.dir * s.t0 : a - u * beyond_;
       const double t_start = near_hit ? s.t0 : dot(start - s.origin, u) / len;  // in units of dir
-      crossings_.clear();
-      // Past each crossing by 1e-7 of the segment's length in the box, as the samplers always stepped.
-      cross(start, u, 0.0, std::isfinite(s.t1) ? (s.t1 - t_start) * len : s.t1, 1e-7 * length(segs_->b(i) - a), out);
-      std::sort(crossings_.begin(), crossings_.end());
+      // Past each crossing by 1e-7 of the segment's length in the box, as the samplers stepped.
+      const double step = 1e-7 * length(segs_->b(i) - a);
       crossed_.clear();
-      for (const auto& [t, o] : crossings_)
-        if (std::find(crossed_.begin(), crossed_.end(), o) == crossed_.end()) crossed_.push_back(o);
+      cross(start, u, 0.0, std::isfinite(s.t1) ? (s.t1 - t_start) * len : s.t1, step, out);
       for (uint32_t o : crossed_) {
         if (out.valid >= segs_->size()) segs_->resize(2 * segs_->size() + 16);
         segs_->set(out.valid++, a, segs_->b(i), o, o, kNoObject, kNoObject);
@@ -214,14 +211,14 @@ class BatchSampler {
     }
   }
 
-  /// Adds to crossings_ (t, object) for the see-through objects that o + t d crosses for t in
-  /// [from, to] (to may be infinite), in order, each `step` past the last: at most 64 crossings.
+  /// Adds to crossed_, once each and in order, the see-through objects that o + t d crosses for t
+  /// in [from, to] (to may be infinite), each `step` past the last: at most 64 crossings.
   void cross(const Vec3& o, const Vec3& d, double from, double to, double step, BatchOutput& out) {
     for (int k = 0; k < 64 && from < to; ++k) {
       const Hit h = see_through_->intersect(Ray{o, d, from, to});
       ++out.see_through_rays;
       if (!h.hit()) return;
-      crossings_.emplace_back(h.t, h.object);
+      if (std::find(crossed_.begin(), crossed_.end(), h.object) == crossed_.end()) crossed_.push_back(h.object);
       from = h.t + step;  // past this crossing
     }
   }
@@ -292,7 +289,6 @@ class BatchSampler {
   const RayCaster* see_through_;  ///< see-through triangles, or null when the scene has none
   double beyond_;
   std::vector<uint32_t> crossed_;
-  std::vector<std::pair<double, uint32_t>> crossings_;
   Box3 box_;
   const std::function<bool(const Vec3&)>& view_space_;
   bool esd_;
