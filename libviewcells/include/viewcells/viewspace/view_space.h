@@ -4,7 +4,9 @@
 /// pipeline asks a ViewSpace and never which kind of scene it has: a scene's loader picks one
 /// (box_view_space() below, or a Quake 3 map's non-solid space, q3/map_view_space.h), and
 /// --play-space asks it for the part where players stand. A new kind of level (a navmesh, a
-/// street band) is a new implementation of this interface, with no change to the pipeline.
+/// street band) is a new implementation of this interface: the loader's choice
+/// (pipeline::view_space_of) names it, or a caller hands it in LoadedScene::view_space; nothing
+/// else in the pipeline changes.
 #include <cstdint>
 #include <functional>
 #include <memory>
