@@ -46,7 +46,7 @@ def start():
     s = bpy.context.scene.viewcells
     s.cells = 8
     s.time = 0
-    s.extra = "--samples 200000 --max-cells 64 --agvs-samples 3000000"  # a few seconds: several timer ticks
+    s.extra = "--samples 200000 --max-cells 64 --agvs-samples 1000000"  # a second or two: several timer ticks
     s.output = os.path.join(work, "gui.pvs")
     s.gltf = os.path.join(work, "gui-cells.glb")
     window = bpy.context.window_manager.windows[0]

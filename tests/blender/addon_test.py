@@ -221,9 +221,9 @@ bpy.ops.viewcells.bake()
 scene = bpy.context.scene
 scene.render.engine = "CYCLES"
 scene.cycles.device = "CPU"
-scene.cycles.samples = 32
+scene.cycles.samples = 8
 scene.cycles.use_denoising = False
-scene.render.resolution_x, scene.render.resolution_y = 720, 450
+scene.render.resolution_x, scene.render.resolution_y = 480, 300
 scene.render.film_transparent = False
 world = bpy.data.worlds.new("world")
 world.color = (0.9, 0.9, 0.9)
