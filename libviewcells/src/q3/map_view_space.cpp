@@ -86,7 +86,7 @@ class MapViewSpace : public ViewSpace {
   }
 
   std::function<void(Subdivision&)> weigher(const Box3& box) const override {
-    auto q3 = std::make_shared<const Subdivision>(space_subdivision(box));
+    std::shared_ptr<const Subdivision> q3 = subdivision_over(box);
     return [q3](Subdivision& s) { weight_by_view_space(s, *q3); };
   }
   std::string weight_rule() const override { return "their volume in the map's " + space_name(); }
@@ -97,6 +97,16 @@ class MapViewSpace : public ViewSpace {
   /// The map's BSP over `box` with the weights of this space's leaves.
   virtual Subdivision space_subdivision(const Box3& box) const { return q3_subdivision(*map_, box); }
   virtual std::string space_name() const { return "non-solid space"; }
+  /// space_subdivision(box), kept for the last box asked: the division's viewpoints and then its
+  /// weights ask for the same one.
+  std::shared_ptr<const Subdivision> subdivision_over(const Box3& box) const {
+    const std::lock_guard<std::mutex> lock(subdivision_mutex_);
+    if (!subdivision_ || !(subdivision_box_ == box)) {
+      subdivision_ = std::make_shared<const Subdivision>(space_subdivision(box));
+      subdivision_box_ = box;
+    }
+    return subdivision_;
+  }
 
   CameraSet place_cameras(const Scene& scene, const RayCaster& caster, const CameraConfig& c,
                           const std::function<int32_t(const Vec3&)>& cell_at,
@@ -138,6 +148,9 @@ class MapViewSpace : public ViewSpace {
   std::shared_ptr<const Q3Map> map_;
 
  private:
+  mutable std::mutex subdivision_mutex_;
+  mutable std::shared_ptr<const Subdivision> subdivision_;
+  mutable Box3 subdivision_box_;
   mutable std::mutex play_mutex_;
   mutable std::shared_ptr<const ViewSpace> play_;
 };
@@ -193,7 +206,7 @@ class PlayViewSpace final : public MapViewSpace, public std::enable_shared_from_
   void set_viewpoints(SubdivisionConfig& config, const Box3& box) const override {
     // Points uniform in the play leaves are the division's viewpoint density.
     config.viewpoints = std::make_shared<const std::vector<Vec3>>(
-        uniform_points(space_subdivision(box), *map_, kPlayViewpoints, config.seed + 0x5eed'0001));
+        uniform_points(*subdivision_over(box), *map_, kPlayViewpoints, config.seed + 0x5eed'0001));
   }
   std::string viewpoint_rule() const override { return play_->rule; }
 
