@@ -313,7 +313,7 @@ double recast_epsilon(const Scene& scene, const Box3& view_box) {
 double beyond(const Scene& scene, const Box3& box) {
   Box3 all = box;
   all.extend(scene.bounds);
-  return length(all.extent()) + 1.0;
+  return all.diagonal() + 1.0;
 }
 
 /// Objects one sees through (water, glass) do not stop rays: where segments cross them is found
