@@ -291,6 +291,22 @@ std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, 
                  "cost; at most 2^31 rays in all (fewer a candidate on scenes with more). 0: none")
       ->capture_default_str()
       ->check(whole(0, 4096));
+  bk->add_flag("--conservative", a->bound.conservative,
+               "Ship no holes by construction: prove objects hidden through the scene's solid space (a Quake 3 "
+               "map's BSP portals, or a mesh's closed convex solids), and add every (cell, object) pair that is "
+               "neither seen by a ray nor proven hidden to the PVSs, so that no line from any point of a cell "
+               "reaches an object missing from its PVS. Costs more to render than the sampled PVSs (the report's "
+               "hidden.cost_per_frame gives both bounds); an error on a scene that can prove nothing hidden");
+  bk->add_flag("--prove-hidden,!--no-prove-hidden", a->bound.prove_hidden,
+               "Sort every (cell, object) pair into proven visible, proven hidden and undecided, and report the "
+               "classes and the render cost of both bounds (the report's \"hidden\"); the PVSs written are unchanged "
+               "unless --conservative")
+      ->capture_default_str();
+  bk->add_option("--proof-steps", a->bound.hidden_max_steps,
+                 "Portals one flood of the proof may try; a flood over it keeps all it might still reach (never "
+                 "less: only the bound loosens)")
+      ->capture_default_str()
+      ->check(whole(1, 1000000000));
   bk->add_option("--near-rounds", a->bound.near.rounds,
                  "Rounds of --near-samples: each round tests the neighbours of what the last one added")
       ->capture_default_str()

@@ -2,6 +2,7 @@
 /// for, write the .pvs (both papers end to end).
 #include "viewcells/pipeline/bake.h"
 
+#include "pipeline/hidden_classes.h"
 #include "pipeline/measured_stop.h"
 
 #include <algorithm>
@@ -399,6 +400,13 @@ void measure_written(const BakeConfig& c, const LoadedScene& loaded, const Subdi
   }
 }
 
+/// The BSP of the view cells `pf`, over the box the written file covers.
+Subdivision covered_cells_bsp(const PvsFile& pf, const Box3& written_box) {
+  Subdivision s = pf.bsp;
+  s.view_box = written_box;
+  return s;
+}
+
 /// The bake's last line.
 void log_bake(const BakeConfig& c, const BakeResult& out, const Log& log) {
   const double err = out.pixel_error, bound = out.pixel_error_bound;
@@ -433,6 +441,18 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   log("viewcells: bake on " + workers_text());
   const uint32_t max_cells = c.subdivision.max_cells ? c.subdivision.max_cells : (c.cells ? 4 * c.cells : 4096);
   LoadedScene loaded = load_scene_for_rays(c.scene, log);
+  std::shared_ptr<const HiddenSpace> hidden;
+  if (c.prove_hidden || c.conservative) {
+    Stopwatch sw;
+    std::string why;
+    hidden = hidden_space_of(loaded, why);
+    if (!hidden && c.conservative)
+      throw Error(c.scene.path, 0, "--conservative needs a scene that can prove objects hidden: " + why);
+    out.hidden.method = hidden ? hidden->describe() : why;
+    log("viewcells: bake: " + (hidden ? "proving hidden objects with " + out.hidden.method + " (portals in " +
+                                            fmt(sw.seconds(), 1) + " s)"
+                                      : "nothing can be proven hidden: " + why));
+  }
   if (c.play_space_where_known && !c.subdivision.density.enabled && c.sampling.view_box.empty() &&
       loaded.view_space->knows_players())
     run.subdivision.play_space = out.config.subdivision.play_space = true;
@@ -482,6 +502,9 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   std::vector<std::vector<uint32_t>> lists = sample_pvs(run, loaded, sampled, cells, cams, out, log);
   if (c.frame_samples) frame_sample_rounds(c, loaded, covered_cells, sampling_frames, lists, out, log);
   if (c.near.rays_per_object) near_object_samples(c, loaded, covered_cells, total, lists, out, log);
+  if (hidden)
+    out.hidden = prove_hidden_classes(c, loaded, *hidden, covered_cells_bsp(sampled, written_box), sampled.leaf_cell,
+                                      cams, lists, log);
   out.agvs_cells = static_cast<uint32_t>(set.cells.size());
   const Written w = fit_budget(c, file, set, lists, written_box, log);
   if (cams) measure_written(c, loaded, file, set, w, written_box, *cams, out, log);

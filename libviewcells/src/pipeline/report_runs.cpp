@@ -132,6 +132,26 @@ std::string report_json(const CompareRunResult& r) {
   return text(summary);
 }
 
+/// The three answers per (view cell, object) pair (BakeResult::HiddenClasses).
+json hidden_classes(const BakeResult::HiddenClasses& h, const BakeConfig& c) {
+  if (!h.proved)
+    return {{"proved", false},
+            {"reason", h.method.empty() ? std::string("not asked for (--prove-hidden, --conservative)") : h.method}};
+  return {{"proved", true},
+          {"method", h.method},
+          {"warnings", h.warnings},
+          {"conservative", c.conservative},
+          {"pairs", {{"proven_visible", h.visible}, {"proven_hidden", h.hidden}, {"undecided", h.undecided}}},
+          {"seen_but_proven_hidden", h.conflicts},
+          {"cost_per_frame", {{"proven_visible", h.cost_visible}, {"with_undecided", h.cost_conservative},
+                              {"weighed_by", h.weights}}},
+          {"floods", h.floods},
+          {"portal_steps", h.steps},
+          {"floods_over_budget", h.overflows},
+          {"max_steps", c.hidden_max_steps},
+          {"seconds", h.seconds}};
+}
+
 std::string report_json(const BakeResult& r) {
   const BakeConfig& c = r.config;
   const AgvsStats& st = r.agvs;
@@ -217,6 +237,7 @@ std::string report_json(const BakeResult& r) {
                                   {"resolution", c.frame.resolution}}
                            : json(nullptr)},
                {"measured_curve", measured_curve(r.measured_curve)},
+               {"hidden", hidden_classes(r.hidden, c)},
                {"agvs",
                 {{"samples", st.samples},
                  {"rays", st.rays},

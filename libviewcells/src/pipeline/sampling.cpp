@@ -10,6 +10,7 @@
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/io/scene_io.h"
+#include "viewcells/q3/hidden.h"
 #include "viewcells/q3/map_view_space.h"
 #include "viewcells/sampling/segments.h"
 
@@ -27,6 +28,12 @@ std::shared_ptr<const Q3Map> map_of(const std::string& path) {
 
 std::shared_ptr<const ViewSpace> view_space_of(const std::shared_ptr<const Q3Map>& map) {
   return map ? q3_map_view_space(map) : box_view_space();
+}
+
+std::shared_ptr<const HiddenSpace> hidden_space_of(const LoadedScene& loaded, std::string& why) {
+  why.clear();
+  if (loaded.map) return q3_hidden_space(*loaded.map, *loaded.scene);
+  return solid_objects_hidden_space(*loaded.scene, why);
 }
 
 LoadedScene load_scene_for_rays(const SceneSource& source, const Log& log) {

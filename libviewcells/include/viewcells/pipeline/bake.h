@@ -68,6 +68,16 @@ struct BakeConfig {
   /// measuring cameras are, from a seed of their own). rays_per_object 0: none.
   NearSampleConfig near;
   uint32_t near_eyes = 512;
+  /// Prove objects hidden where the scene knows its solid space (a map's BSP, closed convex
+  /// solids): every (view cell, object) pair is then proven visible (a ray saw it), proven
+  /// hidden (no line from the cell reaches it through the portals) or undecided, and the report
+  /// gives the classes and the cost of both bounds.
+  bool prove_hidden = false;
+  /// Ship the undecided pairs too: no line from any point of a cell reaches an object missing
+  /// from its PVS (up to the proof's tolerance), at the conservative bound's cost. Error on a
+  /// scene that can prove nothing hidden (every object would be in every PVS).
+  bool conservative = false;
+  uint64_t hidden_max_steps = 200000;  ///< portals one flood may try before it keeps all it might reach
   std::string output;              ///< .pvs; empty: nothing written (the result is in BakeResult::file)
   std::string work_dir;            ///< empty: nothing kept between runs
   double checkpoint_seconds = 60;  ///< with a work directory: AGVS state saved this often (0: at the end)
@@ -100,6 +110,20 @@ struct BakeResult {
   uint64_t near_eyes = 0;
   double near_seconds = 0;
   std::string near_skipped;  ///< why the near-object samples did not run (no viewpoints), or empty
+  /// The three answers per (view cell, object) pair, for the view cells AGVS sampled.
+  struct HiddenClasses {
+    bool proved = false;
+    std::string method;                ///< what proved, or why nothing could be
+    std::vector<std::string> warnings; ///< a leak, in words
+    uint64_t visible = 0, hidden = 0, undecided = 0;  ///< pairs of rendered objects
+    uint64_t conflicts = 0;  ///< pairs a ray saw that the proof calls hidden (a leak or a crack)
+    /// Render cost per frame of the proven-visible sets (below exact visibility) and of the
+    /// conservative sets (proven visible plus undecided: above it), weighed as `weights` says.
+    double cost_visible = 0, cost_conservative = 0;
+    std::string weights;
+    uint64_t floods = 0, steps = 0, overflows = 0;
+    double seconds = 0;
+  } hidden;
   bool agvs_in_view_space = false;  ///< a Quake 3 map: AGVS drew its points in the non-solid space
   /// The view cells and PVSs baked, as written to `output` (point location, hierarchy,
   /// compressed lists and names): what read_pvs(output) gives, also when nothing was written.

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "viewcells/agvs/agvs.h"
+#include "viewcells/hidden/hidden_space.h"
 #include "viewcells/viewspace/view_space.h"
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/raycast/ray_caster.h"
@@ -51,6 +52,10 @@ struct LoadedScene {
   std::shared_ptr<const ViewSpace> view_space = box_view_space();
   double load_seconds = 0, bvh_seconds = 0;
 };
+
+/// What the scene can prove hidden (hidden/hidden_space.h): a Quake 3 map's BSP, else the
+/// scene's closed convex solids; null, with the reason in `why`, when it can prove nothing.
+std::shared_ptr<const HiddenSpace> hidden_space_of(const LoadedScene& loaded, std::string& why);
 
 /// Loads the scene and builds its ray caster.
 LoadedScene load_scene_for_rays(const SceneSource& source, const Log& log);
