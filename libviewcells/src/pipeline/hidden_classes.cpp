@@ -36,9 +36,12 @@ BakeResult::HiddenClasses prove_hidden_classes(const BakeConfig& c, const Loaded
   const size_t n = lists.size();
   // Each cell as the convex parts of its BSP leaves, over the box the file covers.
   std::vector<std::vector<Polytope>> cells(n);
+  std::vector<double> volume(n, 0);
   clip_to_leaves(bsp, ConvexPolyhedron::box(bsp.view_box, 0), [&](int32_t leaf, const ConvexPolyhedron& part) {
     const int32_t cell = leaf_cell[static_cast<size_t>(leaf)];
-    if (cell >= 0 && static_cast<size_t>(cell) < n) cells[static_cast<size_t>(cell)].push_back(polytope_of(part));
+    if (cell < 0 || static_cast<size_t>(cell) >= n) return;
+    cells[static_cast<size_t>(cell)].push_back(polytope_of(part));
+    volume[static_cast<size_t>(cell)] += part.volume();
   });
   const HiddenProof proof = space.prove(cells, c.hidden_max_steps);
   h.floods = proof.floods;
@@ -53,15 +56,11 @@ BakeResult::HiddenClasses prove_hidden_classes(const BakeConfig& c, const Loaded
       if (cell >= 0 && static_cast<size_t>(cell) < n) weight[static_cast<size_t>(cell)] += 1;
     h.weights = "frames of the " + std::to_string(cams->cameras.size()) + " measuring cameras per cell";
   } else {
-    // Volume of each cell: its BSP leaves' cells.
-    std::vector<double> volume(n, 0);
-    clip_to_leaves(bsp, ConvexPolyhedron::box(bsp.view_box, 0), [&](int32_t leaf, const ConvexPolyhedron& part) {
-      const int32_t cell = leaf_cell[static_cast<size_t>(leaf)];
-      if (cell >= 0 && static_cast<size_t>(cell) < n) volume[static_cast<size_t>(cell)] += part.volume();
-    });
     weight = volume;
     h.weights = "the cells' volumes";
   }
+  uint64_t rendered = 0;
+  for (const ObjectInfo& info : scene.objects) rendered += info.rendered && info.triangle_count ? 1 : 0;
   double total = 0, visible_cost = 0, conservative_cost = 0;
   for (size_t i = 0; i < n; ++i) {
     std::vector<uint32_t>& seen = lists[i];
@@ -82,8 +81,6 @@ BakeResult::HiddenClasses prove_hidden_classes(const BakeConfig& c, const Loaded
         ru += r[o];
         ++undecided_rendered;
       }
-    uint64_t rendered = 0;
-    for (const ObjectInfo& info : scene.objects) rendered += info.rendered && info.triangle_count ? 1 : 0;
     h.visible += seen_rendered;
     h.undecided += undecided_rendered;
     h.hidden += rendered - seen_rendered - undecided_rendered;
