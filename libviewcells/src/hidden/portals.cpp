@@ -226,7 +226,6 @@ struct FloodRun {
       in_chain[static_cast<size_t>(q.to)] = 1;
       recurse(t, q.plane, q.to, depth + 1);
       in_chain[static_cast<size_t>(q.to)] = 0;
-      row = might[depth].data();
     }
   }
 };
@@ -345,7 +344,7 @@ Winding base_winding(const HalfPlane& p, const Box3& box) {
 void PortalGraph::make_portals() {
   const SolidBsp& b = bsp_;
   std::vector<HalfPlane> path;
-  // Iterative walk: (node, depth of path when entered, which child next).
+  // Depth first, `path` holding the half-spaces of the node's region.
   std::function<void(int32_t)> walk = [&](int32_t node) {
     if (node < 0) return;
     throw_if_interrupted("portals");
