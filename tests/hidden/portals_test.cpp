@@ -226,6 +226,30 @@ TEST(Hidden, LeakIsReported) {
   }
 }
 
+// A compiled map keeps its planes as floats: a wall's face can lie a little inside the solid
+// leaf behind its node's plane (q3dm6ish has one 4e-4 units in, and the conservative bake
+// missed it in a frame). A surface within the BSP's surface_slack of a plane is placed on both
+// sides; without the slack the same face is in no empty leaf and called hidden, which is the
+// failure this guards against.
+TEST(Hidden, SurfaceJustBehindItsPlaneIsPlaced) {
+  for (double slack : {0.0, 0.01}) {
+    SolidBsp b;
+    b.planes = {HalfPlane{{1, 0, 0}, 1}};  // x > 1: solid (front), x < 1: empty (back)
+    b.nodes = {SolidBsp::Node{0, {-1, -2}}};
+    b.leaf_solid = {1, 0};
+    b.bounds = box(-1, -1, -1, 2, 2, 2);
+    b.surface_slack = slack;
+    RawMesh m;
+    const double x = 1 + 4e-3;  // the face, facing the empty side, just inside the solid
+    m.vertices = {{x, 0, 0}, {x, 1, 0}, {x, 0, 1}};
+    m.triangles = {{0, 1, 2}};
+    const Scene s = make_scene(std::move(m), ObjectGrouping::kGroups, "poster");
+    const auto space = bsp_hidden_space(b, s, "a wall", {Vec3{0, 0.5, 0.5}});
+    const HiddenProof p = space->prove({{Polytope::box(box(-0.5, 0, 0, 0, 1, 1))}}, 1000);
+    EXPECT_EQ(p.unhidden[0].size(), slack > 0 ? 1u : 0u) << "surface slack " << slack;
+  }
+}
+
 TEST(Hidden, PolytopeClip) {
   const Polytope cube = Polytope::box(box(0, 0, 0, 1, 1, 1));
   const Polytope half = clip_polytope(cube, HalfPlane{{1, 0, 0}, 0.5}, 0);

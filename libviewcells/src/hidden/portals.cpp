@@ -437,7 +437,7 @@ void PortalGraph::split_polygon(const Winding& w, std::vector<std::pair<int32_t,
     if (!bsp_.leaf_solid[static_cast<size_t>(leaf)]) out.emplace_back(leaf, part);
   };
   if (bsp_.nodes.empty()) keep(0, w);
-  else descend(bsp_, 0, w, eps_, keep);
+  else descend(bsp_, 0, w, std::max(eps_, bsp_.surface_slack), keep);
 }
 
 void PortalGraph::split_to_leaves(const Polytope& p, std::vector<std::pair<int32_t, Polytope>>& out) const {

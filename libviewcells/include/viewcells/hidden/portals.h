@@ -32,6 +32,11 @@ struct SolidBsp {
   std::vector<Node> nodes;          ///< node 0 is the root (no nodes: a single leaf 0)
   std::vector<uint8_t> leaf_solid;  ///< per leaf
   Box3 bounds;                      ///< everything of interest lies inside; portals are clipped to it
+  /// How far off a plane of the tree a scene surface lying on that plane may be found: a
+  /// compiled map stores its planes as floats, so its faces lie up to ~1e-3 units off them at
+  /// 4096 units. An object polygon that close to a plane is placed on both sides (always the
+  /// safe way: more leaves hold it). 0: the tree's own tolerance, 1e-7 of its diagonal.
+  double surface_slack = 0;
   size_t leaf_count() const { return leaf_solid.size(); }
   /// The leaf holding p.
   int32_t leaf_at(const Vec3& p) const;
