@@ -68,6 +68,7 @@ std::shared_ptr<const viewcells::Scene> scene_from(const vc_bake_object* objects
     mesh.group_names.push_back(name);
     if (any_see_through) mesh.group_occluder.push_back(o.see_through ? 0 : 1);
   }
+  mesh.keep_group_ids = true;  // bake.h: an object's id is its position in the array
   return std::make_shared<const viewcells::Scene>(
       viewcells::make_scene(std::move(mesh), viewcells::ObjectGrouping::kGroups, kName));
 }

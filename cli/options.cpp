@@ -219,7 +219,9 @@ void add_sampling_options(CLI::App* cmd, SamplingOptions& a) {
   cmd->add_option("--segments", a.segments, "Sample until this many valid segments exist (instead of --samples)")
       ->check(whole(1, kMaxSamples))
       ->excludes(samples_opt);
-  cmd->add_option("--seed", a.seed, "Random seed (same seed, same result for any --threads)")->capture_default_str();
+  cmd->add_option("--seed", a.seed, "Random seed (same seed, same result for any --threads)")
+      ->capture_default_str()
+      ->check(whole(0, UINT64_MAX));
   cmd->add_option("--objects", a.objects, "Object grouping: auto | groups | components | triangles | nodes | meshes (nodes and meshes: glTF, FBX and other formats read through Assimp; auto there means nodes)")
       ->capture_default_str();
   cmd->add_option("--view-box", a.view_box, "View space box xmin,ymin,zmin,xmax,ymax,zmax (default: scene bounds)");

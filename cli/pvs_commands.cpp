@@ -99,7 +99,9 @@ void add_pvs_command(CLI::App& app, const Common& common, Commands& commands) {
   pv->add_option("--cells", a->config.cells, "View cells cut from the merge history (default: every elementary cell)")
       ->check(whole(1, kMaxCells));
   add_agvs_options(pv, a->agvs, true, "--samples");
-  pv->add_option("--seed", a->agvs.bound.seed, "Random seed")->capture_default_str();
+  pv->add_option("--seed", a->agvs.bound.seed, "Random seed")
+      ->capture_default_str()
+      ->check(whole(0, UINT64_MAX));
   pv->add_flag("--fast", a->fast, "Embree without robust mode");
   pv->add_option("--measure-cameras", a->config.measure_cameras,
                  "Also measure the pixel error: render this many cameras by ray casting and count the pixels whose "
@@ -393,7 +395,9 @@ void add_measure_command(CLI::App& app, const Common& common, Commands& commands
   ms->add_option("--max-pitch", a->config.cameras.play.max_pitch_degrees, "Play cameras: largest pitch up or down, in degrees")
       ->capture_default_str()
       ->check(in_range(0.0, 89.0));
-  ms->add_option("--seed", a->config.cameras.seed, "Random seed of the cameras")->capture_default_str();
+  ms->add_option("--seed", a->config.cameras.seed, "Random seed of the cameras")
+      ->capture_default_str()
+      ->check(whole(0, UINT64_MAX));
   ms->add_option("--cost-a", a->config.model.a, "Render cost model: r = max(a, b * triangles)")->capture_default_str();
   ms->add_option("--cost-b", a->config.model.b, "Render cost model: cost per triangle")->capture_default_str();
   ms->add_flag("--fast", a->fast, "Embree without robust mode");
@@ -407,6 +411,18 @@ pipeline::BakeConfig bake_config_from_args(const std::vector<std::string>& args,
   common.quiet = quiet;
   Commands commands;
   const std::shared_ptr<BakeArgs> a = add_bake_command(app, common, commands);
+  CLI::App& bake = *commands.front().app;
+  // Words are checked here, in the caller's order, so that an unknown one is named as given
+  // (CLI11 lists leftovers in the order it took them, last first).
+  for (const std::string& word : args) {
+    if (word.rfind("--", 0) != 0) continue;
+    const std::string name = word.substr(0, word.find('='));
+    if (name == "--help")
+      throw Error("bake: help is not an option of a bake from code; the options are viewcells bake's:\n" +
+                  bake.help("", CLI::AppFormatMode::Sub));
+    if (!bake.get_option_no_throw(name))
+      throw Error("bake: unknown option " + name + " (the options are those of `viewcells bake --help`)");
+  }
   std::vector<std::string> reversed = {"bake"};
   reversed.insert(reversed.end(), args.begin(), args.end());
   std::reverse(reversed.begin(), reversed.end());  // CLI11 takes a vector last argument first

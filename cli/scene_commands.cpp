@@ -115,7 +115,9 @@ void add_scene_commands(CLI::App& app, const Common& common, Commands& commands)
   auto gen = std::make_shared<GenerateArgs>();
   auto* g = app.add_subcommand("generate", "Write a generated test scene as OBJ (one group per object)");
   g->add_option("kind", gen->kind, "office | city | rotated-office | town (a city that is not a grid: districts with streets at their own angles, open squares, landmark towers) | glass-city (the city with glass curtain walls and pools of water: see-through surfaces, written with a .mtl beside the .obj)")->required();
-  g->add_option("--seed", gen->seed, "Random seed (same seed, same scene)")->capture_default_str();
+  g->add_option("--seed", gen->seed, "Random seed (same seed, same scene)")
+      ->capture_default_str()
+      ->check(whole(0, UINT64_MAX));
   g->add_option("--size", gen->size,
                 "Scale >= 1: office rooms and floors, city blocks per side (city 20 ~ 1M triangles)")
       ->capture_default_str();

@@ -11,13 +11,20 @@
 // so its defaults and checks are exactly `viewcells bake`'s; the scene then comes from memory
 // (pipeline::SceneSource::scene) when it is a Scene. Errors are viewcells.Error carrying the
 // library's message.
+// Type errors name the argument and the type given, not only "Unable to cast".
+#define PYBIND11_DETAILED_ERROR_MESSAGES
 #include <pybind11/functional.h>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <chrono>
+#include <condition_variable>
+#include <filesystem>
 #include <iterator>
+#include <mutex>
+#include <thread>
 #include <memory>
 #include <optional>
 #include <string>
@@ -25,7 +32,9 @@
 
 #include "commands.h"
 #include "viewcells/cells/view_cells.h"
+#include "viewcells/core/binary_file.h"
 #include "viewcells/core/error.h"
+#include "viewcells/core/interrupt.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pipeline/bake.h"
 #include "viewcells/pipeline/report.h"
@@ -41,22 +50,49 @@ namespace {
 /// A scene from arrays: vertices (N x 3, float64), triangles (M x 3, integer indices), per
 /// triangle its object (M; default: one object), object names, and which objects are seen
 /// through (glass, water: in PVSs, hiding nothing).
+using Indices = py::array_t<int64_t, py::array::c_style | py::array::forcecast>;
+
+/// An array of indices as int64, refusing values a cast would change (2.9, NaN, 1e30): numpy
+/// would truncate them silently.
+Indices whole_numbers(const py::object& values, const std::string& scene, const std::string& what) {
+  py::array a = py::array::ensure(values);
+  if (!a) throw Error(scene, 0, what + " must be an array of integers");
+  const char kind = a.dtype().kind();
+  if (kind == 'f') {
+    const py::array_t<double, py::array::c_style | py::array::forcecast> d(a);
+    const double* v = d.data();
+    for (py::ssize_t i = 0; i < d.size(); ++i)
+      if (!(v[i] == std::floor(v[i]) && std::abs(v[i]) < 9.0e15))
+        throw Error(scene, 0, what + " must be whole numbers: entry " + std::to_string(i) + " is " + py::str(py::float_(v[i])).cast<std::string>());
+  } else if (kind != 'i' && kind != 'u' && kind != 'b') {
+    throw Error(scene, 0, what + " must be an array of integers, not of dtype " + py::str(a.dtype()).cast<std::string>());
+  }
+  return Indices(a);
+}
+
 std::shared_ptr<const Scene> scene_from_arrays(py::array_t<double, py::array::c_style | py::array::forcecast> vertices,
-                                               py::array_t<int64_t, py::array::c_style | py::array::forcecast> triangles,
-                                               std::optional<py::array_t<int64_t, py::array::c_style | py::array::forcecast>> objects,
+                                               const py::object& triangle_values, const py::object& object_values,
                                                std::optional<std::vector<std::string>> names,
                                                std::optional<std::vector<bool>> see_through, const std::string& name) {
   if (vertices.ndim() != 2 || vertices.shape(1) != 3) throw Error(name, 0, "vertices must be an array of shape (N, 3)");
+  const Indices triangles = whole_numbers(triangle_values, name, "triangles");
   if (triangles.ndim() != 2 || triangles.shape(1) != 3) throw Error(name, 0, "triangles must be an array of shape (M, 3)");
+  std::optional<Indices> objects;
+  if (!object_values.is_none()) objects = whole_numbers(object_values, name, "objects");
   RawMesh mesh;
   const auto v = vertices.unchecked<2>();
-  for (py::ssize_t i = 0; i < v.shape(0); ++i) mesh.vertices.push_back({v(i, 0), v(i, 1), v(i, 2)});
+  for (py::ssize_t i = 0; i < v.shape(0); ++i) {
+    mesh.vertices.push_back({v(i, 0), v(i, 1), v(i, 2)});
+    if (!is_finite(mesh.vertices.back()))
+      throw Error(name, 0, "vertex " + std::to_string(i) + " (counting from 0) has a NaN or infinite coordinate");
+  }
   const auto t = triangles.unchecked<2>();
   for (py::ssize_t i = 0; i < t.shape(0); ++i) {
     std::array<uint32_t, 3> tri{};
     for (int k = 0; k < 3; ++k) {
       if (t(i, k) < 0 || t(i, k) >= v.shape(0))
-        throw Error(name, 0, "triangle " + std::to_string(i) + " has a vertex index out of range");
+        throw Error(name, 0, "triangle " + std::to_string(i) + " (counting from 0) has vertex index " +
+                                 std::to_string(t(i, k)) + ", not from 0 to " + std::to_string(v.shape(0) - 1));
       tri[k] = static_cast<uint32_t>(t(i, k));
     }
     mesh.triangles.push_back(tri);
@@ -83,26 +119,39 @@ std::shared_ptr<const Scene> scene_from_arrays(py::array_t<double, py::array::c_
       throw Error(name, 0, "see_through must give a flag for every object (" + std::to_string(groups) + ")");
     for (bool s : *see_through) mesh.group_occluder.push_back(s ? 0 : 1);
   }
+  mesh.keep_group_ids = true;  // the PVSs list the caller's object ids, also past an empty one
   return std::make_shared<const Scene>(make_scene(std::move(mesh), ObjectGrouping::kGroups, name));
 }
 
-/// A keyword argument as command-line words: cells=100 -> --cells 100, no_ga=True -> --no-ga,
-/// a list -> the option once with every value.
+/// A keyword argument as command-line words: cells=100 -> --cells 100, no_ga=True ->
+/// --no-ga=true (so that True given to an option that wants a number is refused by name), a
+/// list -> the option once with every value.
 void add_option(std::vector<std::string>& args, const std::string& key, const py::handle& value) {
   std::string option = "--" + key;
   for (char& c : option)
     if (c == '_') c = '-';
+  if (value.is_none()) return;
   if (py::isinstance<py::bool_>(value)) {
-    if (value.cast<bool>()) args.push_back(option);
+    args.push_back(option + (value.cast<bool>() ? "=true" : "=false"));
     return;
   }
-  if (value.is_none()) return;
   args.push_back(option);
   if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
     for (const py::handle& item : value) args.push_back(py::str(item));
     return;
   }
   args.push_back(py::str(value));
+}
+
+/// A path given as str or os.PathLike (pathlib.Path); TypeError otherwise.
+std::string path_of(const py::handle& value, const char* what) {
+  if (py::isinstance<py::str>(value)) return value.cast<std::string>();
+  if (py::hasattr(value, "__fspath__")) {
+    const py::object p = py::module_::import("os").attr("fspath")(value);
+    if (py::isinstance<py::str>(p)) return p.cast<std::string>();
+  }
+  throw py::type_error(std::string(what) + " must be a path (str or os.PathLike), not " +
+                       py::str(py::type::of(value).attr("__name__")).cast<std::string>());
 }
 
 /// A .pvs file read back: the view cells (their point location, bounds, convex pieces and
@@ -258,15 +307,43 @@ struct Baked {
     const std::vector<double>& c = level_view().cell_cost;
     return py::array_t<double>(static_cast<py::ssize_t>(c.size()), c.data());
   }
-  void write_gltf(const std::string& out) { write_level_gltf(out, level_view()); }
+  void write_gltf(const py::object& target) {
+    const std::string out = path_of(target, "write_gltf: path");
+    refuse_inputs(out);
+    write_level_gltf(out, level_view());
+  }
+  /// An output may not replace this file's scene or the .pvs itself.
+  void refuse_inputs(const std::string& out) const {
+    namespace fs = std::filesystem;
+    const auto key = [](const std::string& p) {
+      std::error_code ec;
+      return fs::weakly_canonical(fs::absolute(p), ec);
+    };
+    if (key(out) == key(path)) throw Error(out, 0, "is the .pvs file read here: write elsewhere");
+    if (scene_file && key(out) == key(scene_file->path))
+      throw Error(out, 0, "is the scene this .pvs was baked from: write elsewhere");
+  }
   std::vector<std::vector<uint32_t>> neighbours() const { return cells->neighbours(); }
   /// The same view cells and point location with other PVSs, written as a .pvs (checked on
   /// reading back), and read back.
-  std::shared_ptr<Baked> with_pvs(const std::string& out, const std::vector<std::vector<uint32_t>>& lists) const {
+  std::shared_ptr<Baked> with_pvs(const py::object& target, const std::vector<std::vector<uint32_t>>& lists) const {
+    const std::string out = path_of(target, "with_pvs: path");
+    if (scene_file) {
+      std::error_code ec;
+      if (std::filesystem::weakly_canonical(std::filesystem::absolute(out), ec) ==
+          std::filesystem::weakly_canonical(std::filesystem::absolute(scene_file->path), ec))
+        throw Error(out, 0, "is the scene this .pvs was baked from: write elsewhere");
+    }
+    if (lists.size() != file.pvs.cell_count)
+      throw Error(out, 0, "with_pvs needs one list per view cell: " + std::to_string(file.pvs.cell_count) +
+                              " cells, " + std::to_string(lists.size()) + " lists given");
     PvsFile f = file;
     for (const auto& l : lists)
       for (uint32_t o : l)
-        if (o >= f.object_count) throw Error(out, 0, "object id " + std::to_string(o) + " is not below the object count");
+        if (o >= f.object_count)
+          throw Error(out, 0, "object id " + std::to_string(o) + " is not one of the file's " +
+                                  std::to_string(f.object_count) + " objects (0 to " +
+                                  std::to_string(f.object_count - 1) + ")");
     std::vector<std::vector<uint32_t>> sorted = lists;
     for (auto& l : sorted) {
       std::sort(l.begin(), l.end());
@@ -284,20 +361,84 @@ struct Baked {
   }
 };
 
-std::shared_ptr<Baked> bake(const py::object& scene, const std::string& output, const py::object& progress,
+/// Runs `work` on a thread of its own while this one waits with the GIL released, checking for
+/// Ctrl-C every 100 ms: on one, the library's stop is asked for (its loops throw Interrupted,
+/// and nothing is written), the thread joined, and KeyboardInterrupt raised here.
+void run_interruptible(const std::function<void()>& work) {
+  std::mutex m;
+  std::condition_variable cv;
+  bool done = false;
+  std::exception_ptr failed;
+  std::thread worker([&] {
+    try {
+      work();
+    } catch (...) {
+      failed = std::current_exception();
+    }
+    std::lock_guard lock(m);
+    done = true;
+    cv.notify_all();
+  });
+  for (;;) {
+    {
+      py::gil_scoped_release release;
+      std::unique_lock lock(m);
+      if (cv.wait_for(lock, std::chrono::milliseconds(100), [&] { return done; })) break;
+    }
+    if (PyErr_CheckSignals() != 0) {  // KeyboardInterrupt (or what a handler raised) is set
+      request_interrupt(true);
+      {
+        py::gil_scoped_release release;
+        worker.join();
+      }
+      request_interrupt(false);
+      throw py::error_already_set();
+    }
+  }
+  {
+    py::gil_scoped_release release;
+    worker.join();
+  }
+  if (failed) std::rethrow_exception(failed);
+}
+
+std::shared_ptr<Baked> bake(const py::object& scene, const py::object& output_path, const py::object& progress,
                             const py::kwargs& options) {
   std::shared_ptr<const Scene> memory;
   std::string name;
-  if (py::isinstance<py::str>(scene)) {
-    name = scene.cast<std::string>();
-  } else {
-    memory = scene.cast<std::shared_ptr<const Scene>>();
+  if (py::isinstance<Scene>(scene)) {
+    memory = scene.cast<std::shared_ptr<Scene>>();
     name = memory->source;
+  } else if (py::isinstance<py::str>(scene) || py::hasattr(scene, "__fspath__")) {
+    name = path_of(scene, "bake: scene");
+  } else {
+    throw py::type_error("bake: scene must be a viewcells.Scene or a scene file's path, not " +
+                         py::str(py::type::of(scene).attr("__name__")).cast<std::string>());
   }
+  const std::string output = path_of(output_path, "bake: output");
+  if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
+    throw py::type_error("bake: progress must be callable (it receives each log line), or None");
   std::vector<std::string> args = {name, "-o", output};
-  for (const auto& [key, value] : options) add_option(args, py::str(key), value);
+  std::string report;
+  for (const auto& [key, value] : options) {
+    if (py::str(key).cast<std::string>() == "report") {
+      if (!value.is_none()) report = path_of(value, "bake: report");
+      continue;
+    }
+    add_option(args, py::str(key), value);
+  }
   pipeline::BakeConfig config = cli::bake_config_from_args(args, progress.is_none());
   if (memory) config.scene.scene = memory;
+  if (!report.empty()) {
+    check_output_target(report);
+    const auto same = [](const std::string& a, const std::string& b) {
+      std::error_code ec;
+      return std::filesystem::weakly_canonical(std::filesystem::absolute(a), ec) ==
+             std::filesystem::weakly_canonical(std::filesystem::absolute(b), ec);
+    };
+    if (same(report, output) || (!memory && same(report, name)))
+      throw Error(report, 0, "is the .pvs or the scene of this bake: write the report elsewhere");
+  }
   pipeline::Log log = [](const std::string&) {};
   if (!progress.is_none())
     log = [&progress](const std::string& line) {
@@ -305,12 +446,12 @@ std::shared_ptr<Baked> bake(const py::object& scene, const std::string& output, 
       progress(line);
     };
   pipeline::BakeResult result;
-  {
-    py::gil_scoped_release release;
+  run_interruptible([&] {
     OutputBatch outputs;  // written in place only when the whole bake succeeded, as the CLI does
     result = pipeline::bake(config, log);
+    if (!report.empty()) pipeline::write_report(report, result);
     outputs.commit();
-  }
+  });
   auto out = std::make_shared<Baked>(output, *result.file, memory, config.model);
   if (!memory) out->scene_file = config.scene;
   out->report = py::module_::import("json").attr("loads")(pipeline::report_json(result));
@@ -319,13 +460,17 @@ std::shared_ptr<Baked> bake(const py::object& scene, const std::string& output, 
 
 /// A .pvs file written earlier, with the scene it was baked from when given (a Scene, or its
 /// file's path and grouping, as `viewcells view --scene` takes them).
-std::shared_ptr<Baked> read_baked(const std::string& path, const py::object& scene, const std::string& objects) {
+std::shared_ptr<Baked> read_baked(const py::object& pvs_path, const py::object& scene, const std::string& objects) {
+  const std::string path = path_of(pvs_path, "read: path");
   std::shared_ptr<const Scene> memory;
-  if (!scene.is_none() && !py::isinstance<py::str>(scene)) memory = scene.cast<std::shared_ptr<const Scene>>();
+  if (py::isinstance<Scene>(scene)) memory = scene.cast<std::shared_ptr<Scene>>();
+  else if (!scene.is_none() && !py::isinstance<py::str>(scene) && !py::hasattr(scene, "__fspath__"))
+    throw py::type_error("read: scene must be a viewcells.Scene, a scene file's path or None, not " +
+                         py::str(py::type::of(scene).attr("__name__")).cast<std::string>());
   auto out = std::make_shared<Baked>(path, memory, CostModel{});
-  if (py::isinstance<py::str>(scene)) {
+  if (!memory && !scene.is_none()) {
     pipeline::SceneSource source;
-    source.path = scene.cast<std::string>();
+    source.path = path_of(scene, "read: scene");
     source.grouping = parse_grouping(objects);
     out->scene_file = source;
   }
@@ -349,8 +494,7 @@ PYBIND11_MODULE(viewcells, m) {
                                             "Triangles grouped into objects: what a PVS lists. From arrays, or "
                                             "Scene.load(path) from a file")
       .def(py::init([](py::array_t<double, py::array::c_style | py::array::forcecast> vertices,
-                       py::array_t<int64_t, py::array::c_style | py::array::forcecast> triangles,
-                       std::optional<py::array_t<int64_t, py::array::c_style | py::array::forcecast>> objects,
+                       const py::object& triangles, const py::object& objects,
                        std::optional<std::vector<std::string>> names, std::optional<std::vector<bool>> see_through,
                        const std::string& name) {
              return std::const_pointer_cast<Scene>(
@@ -359,8 +503,10 @@ PYBIND11_MODULE(viewcells, m) {
            py::arg("vertices"), py::arg("triangles"), py::arg("objects") = py::none(), py::arg("names") = py::none(),
            py::arg("see_through") = py::none(), py::arg("name") = "python scene",
            "vertices (N, 3) float, triangles (M, 3) int, objects (M,) int: each triangle's object (default one "
-           "object), names: one per object, see_through: a flag per object. Degenerate triangles are dropped; "
-           "non-finite coordinates and bad indices are errors.")
+           "object), names: one per object, see_through: a flag per object. Indices count from 0. Object ids "
+           "are kept as given: a PVS lists them, also past an id with no triangles (degenerate triangles are "
+           "dropped; an object left with none is never listed). Non-finite coordinates, bad or fractional "
+           "indices are errors.")
       .def_static(
           "load",
           [](const std::string& path, const std::string& objects) {
@@ -437,6 +583,7 @@ PYBIND11_MODULE(viewcells, m) {
 
   m.def("bake", &bake, py::arg("scene"), py::arg("output"), py::kw_only(), py::arg("progress") = py::none(),
         "Bakes `scene` (a Scene, or a scene file's path) into the .pvs file `output`, with `viewcells bake`'s "
-        "options as keywords and its defaults (cells=100 or memory='256K'; pixel_error, holes='1%', time, ...). "
-        "progress(line) receives the log lines. Returns the file read back.");
+        "options as keywords and its defaults (cells=100 or memory='256K'; pixel_error, holes='1%', time, ...; "
+        "report='r.json' writes the report). progress(line) receives the log lines. Ctrl-C stops the bake "
+        "within a second with KeyboardInterrupt, writing nothing. Returns the file read back.");
 }

@@ -73,11 +73,13 @@ def watch():
     print(f"ticks {state['ticks']}, progress seen {steps}, status '{s.status}'")
     if cells is None or len(cells.objects) != 8:
         finish(f"FAIL: no cells after the background bake ({s.status})", 1)
-    # The bar as the timers saw it only rises; the bake's stages, as the add-on set them, are
-    # several (the timers, every 0.25 s, may miss the short early ones on a fast machine).
+    # Blender's event loop ran while the bake ran (a timer saw the bake's job at least once), and
+    # the bar as the timers saw it never fell. That it rises through the stages is checked on
+    # the stages the add-on set, not on what the timers sampled: how many distinct values a
+    # timer sees depends on the machine's speed (two of five runs on a quiet machine saw one).
     print(f"stages set: {addon.last_stages}")
-    if len(steps) < 2 or state["progress"] != sorted(state["progress"]):
-        finish(f"FAIL: the progress bar should rise while the bake runs: {state['progress']}", 1)
+    if not state["progress"] or state["progress"] != sorted(state["progress"]):
+        finish(f"FAIL: the progress bar should show and never fall while the bake runs: {state['progress']}", 1)
     if len(addon.last_stages) < 5 or addon.last_stages != sorted(addon.last_stages):
         finish(f"FAIL: the bake should go through its stages in order: {addon.last_stages}", 1)
     if not os.path.exists(s.output) or not os.path.exists(s.gltf):

@@ -647,6 +647,14 @@ expect_error "empty value" "$VC" bake office.obj --cells 5 -o ""
 expect_error "also given as an output file" "$VC" bake office.obj --cells 5 -o samedir --work samedir
 touch afile
 expect_error "exists and is not a directory" "$VC" bake office.obj --cells 5 -o x.pvs --work afile
+# A .pvs inside the work directory would break every later run with it (issue 67).
+mkdir -p wdir
+expect_error "is inside the work directory wdir" "$VC" bake office.obj --cells 5 -o wdir/hierarchy.vcells --work wdir
+[ -z "$(ls wdir)" ] && ok || bad "a refused bake wrote into its work directory: $(ls wdir)"
+# Seeds are whole numbers that fit 64 bits: -1 and 2^64 used to run as 2^64 - 1 (issue 67).
+expect_error "--seed: '-1' is not allowed" "$VC" bake office.obj --cells 5 --seed -1 -o x.pvs
+expect_error "--seed: '18446744073709551616' is not allowed" "$VC" bake office.obj --cells 5 --seed 18446744073709551616 -o x.pvs
+expect_error "--seed: '99999999999999999999999' is not allowed" "$VC" measure office.obj bake1.pvs --seed 99999999999999999999999
 # 309-digit numbers are printed as 1.000e+308.
 "$VC" query bake1.pvs 1e308 0 0 >out.txt 2>err.txt
 grep -q "1.000e+308" err.txt && [ "$(wc -c <err.txt)" -lt 200 ] && ok || bad "query 1e308: $(cat err.txt)"

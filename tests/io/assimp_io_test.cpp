@@ -224,5 +224,31 @@ TEST(AssimpIo, BrokenFilesAreErrorsNamingTheFile) {
   expect_error(write_temp("big.gltf", big_buffer), "a buffer declares 999999999 bytes");
 }
 
+// A glTF's external files must lie in its folder (issue 67): a level from an untrusted source
+// may not read the baking machine's files. The same file reads when its buffer is beside it.
+TEST(AssimpIo, ExternalFilesOutsideTheFoldersAreRefused) {
+  namespace fs = std::filesystem;
+  const fs::path root = fs::temp_directory_path() / "viewcells_gltf_uris";
+  fs::remove_all(root);
+  fs::create_directories(root / "level");
+  const std::string model = kModels + "glTF2/BoxTextured-glTF/";
+  fs::copy_file(model + "BoxTextured0.bin", root / "level" / "BoxTextured0.bin");
+  fs::copy_file(model + "BoxTextured0.bin", root / "secret.bin");
+  std::ifstream in(model + "BoxTextured.gltf");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto with_uri = [&](const std::string& uri) {
+    const fs::path p = root / "level" / "level.gltf";
+    std::ofstream(p) << replaced(text, R"("uri": "BoxTextured0.bin")", "\"uri\": \"" + uri + "\"");
+    return p.string();
+  };
+  EXPECT_GT(load_scene(with_uri("BoxTextured0.bin")).triangle_count(), 0u);
+  for (const std::string uri : {"../secret.bin", "%2e%2e/secret.bin", "/etc/passwd", "file:///etc/passwd",
+                                "./../level/../../secret.bin"})
+    expect_error(with_uri(uri), "is outside the file's folder");
+  fs::create_directory_symlink(root, root / "level" / "up");
+  expect_error(with_uri("up/secret.bin"), "is outside the file's folder");
+  fs::remove_all(root);
+}
+
 }  // namespace
 }  // namespace viewcells

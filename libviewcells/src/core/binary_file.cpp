@@ -5,6 +5,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -20,9 +21,12 @@ uint64_t fnv1a64(const std::string& bytes) { return format::fnv1a64(bytes); }
 
 namespace {
 
-/// The open OutputBatch's staged files (tmp, target), or null when none is open.
+/// The open OutputBatch's staged files (tmp, target), or null when none is open: per thread,
+/// so that a file written on one thread (Python's write_gltf) is not held back by a bake
+/// running on another, and two bakes in one process each keep their own batch.
 std::mutex g_batch_mutex;
-std::vector<std::pair<std::string, std::string>>* g_batch = nullptr;
+thread_local std::vector<std::pair<std::string, std::string>>* g_batch = nullptr;
+std::atomic<uint64_t> g_temporaries{0};
 
 }  // namespace
 
@@ -42,7 +46,10 @@ void check_output_target(const std::string& path) {
     throw Error(path, 0, "cannot be written: its directory " + dir.string() + " is not writable");
 }
 
-std::string temporary_for(const std::string& path) { return path + ".tmp." + std::to_string(getpid()); }
+std::string temporary_for(const std::string& path) {
+  // Unique within the process too: two threads may write files of the same name at once.
+  return path + ".tmp." + std::to_string(getpid()) + "." + std::to_string(g_temporaries.fetch_add(1));
+}
 
 void install_file(const std::string& tmp, const std::string& path) {
   {

@@ -4,7 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cctype>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -97,6 +99,12 @@ class GltfCheck {
       // At least one byte per element must be there (the exact element size is Assimp's check).
       if (count > 0 && (offset >= view->second || count - 1 > view->second - offset))
         fail("an accessor declares more elements than its buffer view holds");
+    });
+    for_each(doc, "images", [&](const std::string&, const nlohmann::json& im) {
+      if (im.is_object() && im.contains("uri") && im["uri"].is_string()) {
+        const std::string uri = im["uri"].get<std::string>();
+        if (uri.rfind("data:", 0) != 0) check_inside_folder(uri, "image");
+      }
     });
     check_node_depth(doc);
   }
@@ -198,11 +206,44 @@ class GltfCheck {
       if (comma == std::string::npos) fail("a data URI without data");
       return (uri.size() - comma - 1) / 4 * 3 + 3;
     }
+    check_inside_folder(uri, "buffer");
     std::error_code ec;
     const auto path = dir_ / uri;
     const auto size = std::filesystem::file_size(path, ec);
     if (ec) fail("its buffer file '" + uri + "' cannot be read");
     return size;
+  }
+
+  /// An external file a glTF names must be in its folder or below: a level from an untrusted
+  /// source (a mod, an upload) may not read the baking machine's files ("../../etc/passwd", an
+  /// absolute path, another scheme, or a symbolic link out). Checked as written and with its
+  /// percent escapes decoded, as a reader may take it either way.
+  void check_inside_folder(const std::string& uri, const char* what) const {
+    namespace fs = std::filesystem;
+    auto refuse = [&] {
+      fail(std::string("its ") + what + " file '" + uri +
+           "' is outside the file's folder: external files must be relative paths inside it");
+    };
+    if (uri.find("://") != std::string::npos || uri.rfind("file:", 0) == 0) refuse();
+    std::string decoded;
+    for (size_t i = 0; i < uri.size(); ++i) {
+      if (uri[i] == '%' && i + 2 < uri.size() && std::isxdigit(static_cast<unsigned char>(uri[i + 1])) &&
+          std::isxdigit(static_cast<unsigned char>(uri[i + 2]))) {
+        decoded += static_cast<char>(std::stoi(uri.substr(i + 1, 2), nullptr, 16));
+        i += 2;
+      } else {
+        decoded += uri[i];
+      }
+    }
+    std::error_code ec;
+    const fs::path base = fs::weakly_canonical(fs::absolute(dir_.empty() ? fs::path(".") : dir_), ec);
+    for (const std::string& u : {uri, decoded}) {
+      if (u.empty() || u.front() == '/' || u.front() == '\\' || (u.size() > 1 && u[1] == ':')) refuse();
+      const fs::path p = fs::weakly_canonical(base / u, ec);
+      if (ec) refuse();
+      const fs::path rel = p.lexically_relative(base);
+      if (rel.empty() || *rel.begin() == "..") refuse();
+    }
   }
 
   std::string name_;

@@ -227,6 +227,32 @@ ViewCellSet first_cut(const BakeConfig& c, const SubdivisionFile& file, const Lo
 }
 
 /// The settings a bake refuses, before any work.
+/// The output is checked before any work (every front end gets this, not only the command
+/// line): its directory exists and is writable, it is not the scene being baked, and it is not
+/// inside the work directory, whose files a later run with the same directory reads.
+void check_bake_paths(const BakeConfig& c) {
+  namespace fs = std::filesystem;
+  if (c.output.empty()) return;
+  check_output_target(c.output);
+  auto key = [](const std::string& p) {
+    std::error_code ec;
+    const fs::path k = fs::weakly_canonical(fs::absolute(p), ec);
+    return ec ? fs::absolute(p).lexically_normal() : k;
+  };
+  const fs::path out = key(c.output);
+  if (!c.scene.scene && !c.scene.path.empty() && out == key(c.scene.path))
+    throw Error(c.output, 0, "is the scene being baked (" + c.scene.path + "): the .pvs would replace it; write it elsewhere");
+  if (!c.work_dir.empty()) {
+    const fs::path dir = key(c.work_dir);
+    for (fs::path p = out.parent_path(); !p.empty(); p = p.parent_path()) {
+      if (p == dir)
+        throw Error(c.output, 0, "is inside the work directory " + c.work_dir +
+                                     ", whose files later runs with it read: write the .pvs elsewhere");
+      if (p == p.root_path()) break;
+    }
+  }
+}
+
 void check_bake(const BakeConfig& c) {
   if ((c.cells > 0) == (c.memory > 0)) throw Error("bake needs one budget: --cells N or --memory BYTES");
   if (!(c.measured_error >= 0) || !std::isfinite(c.measured_error))
@@ -242,6 +268,7 @@ void check_bake(const BakeConfig& c) {
       !(c.holes > 0) && !(c.max_seconds > 0))
     throw Error("give when the PVSs are good enough: a pixel error (estimated or measured), a time or a number of "
                 "AGVS samples");
+  check_bake_paths(c);
   if (c.cells && c.subdivision.max_cells && c.cells > c.subdivision.max_cells)
     throw Error("--cells " + std::to_string(c.cells) + " asks for more view cells than the " +
                 std::to_string(c.subdivision.max_cells) + " elementary cells of --max-cells: raise --max-cells or "

@@ -200,8 +200,16 @@ Scene make_scene(RawMesh mesh, ObjectGrouping grouping, const std::string& sourc
     case ObjectGrouping::kNodes:  // the Assimp reader made one group per node (or mesh)
     case ObjectGrouping::kMeshes:
     case ObjectGrouping::kGroups: {
-      // Objects in order of first appearance; groups that lost all triangles vanish.
+      // Objects in order of first appearance; groups that lost all triangles vanish (unless the
+      // caller's ids are kept: then every group is the object of its index).
       std::vector<uint32_t> remap(std::max<size_t>(mesh.group_names.size(), 1), kNoObject);
+      if (mesh.keep_group_ids && has_groups)
+        for (uint32_t g = 0; g < mesh.group_names.size(); ++g) {
+          remap[g] = g;
+          ObjectInfo info;
+          info.name = mesh.group_names[g];
+          scene.objects.push_back(info);
+        }
       for (size_t t = 0; t < n; ++t) {
         uint32_t& id = remap[kept_group[t]];
         if (id == kNoObject) {
@@ -252,6 +260,15 @@ Scene make_scene(RawMesh mesh, ObjectGrouping grouping, const std::string& sourc
     for (ObjectInfo& o : scene.objects) o.*member = false;
     for (size_t t = 0; t < n; ++t)
       if ((*flags)[kept_group[t]]) scene.objects[scene.triangle_object[t]].*member = true;
+  }
+  if (mesh.keep_group_ids) {  // a kept id with no triangles draws nothing (and, with none, hides nothing)
+    std::vector<uint8_t> has(scene.objects.size(), 0);
+    for (uint32_t o : scene.triangle_object) has[o] = 1;
+    for (size_t o = 0; o < scene.objects.size(); ++o)
+      if (!has[o]) {
+        scene.objects[o].rendered = false;
+        scene.objects[o].occluder = true;  // not "seen through": it has nothing to see through
+      }
   }
   scene.finalize();
   return scene;

@@ -129,7 +129,8 @@ void write_text_file(const std::string& path, const std::string& text);
 /// Throws Error when `path` exists and is not a regular file (a directory, device, FIFO or
 /// symbolic link): outputs replace files, and must not replace those.
 void check_output_target(const std::string& path);
-/// The temporary file a writer of `path` writes first (beside it, named by the process).
+/// The temporary file a writer of `path` writes first (beside it, named by the process and a
+/// counter).
 std::string temporary_for(const std::string& path);
 /// Moves the finished temporary `tmp` onto `path`: at once, or, while an OutputBatch is open,
 /// when it commits.
@@ -153,7 +154,8 @@ class UnbatchedWrites {
 /// All outputs of one command: while it is open, files written through write_text_file,
 /// write_container or install_file stay temporary and are renamed onto their targets only by
 /// commit(). Destroyed without commit (the command failed), it removes them, so that a failing
-/// command leaves every earlier file as it was. One at a time per process.
+/// command leaves every earlier file as it was. One at a time per thread: it holds the files
+/// written on the thread that opened it (a bake writes its outputs on its calling thread).
 class OutputBatch {
  public:
   OutputBatch();

@@ -55,6 +55,11 @@ struct RawMesh {
   std::vector<uint8_t> group_rendered;
   /// Per group: false when the group does not stop rays (ObjectInfo::occluder); empty: all do.
   std::vector<uint8_t> group_occluder;
+  /// With ObjectGrouping::kGroups: object i is group i, for every group, also one left with no
+  /// triangles (none given, or all degenerate: then neither rendered nor an occluder), so that
+  /// the ids in every PVS are the caller's (arrays from Python, the C API). Otherwise objects
+  /// are the groups with triangles, in order of first appearance.
+  bool keep_group_ids = false;
 };
 
 class Scene {
