@@ -309,6 +309,12 @@ std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, 
                  "less: only the bound loosens)")
       ->capture_default_str()
       ->check(whole(1, 1000000000));
+  bk->add_option("--aimed-rays", a->bound.aimed_rays,
+                 "With the proof (--prove-hidden, --conservative): rays aimed at each (view cell, object) pair it "
+                 "leaves undecided, from points of the cell's empty space to points of the object, up to this many a "
+                 "pair; one that arrives proves the pair visible (0: none)")
+      ->capture_default_str()
+      ->check(whole(0, 1000000));
   bk->add_option("--near-rounds", a->bound.near.rounds,
                  "Rounds of --near-samples: each round tests the neighbours of what the last one added")
       ->capture_default_str()

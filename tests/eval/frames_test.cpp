@@ -68,6 +68,16 @@ TEST(Frames, WrongPixelsAreThoseOfObjectsMissingFromThePvs) {
   const PixelErrorMeasure serial = measure_frames(scene, *caster, cams, cam_cells, GlobalPvs::from_lists(scene.object_count(), all), frame);
   EXPECT_EQ(serial.share, m.share);
   EXPECT_EQ(serial.median_pixels, m.median_pixels);
+  EXPECT_EQ(m.cameras, 60u);
+  EXPECT_EQ(m.cameras_asked, 60u);
+  // A deadline already passed: no frame is rendered, and the measure says so (a bake's --time
+  // cut its measurements this way, issue 67).
+  FrameConfig late = frame;
+  late.deadline = Deadline{std::chrono::steady_clock::now()};
+  const PixelErrorMeasure cut = measure_frames(scene, *caster, cams, cam_cells, GlobalPvs::from_lists(scene.object_count(), all), late);
+  EXPECT_EQ(cut.cameras, 0u);
+  EXPECT_EQ(cut.cameras_asked, 60u);
+  EXPECT_TRUE(cut.wrong.empty());
 }
 
 TEST(Frames, CoherentPacketsSeeWhatSingleRaysSeeAndEveryPixelOnce) {

@@ -2,6 +2,7 @@
 #include "viewcells/core/interrupt.h"
 
 #include <atomic>
+#include <cmath>
 #include <csignal>
 
 namespace viewcells {
@@ -35,5 +36,13 @@ void throw_if_interrupted(const char* what) {
 }
 
 void request_interrupt(bool on) { g_requested.store(on ? 1 : 0); }
+
+Deadline Deadline::after(double seconds) {
+  Deadline d;
+  if (seconds > 0 && seconds < 1e9)
+    d.at = std::chrono::steady_clock::now() +
+           std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(seconds));
+  return d;
+}
 
 }  // namespace viewcells

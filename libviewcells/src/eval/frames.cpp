@@ -142,7 +142,7 @@ uint64_t add_frame_samples(const RayCaster& caster, std::span<const Camera> came
     std::vector<Hit> hits;
     for (size_t k = range.begin(); k < range.end(); ++k) {
       throw_if_interrupted("frame samples");
-      if (cells[k] < 0) continue;
+      if (cells[k] < 0 || config.deadline.passed()) continue;  // past the deadline: adds nothing
       frame_rays(cameras[k], config, rays);
       cast_frame(caster, rays, hits, true);
       for (const Hit& h : hits)
@@ -177,15 +177,17 @@ PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, st
   for (int32_t c : cells)
     if (c < -1 || (c >= 0 && static_cast<uint32_t>(c) >= pvs.cell_count()))
       throw Error("measure_frames: a camera's cell is not one of the PVS's");
-  const uint32_t n = static_cast<uint32_t>(cameras.size());
-  std::vector<std::vector<WrongView>> wrong_of(n);
-  Progress progress("frames", n);
-  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, n, 1), [&](const tbb::blocked_range<uint32_t>& range) {
+  const uint32_t asked = static_cast<uint32_t>(cameras.size());
+  std::vector<std::vector<WrongView>> wrong_of(asked);
+  std::vector<uint8_t> done(asked, 0);
+  Progress progress("frames", asked);
+  tbb::parallel_for(tbb::blocked_range<uint32_t>(0, asked, 1), [&](const tbb::blocked_range<uint32_t>& range) {
     std::vector<Ray> rays;
     std::vector<Hit> hits;
     std::vector<uint32_t> objects, count(scene.objects.size(), 0);
     for (uint32_t k = range.begin(); k < range.end(); ++k) {
       throw_if_interrupted("measuring frames");
+      if (config.deadline.passed()) continue;  // past the deadline: left out, not counted
       frame_rays(cameras[k], config, rays);
       cast_frame(caster, rays, hits, config.coherent);
       // Counted per object (a frame of 786K pixels is not sorted): the objects met, then
@@ -200,12 +202,18 @@ PixelErrorMeasure measure_frames(const Scene& scene, const RayCaster& caster, st
         wrong_of[k].push_back({k, o, count[o]});
         count[o] = 0;
       }
+      done[k] = 1;
       progress.advance();
     }
   });
   progress.finish();
   PixelErrorMeasure out;
+  out.cameras_asked = asked;
+  // Cut by the deadline, the measure is over the first cameras all done (cameras are drawn
+  // independently, so these are a smaller sample of the same distribution).
+  const uint32_t n = static_cast<uint32_t>(std::find(done.begin(), done.end(), 0) - done.begin());
   out.cameras = n;
+  if (n == 0) return out;
   std::vector<uint64_t> per_camera(n, 0);
   for (uint32_t k = 0; k < n; ++k) {
     for (const WrongView& w : wrong_of[k]) per_camera[k] += w.pixels;

@@ -16,6 +16,7 @@
 
 #include "viewcells/core/error.h"
 #include "viewcells/core/interrupt.h"
+#include "viewcells/core/progress.h"
 
 namespace viewcells {
 
@@ -47,18 +48,31 @@ class BspHiddenSpace : public HiddenSpace {
   }
   std::vector<std::string> warnings() const override { return warnings_; }
   bool leaks() const override { return leaks_; }
+  bool solid_at(const Vec3& p) const override {
+    const SolidBsp& b = graph_.bsp();
+    return b.leaf_solid[static_cast<size_t>(b.leaf_at(p))] != 0;
+  }
 
-  HiddenProof prove(const std::vector<std::vector<Polytope>>& cells, uint64_t max_steps) const override {
+  HiddenProof prove(const std::vector<std::vector<Polytope>>& cells, uint64_t max_steps,
+                    const Deadline& deadline) const override {
     const auto t0 = std::chrono::steady_clock::now();
     HiddenProof out;
     out.unhidden.resize(cells.size());
     std::vector<PortalGraph::FloodStats> stats(cells.size());
     std::vector<uint64_t> floods(cells.size(), 0);
+    std::vector<uint8_t> unproven(cells.size(), 0);
+    Progress progress("proving hidden objects", cells.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
       PortalGraph::FloodState state;
       std::vector<std::pair<int32_t, Polytope>> parts;
       for (size_t c = r.begin(); c < r.end(); ++c) {
         throw_if_interrupted("proving hidden objects");
+        if (deadline.passed()) {  // out of time: this cell proves nothing
+          unproven[c] = 1;
+          out.unhidden[c].resize(object_count_);
+          for (uint32_t o = 0; o < object_count_; ++o) out.unhidden[c][o] = o;
+          continue;
+        }
         graph_.reset(state);
         parts.clear();
         for (const Polytope& piece : cells[c]) graph_.split_to_leaves(piece, parts);
@@ -67,15 +81,18 @@ class BspHiddenSpace : public HiddenSpace {
           ++floods[c];
         }
         graph_.finish(state);
+        progress.advance();
         auto& list = out.unhidden[c];
         for (uint32_t o = 0; o < object_count_; ++o)
           if (state.object_seen[o]) list.push_back(o);
       }
     });
+    progress.finish();
     for (size_t c = 0; c < cells.size(); ++c) {
       out.steps += stats[c].steps;
       out.overflows += stats[c].overflows;
       out.floods += floods[c];
+      out.cells_unproven += unproven[c];
     }
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return out;

@@ -288,7 +288,7 @@ void frame_sample_rounds(const BakeConfig& c, const LoadedScene& loaded, const C
   std::string rule;
   for (uint32_t round = 0; round < c.frame_rounds; ++round) {
     const size_t n_active = static_cast<size_t>(std::count(active.begin(), active.end(), 1));
-    if (n_active == 0) break;
+    if (n_active == 0 || c.sample_frame.deadline.passed()) break;
     CameraConfig sc = c.cameras;
     sc.count = static_cast<uint32_t>(std::min<uint64_t>(sampling_frames * lists.size() / n_active, 10'000'000));
     sc.seed = c.cameras.seed + 0x5a3'0001 + round;
@@ -406,7 +406,9 @@ Written fit_budget(const BakeConfig& c, const SubdivisionFile& file, const ViewC
 void measure_written(const BakeConfig& c, const LoadedScene& loaded, const SubdivisionFile& file,
                      const ViewCellSet& set, const Written& w, const Box3& written_box, const CameraSet& cams,
                      BakeResult& out, const Log& log) {
-  if (w.cells.cells.size() == set.cells.size() && !out.measured_curve.empty() && !c.frame_samples && !c.near.rays_per_object) {
+  const bool last_whole = !out.measured_curve.empty() &&
+                          out.measured_curve.back().measured.cameras == out.measured_curve.back().measured.cameras_asked;
+  if (w.cells.cells.size() == set.cells.size() && last_whole && !c.frame_samples && !c.near.rays_per_object) {
     out.measured = out.measured_curve.back().measured;  // the PVSs written, measured last
   } else {
     // The cells written (coarser when the budget coarsened them): each camera's is found again.
@@ -422,8 +424,18 @@ void measure_written(const BakeConfig& c, const LoadedScene& loaded, const Subdi
     out.measured = measure_frames(*loaded.scene, *loaded.caster, in_written.cameras, in_written.cells,
                                   GlobalPvs::from_lists(file.object_count, w.lists), c.frame);
     out.measured->wrong.clear();
-    log("viewcells: bake: measured pixel error " + fmt(out.measured->pixels, 3) + " (median camera " +
-        fmt(out.measured->median_pixels, 3) + ") in " + fmt(sw.seconds(), 1) + " s");
+    const PixelErrorMeasure& m = *out.measured;
+    if (m.cameras == 0) {
+      log("viewcells: bake: the written PVSs are not measured: the time limit (--time) ran out before the first of " +
+          std::to_string(m.cameras_asked) + " frames");
+      out.measured.reset();
+      return;
+    }
+    log("viewcells: bake: measured pixel error " + fmt(m.pixels, 3) + " (median camera " + fmt(m.median_pixels, 3) +
+        ") in " + fmt(sw.seconds(), 1) + " s" +
+        (m.cameras < m.cameras_asked ? " over the first " + std::to_string(m.cameras) + " of " +
+                                           std::to_string(m.cameras_asked) + " frames: the time limit (--time) ran out"
+                                     : std::string()));
   }
 }
 
@@ -460,6 +472,9 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   // The whole bake's clock: a quarter for each of the merge's AGVS runs (the hierarchy's only
   // stages without a bound of their own), what is left for the PVSs' AGVS.
   BakeConfig run = c;
+  // Frames (measured or sampled) stop at the bake's limit; AGVS's measurements at its own.
+  const Deadline deadline = Deadline::after(c.max_seconds);
+  run.frame.deadline = run.sample_frame.deadline = deadline;
   if (c.max_seconds > 0 && run.merge_agvs) {
     const double share = 0.25 * c.max_seconds;
     run.merge_agvs->max_seconds = run.merge_agvs->max_seconds > 0 ? std::min(run.merge_agvs->max_seconds, share) : share;
@@ -494,10 +509,6 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
                                    "sampled: give more time, fewer --samples or --max-cells" +
                                    (c.work_dir.empty() ? std::string(", or --work to keep the hierarchy for a rerun")
                                                        : std::string(" (the hierarchy is kept in " + c.work_dir + ")")));
-    // With near-object samples after it, AGVS leaves them a quarter of what is left; they stop
-    // at the bake's limit.
-    const double agvs_left = c.near.rays_per_object ? 0.75 * left : left;
-    run.agvs.max_seconds = run.agvs.max_seconds > 0 ? std::min(run.agvs.max_seconds, agvs_left) : agvs_left;
   }
   out.elementary_cells = static_cast<uint32_t>(h.leaf_count);
   out.scene_fingerprint = file.scene_fingerprint;
@@ -514,6 +525,22 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   Subdivision covered_bsp = sampled.bsp;
   covered_bsp.view_box = written_box;
   const CellLocator covered_cells(std::move(covered_bsp), sampled.leaf_cell, sampled.pvs.cell_count);
+  // The proof needs no samples: first, with at most half of the time left (cells it has not
+  // begun then prove nothing, which is safe).
+  std::optional<CellProof> proved;
+  if (hidden)
+    proved = prove_cells(c, *hidden, covered_cells_bsp(sampled, written_box), sampled.leaf_cell,
+                         sampled.pvs.cell_count, Deadline::after(0.5 * (c.max_seconds - total.seconds())));
+  if (c.max_seconds > 0) {
+    // Each later stage that renders or casts on its own (frame samples, near-object samples, a
+    // measurement of the written PVSs) leaves AGVS a quarter less of what is left, down to a
+    // half; those stages stop at the bake's limit.
+    const double left = std::max(c.max_seconds - total.seconds(), 1e-9);
+    const int after = (c.near.rays_per_object ? 1 : 0) + (c.frame_samples ? 1 : 0) + (c.measure_cameras ? 1 : 0);
+    const double agvs_left = left * (after == 0 ? 1.0 : after == 1 ? 0.75 : 0.5);
+    run.agvs.max_seconds = run.agvs.max_seconds > 0 ? std::min(run.agvs.max_seconds, agvs_left) : agvs_left;
+    run.frame.deadline = Deadline::after(agvs_left);  // AGVS's own measurements
+  }
   std::optional<CameraSet> cams;
   if (c.measure_cameras) {
     Stopwatch sw;
@@ -527,14 +554,17 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
         fmt(sw.seconds(), 2) + " s");
   }
   std::vector<std::vector<uint32_t>> lists = sample_pvs(run, loaded, sampled, cells, cams, out, log);
-  if (c.frame_samples) frame_sample_rounds(c, loaded, covered_cells, sampling_frames, lists, out, log);
+  run.frame.deadline = deadline;  // from here on, frames stop at the bake's own limit
+  if (c.frame_samples) frame_sample_rounds(run, loaded, covered_cells, sampling_frames, lists, out, log);
   if (c.near.rays_per_object) near_object_samples(c, loaded, covered_cells, total, lists, out, log);
-  if (hidden)
-    out.hidden = prove_hidden_classes(c, loaded, *hidden, covered_cells_bsp(sampled, written_box), sampled.leaf_cell,
-                                      cams, lists, log);
+  if (hidden) {
+    AimedRays aimed;
+    if (c.aimed_rays) aimed = aim_at_undecided(c, loaded, *hidden, *proved, covered_cells, lists, deadline, log);
+    out.hidden = hidden_classes(c, loaded, *hidden, *proved, aimed, cams, lists, log);
+  }
   out.agvs_cells = static_cast<uint32_t>(set.cells.size());
   const Written w = fit_budget(c, file, set, lists, written_box, log);
-  if (cams) measure_written(c, loaded, file, set, w, written_box, *cams, out, log);
+  if (cams) measure_written(run, loaded, file, set, w, written_box, *cams, out, log);
   out.file = w.bytes.pvs;
   out.file_bytes = w.bytes.file;
   out.list_bytes = w.bytes.lists;

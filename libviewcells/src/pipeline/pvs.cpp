@@ -236,6 +236,11 @@ bool run_to_measured_error(AgvsSolver& solver, const AgvsConfig& a, const Measur
     const AgvsStats& st = solver.stats();
     curve.push_back(measure_solver(m, solver, log));
     MeasuredPoint& now = curve.back();
+    if (now.measured.cameras < now.measured.cameras_asked) {  // the frame deadline cut it
+      log("viewcells: the time limit ran out while measuring (" + std::to_string(now.measured.cameras) + " of " +
+          std::to_string(now.measured.cameras_asked) + " frames): sampling stops here");
+      return false;
+    }
     if (target.met(now.measured)) {
       now.eta_seconds = 0;
       return true;

@@ -214,6 +214,7 @@ json measured_curve(const std::vector<MeasuredPoint>& curve) {
                    {"measured_p99_pixels", p.measured.p99_pixels},
                    {"measured_worst_pixels", p.measured.worst_pixels},
                    {"cameras_with_wrong_pixels", p.measured.cameras_wrong},
+                   {"cameras", p.measured.cameras},
                    {"frames_with_wrong_pixels_share",
                     p.measured.wrong_frame_share()},
                    {"eta_seconds", number_or_null(p.eta_seconds)}});

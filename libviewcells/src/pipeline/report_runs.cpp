@@ -148,6 +148,9 @@ json hidden_classes(const BakeResult::HiddenClasses& h, const BakeConfig& c) {
           {"floods", h.floods},
           {"portal_steps", h.steps},
           {"floods_over_budget", h.overflows},
+          {"cells_unproven_by_time", h.cells_unproven},
+          {"aimed_rays", {{"per_pair", c.aimed_rays}, {"pairs", h.aimed_pairs}, {"rays", h.aimed_rays},
+                          {"found_visible", h.aimed_found}, {"seconds", h.aimed_seconds}}},
           {"max_steps", c.hidden_max_steps},
           {"seconds", h.seconds}};
 }
@@ -225,6 +228,7 @@ std::string report_json(const BakeResult& r) {
                                   {"median_pixels", r.measured->median_pixels},
                                   {"share", r.measured->share},
                                   {"cameras", r.measured->cameras},
+                                  {"cameras_asked", r.measured->cameras_asked},
                                   {"cameras_with_wrong_pixels", r.measured->cameras_wrong},
                                   {"p99_pixels", r.measured->p99_pixels},
                                   {"worst_pixels", r.measured->worst_pixels},

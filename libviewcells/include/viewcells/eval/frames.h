@@ -8,6 +8,7 @@
 #include <span>
 #include <vector>
 
+#include "viewcells/core/interrupt.h"
 #include "viewcells/cells/view_cells.h"
 #include "viewcells/core/rng.h"
 #include "viewcells/core/vec3.h"
@@ -52,6 +53,9 @@ struct FrameConfig {
   /// Cast each frame's rays as coherent packets of 4x4 pixels (RayCaster::intersect_coherent);
   /// false: as incoherent rays (for the A/B of their rates).
   bool coherent = true;
+  /// When it passes, the frames not yet rendered are left out (measure_frames: the statistics
+  /// are over the first cameras done, PixelErrorMeasure::cameras of cameras_asked).
+  Deadline deadline{};
 };
 
 /// A frame's primary rays, 4x4 pixel tile after tile (rows of tiles, pixels in a tile row by
@@ -83,7 +87,8 @@ struct PixelErrorMeasure {
   double median_pixels = 0;  ///< median over the cameras of their wrong pixels, scaled to `resolution`
   double p99_pixels = 0;     ///< 99th percentile over the cameras (nearest rank), scaled to `resolution`
   double worst_pixels = 0;   ///< the worst camera's, scaled to `resolution`
-  uint32_t cameras = 0;
+  uint32_t cameras = 0;           ///< cameras measured (all asked, unless the deadline cut them)
+  uint32_t cameras_asked = 0;     ///< cameras given; the statistics are over the first `cameras`
   uint32_t cameras_wrong = 0;     ///< cameras with at least one wrong pixel
   /// Cameras in no view cell (cell -1): an engine gets no PVS there and draws nothing, so every
   /// pixel showing an object is wrong. A bake must leave none; counted among cameras_wrong

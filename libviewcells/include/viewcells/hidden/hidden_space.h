@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "viewcells/core/interrupt.h"
 #include "viewcells/hidden/portals.h"
 #include "viewcells/scene/scene.h"
 
@@ -20,6 +21,7 @@ struct HiddenProof {
   uint64_t floods = 0;          ///< convex pieces (cell part in one empty leaf) flooded from
   uint64_t steps = 0;           ///< portals tried
   uint64_t overflows = 0;       ///< floods that ran out of steps and kept all they might see
+  uint64_t cells_unproven = 0;  ///< cells not flooded before the deadline: everything unhidden
   double seconds = 0;
 };
 
@@ -32,10 +34,17 @@ class HiddenSpace {
   virtual std::vector<std::string> warnings() const { return {}; }
   /// Whether the solid space leaks: empty space where viewers are connects to the outside.
   virtual bool leaks() const { return false; }
+  /// Whether p is inside solid space (no viewer stands there; rays from it see back faces).
+  virtual bool solid_at(const Vec3& p) const {
+    (void)p;
+    return false;
+  }
   /// Per view cell given as convex pieces (their union holds every viewpoint of the cell), the
   /// objects not proven hidden. Deterministic for any thread count. `max_steps` bounds each
-  /// flood; a flood over it keeps everything it might still reach (never less).
-  virtual HiddenProof prove(const std::vector<std::vector<Polytope>>& cells, uint64_t max_steps) const = 0;
+  /// flood; a flood over it keeps everything it might still reach (never less). A cell not
+  /// begun when `deadline` passes proves nothing: every object is unhidden (never less).
+  virtual HiddenProof prove(const std::vector<std::vector<Polytope>>& cells, uint64_t max_steps,
+                            const Deadline& deadline = {}) const = 0;
 };
 
 /// Solid space given as a BSP (a compiled map's), with the scene's objects placed in its

@@ -78,6 +78,12 @@ struct BakeConfig {
   /// scene that can prove nothing hidden (every object would be in every PVS).
   bool conservative = false;
   uint64_t hidden_max_steps = 200000;  ///< portals one flood may try before it keeps all it might reach
+  /// With the proof, after the other samplers: rays aimed at each undecided (cell, object) pair,
+  /// from uniform points of the cell's empty space to uniform points of the object's surface,
+  /// up to this many a pair (in rounds of 8, 16, 32, ... while the pair stays undecided); an
+  /// unblocked one proves the pair visible. The only pairs worth rays: the proof has decided
+  /// the rest. 0: none.
+  uint32_t aimed_rays = 0;
   std::string output;              ///< .pvs; empty: nothing written (the result is in BakeResult::file)
   std::string work_dir;            ///< empty: nothing kept between runs
   double checkpoint_seconds = 60;  ///< with a work directory: AGVS state saved this often (0: at the end)
@@ -122,6 +128,9 @@ struct BakeResult {
     double cost_visible = 0, cost_conservative = 0;
     std::string weights;
     uint64_t floods = 0, steps = 0, overflows = 0;
+    uint64_t cells_unproven = 0;  ///< cells the time limit left unproven (all their pairs undecided)
+    uint64_t aimed_pairs = 0, aimed_rays = 0, aimed_found = 0;  ///< aimed rays: pairs tried, rays, pairs seen
+    double aimed_seconds = 0;
     double seconds = 0;
   } hidden;
   bool agvs_in_view_space = false;  ///< a Quake 3 map: AGVS drew its points in the non-solid space
