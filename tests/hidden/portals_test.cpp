@@ -278,7 +278,7 @@ TEST(Hidden, ConservativeBakeHasNoHoles) {
   k.targets.push_back(box(7.9, 3.6, 0.2, 7.95, 3.65, 0.25));
   auto scene = std::make_shared<const Scene>(scene_of(k, {}));
   const auto caster = make_embree_caster(*scene);
-  auto holes_of = [&](bool conservative, pipeline::BakeResult& r) {
+  auto holes_of = [&](bool conservative, pipeline::BakeResult& r, uint32_t aimed = 0) {
     pipeline::BakeConfig c;
     c.scene.path = "two rooms";
     c.scene.scene = scene;
@@ -289,6 +289,7 @@ TEST(Hidden, ConservativeBakeHasNoHoles) {
     c.near.rays_per_object = 0;
     c.conservative = conservative;
     c.prove_hidden = true;
+    c.aimed_rays = aimed;
     r = pipeline::bake(c, [](const std::string&) {});
     const PvsFile& f = *r.file;
     const CellLocator cells(f.bsp, f.leaf_cell, f.pvs.cell_count);
@@ -314,9 +315,17 @@ TEST(Hidden, ConservativeBakeHasNoHoles) {
     }
     return holes;
   };
-  pipeline::BakeResult sampled, conservative;
-  holes_of(false, sampled);
+  pipeline::BakeResult sampled, aimed, conservative;
+  const uint64_t sampled_holes = holes_of(false, sampled);
   EXPECT_EQ(holes_of(true, conservative), 0u);
+  // Rays aimed at the undecided pairs prove some visible (every one by a real ray), and leave
+  // no more holes than sampling alone.
+  const uint64_t aimed_holes = holes_of(false, aimed, 256);
+  EXPECT_GT(sampled.hidden.undecided, 0u);
+  EXPECT_GT(aimed.hidden.aimed_found, 0u);
+  EXPECT_EQ(aimed.hidden.aimed_pairs, sampled.hidden.undecided);
+  EXPECT_EQ(aimed.hidden.visible, sampled.hidden.visible + aimed.hidden.aimed_found);
+  EXPECT_LE(aimed_holes, sampled_holes);
   const auto& h = conservative.hidden;
   EXPECT_TRUE(h.proved);
   EXPECT_GT(h.hidden, 0u);
