@@ -50,8 +50,11 @@ std::shared_ptr<const viewcells::Scene> scene_from(const vc_bake_object* objects
     const uint32_t base = static_cast<uint32_t>(mesh.vertices.size());
     if (uint64_t{base} + o.vertex_count > uint64_t{UINT32_MAX})
       throw Error(kName, 0, "more than 2^32 - 1 vertices in all");
-    for (uint32_t v = 0; v < o.vertex_count; ++v)
+    for (uint32_t v = 0; v < o.vertex_count; ++v) {
       mesh.vertices.push_back({o.vertices[3 * v], o.vertices[3 * v + 1], o.vertices[3 * v + 2]});
+      if (!viewcells::is_finite(mesh.vertices.back()))
+        throw Error(kName, 0, what + ": vertex " + std::to_string(v) + " has a NaN or infinite coordinate");
+    }
     for (uint32_t t = 0; t < o.triangle_count; ++t) {
       std::array<uint32_t, 3> tri{};
       for (int k = 0; k < 3; ++k) {

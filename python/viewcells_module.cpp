@@ -19,6 +19,7 @@
 #include <pybind11/stl.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <condition_variable>
 #include <filesystem>
@@ -141,6 +142,27 @@ void add_option(std::vector<std::string>& args, const std::string& key, const py
     return;
   }
   args.push_back(py::str(value));
+}
+
+/// A message of the command-line parser with each option the caller gave as a keyword named as
+/// that keyword: "--max-cells" -> "max_cells (keyword)".
+std::string as_keywords(std::string message, const py::kwargs& options) {
+  for (const auto& item : options) {
+    const std::string key = py::str(item.first);
+    std::string option = "--" + key;
+    for (char& c : option)
+      if (c == '_') c = '-';
+    for (size_t at = message.find(option); at != std::string::npos; at = message.find(option, at)) {
+      const size_t end = at + option.size();
+      if (end < message.size() && (std::isalnum(static_cast<unsigned char>(message[end])) || message[end] == '-')) {
+        at = end;
+        continue;
+      }
+      message.replace(at, option.size(), key + " (keyword)");
+      at += key.size();
+    }
+  }
+  return message;
 }
 
 /// A path given as str or os.PathLike (pathlib.Path); TypeError otherwise.
@@ -427,7 +449,12 @@ std::shared_ptr<Baked> bake(const py::object& scene, const py::object& output_pa
     }
     add_option(args, py::str(key), value);
   }
-  pipeline::BakeConfig config = cli::bake_config_from_args(args, progress.is_none());
+  pipeline::BakeConfig config;
+  try {
+    config = cli::bake_config_from_args(args, progress.is_none());
+  } catch (const Error& e) {
+    throw Error(as_keywords(e.what(), options));
+  }
   if (memory) config.scene.scene = memory;
   if (!report.empty()) {
     check_output_target(report);

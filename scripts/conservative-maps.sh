@@ -1,35 +1,39 @@
 #!/usr/bin/env bash
 # The conservative mode on OpenArena maps (issue 65): a bake of 300 view cells (300,000
 # construction samples, 1M AGVS samples, no near-object samples: the conservative sets hardly
-# depend on sampling) with --conservative, measured by 300 play cameras of 1024x768 (seed 7),
-# and the map's own PVS (q3map2's) measured by the same cameras. Prints a Markdown table.
+# depend on sampling) with --conservative, measured by CAMERAS (default 1000, the issue's goal)
+# play cameras of 1024x768 (seed 7), and the map's own PVS (q3map2's) measured by the same
+# cameras. Prints a Markdown table.
 # Usage: scripts/conservative-maps.sh MAP:HALF ...   (e.g. oa_dm2:tuning aggressor:held-out)
 # The halves are those of scripts/near-samples.sh (alphabetical position 4k+2, 4k+3: tuning).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 vc="${VIEWCELLS:-build/cli/viewcells}"
 out=out/bench/conservative
+cameras="${CAMERAS:-1000}"
 mkdir -p "$out"
 for arg in "$@"; do
   m="${arg%%:*}"
   map="data/maps/bsp/$m.bsp"
-  if [ ! -f "$out/$m-cons-m.json" ]; then
+  if [ ! -f "$out/$m-cons.pvs" ]; then
     start=$(date +%s.%N)
     "$vc" -q bake "$map" --cells 300 --samples 300000 --agvs-samples 1000000 --near-samples 0 --seed 1 \
       --conservative -o "$out/$m-cons.pvs" --report "$out/$m-cons-bake.json"
     python3 -c "import time; print(round(time.time() - $start, 1))" > "$out/$m-cons.secs"
-    "$vc" -q measure "$map" "$out/$m-cons.pvs" --count 300 --seed 7 --report "$out/$m-cons-m.json"
   fi
-  [ -f "$out/$m-q3-m.json" ] || "$vc" -q measure "$map" --count 300 --seed 7 --report "$out/$m-q3-m.json"
+  [ -f "$out/$m-cons-m$cameras.json" ] ||
+    "$vc" -q measure "$map" "$out/$m-cons.pvs" --count "$cameras" --seed 7 --report "$out/$m-cons-m$cameras.json"
+  [ -f "$out/$m-q3-m$cameras.json" ] ||
+    "$vc" -q measure "$map" --count "$cameras" --seed 7 --report "$out/$m-q3-m$cameras.json"
 done
-python3 - "$out" "$@" <<'PY'
+python3 - "$out" "$cameras" "$@" <<'PY'
 import json, sys
-out = sys.argv[1]
+out, cams = sys.argv[1], sys.argv[2]
 print("| map | half | conservative / q3map2 cost per frame | frames with a wrong pixel, conservative | q3map2 | worst frame (px per 1024^2) | pairs proven visible / hidden / undecided | seen by rays, proven hidden | cost bounds (visible, with undecided; by volume) | floods over budget | proof s | bake s |")
 print("|---|---|---:|---:|---:|---:|---|---:|---|---:|---:|---:|")
-for m, half in [a.split(":") for a in sys.argv[2:]]:
+for m, half in [a.split(":") for a in sys.argv[3:]]:
     b = json.load(open(f"{out}/{m}-cons-bake.json")); h = b["hidden"]
-    c = json.load(open(f"{out}/{m}-cons-m.json")); q = json.load(open(f"{out}/{m}-q3-m.json"))
+    c = json.load(open(f"{out}/{m}-cons-m{cams}.json")); q = json.load(open(f"{out}/{m}-q3-m{cams}.json"))
     pe, qe, n = c["pixel_error"], q["pixel_error"], c["cameras"]["count"]
     p, cb = h["pairs"], h["cost_per_frame"]
     secs = open(f"{out}/{m}-cons.secs").read().strip()

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Fuzzes every reader with libFuzzer (clang-14, AddressSanitizer and UBSan): OBJ, PLY, OFF, STL,
 # Quake 3 BSP, binary glTF and FBX (through Assimp), .vseg, .vcells, .pvs and .vagvs, and the engines'
-# runtime reader (runtime/: a .pvs payload and two query points, through every C API call). Seed
+# runtime reader (runtime/: a .pvs payload and two query points, through every C API call), and vc_bake
+# on objects and option words from the bytes, its result opened from memory. Seed
 # corpora are made by the project's own generators and commands (in build-fuzz/corpus, not in git); the toolkit's own formats are
 # fuzzed as container payloads, so that inputs get past the checksum to the parsers.
 # Each target runs SECONDS (default 60), two at a time; findings (crash-, leak-, oom-,
@@ -12,7 +13,7 @@ cd "$(dirname "$0")/.."
 seconds="${1:-60}"
 shift $(( $# > 0 ? 1 : 0 ))
 targets=("$@")
-[ ${#targets[@]} -gt 0 ] || targets=(obj ply off stl bsp glb fbx vseg vcells pvs runtime vagvs)
+[ ${#targets[@]} -gt 0 ] || targets=(obj ply off stl bsp glb fbx vseg vcells pvs runtime vagvs bake)
 
 bash scripts/install-deps.sh --fuzz
 CC=clang-14 CXX=clang++-14 bash scripts/build.sh build-fuzz RelWithDebInfo -DVIEWCELLS_FUZZ=ON -DVIEWCELLS_BUILD_TESTS=OFF
@@ -47,7 +48,7 @@ obj_to_stl() {
 if [ ! -f "$corpus/done" ]; then
   echo "fuzz: making seed corpora"
   rm -rf "$corpus"
-  for t in obj ply off stl bsp glb fbx vseg vcells pvs runtime vagvs; do mkdir -p "$corpus/$t"; done
+  for t in obj ply off stl bsp glb fbx vseg vcells pvs runtime vagvs bake; do mkdir -p "$corpus/$t"; done
   work=$(mktemp -d)
   "$vc" -q generate office --size 1 -o "$corpus/obj/office.obj"
   "$vc" -q generate rotated-office --size 1 --seed 2 -o "$corpus/obj/rotated.obj"
@@ -71,6 +72,9 @@ if [ ! -f "$corpus/done" ]; then
   { head -c 1 "$corpus/pvs/office"; head -c 24 /dev/zero; printf '\x00\x00\x00\x00\x00\x00\xe0\x7f%.0s' 1 2 3;
     tail -c +2 "$corpus/pvs/office"; } >"$corpus/runtime/office"
   cp data/fuzz/regressions/runtime/* "$corpus/runtime/"
+  # vc_bake's input (tests/fuzz/entries.cpp, entry_bake): two closed cubes, with and without
+  # option words, and bad vertices and indices.
+  cp data/fuzz/regressions/bake/* "$corpus/bake/"
   VIEWCELLS_FUZZ_SEED="$work/state.vagvs" "$bin/fuzz_vagvs" >/dev/null 2>&1
   payload "$work/state.vagvs" "$corpus/vagvs/office"
   # The two smallest OpenArena maps, when scripts/fetch-maps.sh has fetched them.
@@ -80,6 +84,10 @@ if [ ! -f "$corpus/done" ]; then
   printf 'IBSP\x2e\x00\x00\x00' >"$corpus/bsp/header-only"
   rm -rf "$work"
   touch "$corpus/done"
+fi
+if [ ! -d "$corpus/bake" ]; then  # corpora made before the bake target existed
+  mkdir -p "$corpus/bake"
+  cp data/fuzz/regressions/bake/* "$corpus/bake/"
 fi
 
 run_one() {

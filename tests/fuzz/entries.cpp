@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <cstring>
+#include <iterator>
+#include <vector>
 #include <memory>
 #include <optional>
 #include <sstream>
@@ -18,6 +20,7 @@
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pvs/pvs.h"
+#include "viewcells/bake.h"
 #include "viewcells/runtime.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/segments.h"
@@ -223,6 +226,70 @@ void write_vagvs_seed(const std::string& path) {
   AgvsSolver solver(f.scene, *f.caster, f.cells, f.config);
   solver.run();
   solver.save(path, kIdentity);
+}
+
+void entry_bake(const uint8_t* data, size_t size) {
+  // The in-memory C API end to end (issue 67). Byte 0: objects (1 to 4). Per object: vertex
+  // count, triangle count (0 to 15 each) and a see-through flag; then three bytes per vertex
+  // (grid coordinates 0 to 15, or, from 250 up, NaN, infinities, 1e300, -0), three per
+  // triangle (vertex indices, possibly out of range); the rest picks option words from a
+  // dictionary of cheap ones (so that a run stays short) after a small base bake. Whatever
+  // vc_bake accepts must give a file the runtime opens with exactly that many objects (ids are
+  // positions). The input's bytes also go to vc_pvs_open_memory as they are.
+  size_t at = 0;
+  auto next = [&]() -> uint8_t { return at < size ? data[at++] : 0; };
+  const size_t n = 1 + next() % 4;
+  std::vector<std::vector<double>> vertices(n);
+  std::vector<std::vector<uint32_t>> indices(n);
+  std::vector<int> see_through(n);
+  std::vector<std::string> names(n);
+  for (size_t i = 0; i < n; ++i) {
+    const uint32_t v = next() % 16, t = next() % 16;
+    see_through[i] = next() & 1;
+    names[i] = "o" + std::to_string(i);
+    for (uint32_t k = 0; k < 3 * v; ++k) {
+      const uint8_t b = next();
+      const double special[] = {std::nan(""), INFINITY, -INFINITY, 1e300, -0.0, 0.5};
+      vertices[i].push_back(b >= 250 ? special[b - 250] : static_cast<double>(b % 16));
+    }
+    for (uint32_t k = 0; k < 3 * t; ++k) indices[i].push_back(next() % 20);
+  }
+  static const char* const kWords[] = {"--seed", "7", "--no-ga", "--prove-hidden", "--conservative", "--cells", "3", "0",
+                                       "-1", "99999999999999999999", "nan", "x", "--memory", "1K", "--time", "0.5",
+                                       "--aimed-rays", "8", "--view-box", "0,0,0,1,1,1", "--samples", "--max-cells",
+                                       "--near-samples", "--objects", "groups", "--report", "-o", "--help", "--holes",
+                                       "50%", "", "--pixel-error", "1e-300"};
+  std::vector<std::string> words = {"--cells", "2", "--samples", "500", "--agvs-samples", "500", "--near-samples", "0",
+                                    "--max-cells", "8"};
+  while (at < size && words.size() < 24) words.push_back(kWords[next() % std::size(kWords)]);
+  std::vector<const char*> options;
+  for (const std::string& w : words) options.push_back(w.c_str());
+  options.push_back(nullptr);
+  std::vector<vc_bake_object> objects;
+  for (size_t i = 0; i < n; ++i)
+    objects.push_back({names[i].c_str(), vertices[i].data(), static_cast<uint32_t>(vertices[i].size() / 3),
+                       indices[i].data(), static_cast<uint32_t>(indices[i].size() / 3), see_through[i]});
+  vc_bake_result* result = nullptr;
+  char error[256] = "";
+  const int code = vc_bake(objects.data(), objects.size(), options.data(), nullptr, nullptr, nullptr, &result, error,
+                           sizeof error);
+  if ((code == 0) != (result != nullptr) || code < 0 || code > 3 || (code != 0 && error[0] == '\0')) std::abort();
+  if (result) {
+    size_t bytes = 0;
+    const void* image = vc_bake_result_bytes(result, &bytes);
+    vc_pvs* p = nullptr;
+    if (vc_pvs_open_memory(image, bytes, 0, &p, nullptr, 0) != 0) std::abort();  // what it wrote must open
+    if (vc_pvs_object_count(p) != n) std::abort();                                 // ids are positions
+    vc_pvs_close(p);
+    vc_bake_result_free(result);
+  }
+  for (int compact : {0, 1}) {
+    vc_pvs* p = nullptr;
+    if (vc_pvs_open_memory(data, size, compact, &p, nullptr, 0) == 0) {
+      (void)vc_pvs_locate(p, 0.5, 0.5, 0.5);
+      vc_pvs_close(p);
+    }
+  }
 }
 
 }  // namespace viewcells::fuzz

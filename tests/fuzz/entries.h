@@ -25,6 +25,9 @@ void entry_pvs(const uint8_t* data, size_t size);
 /// The engines' reader (runtime/): bytes 1-48 of the input are two query points (raw doubles),
 /// the rest a .pvs payload in a valid container; every C API call, checked against the toolkit.
 void entry_runtime(const uint8_t* data, size_t size);
+/// vc_bake on objects and option words from the bytes (see entries.cpp), its result opened by
+/// the runtime from memory; the same bytes through vc_pvs_open_memory.
+void entry_bake(const uint8_t* data, size_t size);
 /// Loads the state into an AGVS solver over a small office, and samples on when it loads.
 void entry_vagvs(const uint8_t* data, size_t size);
 /// Writes a state of entry_vagvs's solver (for the seed corpus).

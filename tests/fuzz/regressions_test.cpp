@@ -17,7 +17,7 @@ TEST(FuzzRegressions, SavedFindingsEndInAnErrorOrSuccess) {
       {"obj", entry_obj}, {"ply", entry_ply},       {"off", entry_off}, {"stl", entry_stl},     {"bsp", entry_bsp},
       {"glb", entry_glb}, {"fbx", entry_fbx},
       {"vseg", entry_vseg}, {"vcells", entry_vcells}, {"pvs", entry_pvs}, {"runtime", entry_runtime},
-      {"vagvs", entry_vagvs}};
+      {"vagvs", entry_vagvs}, {"bake", entry_bake}};
   const std::filesystem::path root = std::filesystem::path(VIEWCELLS_DATA_DIR) / "fuzz" / "regressions";
   size_t replayed = 0;
   for (const auto& [format, entry] : formats) {

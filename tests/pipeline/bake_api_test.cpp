@@ -4,6 +4,7 @@
 // failing bake leaves an earlier file as it was.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
@@ -209,6 +210,44 @@ TEST(BakeApi, RefusesBadArgumentsWithAMessageAndKeepsEarlierFiles) {
   char small[8];
   EXPECT_EQ(vc_bake(nullptr, 0, nullptr, nullptr, nullptr, nullptr, nullptr, small, sizeof small), 1);
   EXPECT_EQ(std::string(small), "vc_bake");  // truncated, NUL-terminated
+}
+
+// bake.h promises that an object's id is its position in the array: an object with no triangles
+// (or only degenerate ones) keeps its id, and the ids after it do not shift (issue 67: they
+// did). And a missing output directory is an error before the bake, not after it.
+TEST(BakeApi, ObjectIdsArePositionsAlsoPastAnEmptyObject) {
+  Meshes m = office();
+  const size_t n = m.names.size();
+  m.names.insert(m.names.begin() + 1, "empty");
+  m.vertices.insert(m.vertices.begin() + 1, std::vector<double>{});
+  m.indices.insert(m.indices.begin() + 1, std::vector<uint32_t>{});
+  m.see_through.insert(m.see_through.begin() + 1, 0);
+  m.names.insert(m.names.begin() + 3, "flat");  // one triangle with three equal corners
+  m.vertices.insert(m.vertices.begin() + 3, std::vector<double>{1, 1, 1});
+  m.indices.insert(m.indices.begin() + 3, std::vector<uint32_t>{0, 0, 0});
+  m.see_through.insert(m.see_through.begin() + 3, 0);
+  vc_bake_result* r = nullptr;
+  std::string error;
+  ASSERT_EQ(bake(m, kOptions, nullptr, &r, &error), 0) << error;
+  size_t size = 0;
+  const void* bytes = vc_bake_result_bytes(r, &size);
+  vc_pvs* p = nullptr;
+  ASSERT_EQ(vc_pvs_open_memory(bytes, size, 0, &p, nullptr, 0), 0);
+  EXPECT_EQ(vc_pvs_object_count(p), n + 2);
+  std::vector<uint32_t> seen;
+  for (uint32_t c = 0; c < vc_pvs_cell_count(p); ++c) {
+    const uint32_t* list = nullptr;
+    const size_t count = vc_pvs_cell_objects(p, static_cast<int32_t>(c), &list);
+    seen.insert(seen.end(), list, list + count);
+  }
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 1u), 0);
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 3u), 0);
+  EXPECT_EQ(*std::max_element(seen.begin(), seen.end()), n + 1) << "the last object keeps its position";
+  vc_pvs_close(p);
+  vc_bake_result_free(r);
+  const std::string missing = test::temp_path("no_such_dir/x.pvs");
+  EXPECT_EQ(bake(m, {"--cells", "4", "--samples", "1000000000"}, missing.c_str(), &r, &error), 2);
+  EXPECT_NE(error.find("does not exist"), std::string::npos) << error;
 }
 
 }  // namespace
