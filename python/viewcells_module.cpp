@@ -104,7 +104,11 @@ std::shared_ptr<const Scene> scene_from_arrays(py::array_t<double, py::array::c_
       throw Error(name, 0, "objects must give one object id per triangle");
     const auto o = objects->unchecked<1>();
     for (py::ssize_t i = 0; i < o.shape(0); ++i) {
-      if (o(i) < 0 || o(i) >= (int64_t{1} << 31)) throw Error(name, 0, "object ids must be from 0 to 2^31 - 1");
+      // Ids are kept (every id below the largest is an object): bounded so that a stray large
+      // id cannot ask for billions of objects.
+      if (o(i) < 0 || o(i) >= (int64_t{1} << 24))
+        throw Error(name, 0, "objects: entry " + std::to_string(i) + " is " + std::to_string(o(i)) +
+                                 "; object ids must be from 0 to 2^24 - 1 (16777215)");
       mesh.triangle_group.push_back(static_cast<uint32_t>(o(i)));
       groups = std::max(groups, o(i) + 1);
     }

@@ -335,6 +335,8 @@ def test_arguments_are_checked_before_any_work(tmp_path):
     assert viewcells.Scene(v, t.astype(float), objects=o).fingerprint == scene.fingerprint
     with pytest.raises(viewcells.Error, match="whole numbers"):
         viewcells.Scene(v, t, objects=o + 0.5)
+    with pytest.raises(viewcells.Error, match=r"objects: entry 0 is 2147483647; object ids must be from 0 to 2\^24 - 1"):
+        viewcells.Scene(v, t, objects=np.full(len(t), 2**31 - 1))
     with pytest.raises(viewcells.Error, match=r"cells \(keyword\): 'true' is not allowed: give a whole number from 1"):
         viewcells.bake(scene, str(tmp_path / "x.pvs"), cells=True)
     with pytest.raises(viewcells.Error, match="help is not an option of a bake from code") as e:

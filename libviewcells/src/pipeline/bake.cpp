@@ -226,7 +226,6 @@ ViewCellSet first_cut(const BakeConfig& c, const SubdivisionFile& file, const Lo
   return set;
 }
 
-/// The settings a bake refuses, before any work.
 /// The output is checked before any work (every front end gets this, not only the command
 /// line): its directory exists and is writable, it is not the scene being baked, and it is not
 /// inside the work directory, whose files a later run with the same directory reads.
@@ -253,6 +252,7 @@ void check_bake_paths(const BakeConfig& c) {
   }
 }
 
+/// The settings a bake refuses, before any work.
 void check_bake(const BakeConfig& c) {
   if ((c.cells > 0) == (c.memory > 0)) throw Error("bake needs one budget: --cells N or --memory BYTES");
   if (!(c.measured_error >= 0) || !std::isfinite(c.measured_error))
@@ -469,10 +469,10 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   Stopwatch total;
   BakeResult out;
   out.config = c;
-  // The whole bake's clock: a quarter for each of the merge's AGVS runs (the hierarchy's only
-  // stages without a bound of their own), what is left for the PVSs' AGVS.
+  // The whole bake's clock (BakeConfig::max_seconds): a quarter for each of the merge's AGVS
+  // runs (the hierarchy's only stages without a bound of their own); the later shares are set
+  // once the hierarchy is made. Frames stop at the bake's limit unless given an earlier one.
   BakeConfig run = c;
-  // Frames (measured or sampled) stop at the bake's limit; AGVS's measurements at its own.
   const Deadline deadline = Deadline::after(c.max_seconds);
   run.frame.deadline = run.sample_frame.deadline = deadline;
   if (c.max_seconds > 0 && run.merge_agvs) {

@@ -37,8 +37,13 @@ struct BakeConfig {
   bool memory_of_lists = false;
   AgvsConfig agvs;                 ///< stopping rule (pixel error, time, samples), seed, batch
   /// The whole bake's time limit in seconds (0: none): each of the merge's two AGVS runs
-  /// stops at a quarter of it, the PVSs' AGVS at what the hierarchy left (and at
-  /// agvs.max_seconds); a hierarchy that leaves nothing is an Error (its --work copy is kept).
+  /// stops at a quarter of it; the proof at half of what the hierarchy left (cells not begun
+  /// prove nothing); the PVSs' AGVS, with its measurements, at what is then left, less a quarter
+  /// for each later stage of frame samples, near-object samples or measuring (down to a half,
+  /// and at agvs.max_seconds); those stages, aimed rays included, at the limit itself, leaving
+  /// out the frames and rays not begun by then (the report says how many frames were measured).
+  /// The overshoot is one frame, one batch of rays and the file's writing. A hierarchy that
+  /// leaves nothing is an Error (its --work copy is kept).
   double max_seconds = 0;
   /// Cameras that measure the PVSs as `viewcells measure` does (its placement, seed and
   /// frames: on a Quake 3 map player eyes above reachable floors); 0: none. The file
