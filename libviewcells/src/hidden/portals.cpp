@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <deque>
 #include <functional>
 #include <limits>
 #include <set>
@@ -95,11 +96,12 @@ Convex convex_of(const Winding& w) {
   return c;
 }
 
-/// Clips `t` by every plane through an edge of one of `a`, `b` and a vertex of the other that
-/// has all of `a` behind it and all of `b` in front (a separating plane): a line from `a`
-/// through `b` meets what lies beyond `b` only in front of every such plane. False when
-/// nothing of `t` is left.
-bool clip_by_separators(const Convex& a, const Convex& b, Winding& t, double eps, double slack) {
+/// Every plane through an edge of one of `a`, `b` and a vertex of the other that has all of `a`
+/// behind it and all of `b` in front (a separating plane), oriented so that a line from `a`
+/// through `b` meets what lies beyond `b` only in front of each. The same for every target
+/// beyond `b`: a flood finds them once per portal sequence, not once per target.
+void separators(const Convex& a, const Convex& b, double eps, std::vector<HalfPlane>& out) {
+  out.clear();
   for (int pass = 0; pass < 2; ++pass) {
     const Convex& edges = pass == 0 ? a : b;
     const Convex& points = pass == 0 ? b : a;
@@ -132,10 +134,17 @@ bool clip_by_separators(const Convex& a, const Convex& b, Winding& t, double eps
         if (amax <= eps && bmin >= -eps && (bmax > eps || amin < -eps)) sign = 1;
         else if (amin >= -eps && bmax <= eps && (bmin < -eps || amax > eps)) sign = -1;
         else continue;
-        t = clip_collect(t, HalfPlane{n * sign, d0 * sign}, slack, nullptr);
-        if (t.empty()) return false;
+        out.push_back(HalfPlane{n * sign, d0 * sign});
       }
     }
+  }
+}
+
+/// Clips `t` by `planes` in order; false when nothing of it is left.
+bool clip_by(const std::vector<HalfPlane>& planes, Winding& t, double slack) {
+  for (const HalfPlane& h : planes) {
+    t = clip_collect(t, h, slack, nullptr);
+    if (t.empty()) return false;
   }
   return true;
 }
@@ -153,6 +162,9 @@ struct FloodRun {
   PortalGraph::FloodStats& stats;
   std::vector<uint8_t>& in_chain;
   std::vector<std::vector<uint64_t>> might;  ///< per depth
+  /// Per depth, the source's and the pass's separating planes (a deque: deeper levels are
+  /// added while shallower ones are in use).
+  std::deque<std::vector<HalfPlane>> separating;
   bool overflow = false;
   double eps, slack;
   uint64_t steps = 0;
@@ -179,22 +191,22 @@ struct FloodRun {
     if (st.remaining[static_cast<size_t>(g.portals_[q].to)] == 0) set_bit(st.done.data(), q);
   }
 
-  /// The placed polygons of `leaf` that a line from the source through `pass` (in front of
-  /// `pass_plane`) meets.
-  void see_through(const Convex& pass, const HalfPlane& pass_plane, int32_t leaf) {
+  /// The placed polygons of `leaf` that a line from the source through the pass (in front of
+  /// `pass_plane` and of its separating planes `seps`) meets.
+  void see_through(const std::vector<HalfPlane>& seps, const HalfPlane& pass_plane, int32_t leaf) {
     if (st.remaining[static_cast<size_t>(leaf)] == 0) return;
     for (const PortalGraph::Placed& p : g.placed_[static_cast<size_t>(leaf)]) {
       if (st.object_seen[p.object]) continue;
       Winding w = clip_collect(p.polygon, pass_plane, slack, nullptr);
-      if (!w.empty() && clip_by_separators(source, pass, w, eps, slack)) {
-        see(p.object);
-      }
+      if (!w.empty() && clip_by(seps, w, slack)) see(p.object);
     }
   }
 
   void recurse(const Winding& pass, const HalfPlane& pass_plane, int32_t leaf, size_t depth) {
-    const Convex pass_convex = convex_of(pass);
-    see_through(pass_convex, pass_plane, leaf);
+    if (separating.size() <= depth) separating.resize(depth + 1);
+    std::vector<HalfPlane>& seps = separating[depth];
+    separators(source, convex_of(pass), eps, seps);
+    see_through(seps, pass_plane, leaf);
     if (might.size() <= depth + 1) might.emplace_back(g.words_);
     const uint64_t* row = might[depth].data();
     for (const uint32_t qi : g.out_[static_cast<size_t>(leaf)]) {
@@ -221,7 +233,7 @@ struct FloodRun {
       }
       if (!more && test_bit(st.done.data(), qi)) continue;  // nothing it could add
       Winding t = clip_collect(q.winding, pass_plane, slack, nullptr);  // beyond the last portal
-      if (t.empty() || !clip_by_separators(source, pass_convex, t, eps, slack)) continue;
+      if (t.empty() || !clip_by(seps, t, slack)) continue;
       cross(qi);
       in_chain[static_cast<size_t>(q.to)] = 1;
       recurse(t, q.plane, q.to, depth + 1);
@@ -506,7 +518,7 @@ void PortalGraph::flood(const Polytope& source, int32_t start, FloodState& st, u
                         FloodStats& stats) const {
   VC_CHECK(st.visible.size() == words_ && st.remaining.size() == bsp_.leaf_count());
   std::vector<uint8_t> in_chain(bsp_.leaf_count(), 0);
-  FloodRun run{*this, convex_of(source, eps_), st, max_steps, stats, in_chain, {}, false, eps_, 10 * eps_};
+  FloodRun run{*this, convex_of(source, eps_), st, max_steps, stats, in_chain, {}, {}, false, eps_, 10 * eps_};
   run.might.emplace_back(words_);
   run.might.emplace_back(words_);
   // What lies in the region's own leaf may be seen from it.
