@@ -11,33 +11,37 @@ cd "$(dirname "$0")/.."
 vc="${VIEWCELLS:-build/cli/viewcells}"
 out=out/bench/conservative
 cameras="${CAMERAS:-1000}"
+steps="${PROOF_STEPS:-200000}"  # --proof-steps; another value bakes files of its own (NAME-sSTEPS)
 mkdir -p "$out"
 for arg in "$@"; do
-  m="${arg%%:*}"
-  map="data/maps/bsp/$m.bsp"
+  name="${arg%%:*}"
+  map="data/maps/bsp/$name.bsp"
+  m="$name"
+  [ "$steps" = 200000 ] || m="$name-s$steps"
   if [ ! -f "$out/$m-cons.pvs" ]; then
     start=$(date +%s.%N)
     "$vc" -q bake "$map" --cells 300 --samples 300000 --agvs-samples 1000000 --near-samples 0 --seed 1 \
-      --conservative -o "$out/$m-cons.pvs" --report "$out/$m-cons-bake.json"
+      --proof-steps "$steps" --conservative -o "$out/$m-cons.pvs" --report "$out/$m-cons-bake.json"
     python3 -c "import time; print(round(time.time() - $start, 1))" > "$out/$m-cons.secs"
   fi
   [ -f "$out/$m-cons-m$cameras.json" ] ||
     "$vc" -q measure "$map" "$out/$m-cons.pvs" --count "$cameras" --seed 7 --report "$out/$m-cons-m$cameras.json"
-  [ -f "$out/$m-q3-m$cameras.json" ] ||
-    "$vc" -q measure "$map" --count "$cameras" --seed 7 --report "$out/$m-q3-m$cameras.json"
+  [ -f "$out/$name-q3-m$cameras.json" ] ||
+    "$vc" -q measure "$map" --count "$cameras" --seed 7 --report "$out/$name-q3-m$cameras.json"
 done
-python3 - "$out" "$cameras" "$@" <<'PY'
+python3 - "$out" "$cameras" "$steps" "$@" <<'PY'
 import json, sys
-out, cams = sys.argv[1], sys.argv[2]
+out, cams, steps = sys.argv[1], sys.argv[2], sys.argv[3]
 print("| map | half | conservative / q3map2 cost per frame | frames with a wrong pixel, conservative | q3map2 | worst frame (px per 1024^2) | pairs proven visible / hidden / undecided | seen by rays, proven hidden | cost bounds (visible, with undecided; by volume) | floods over budget | proof s | bake s |")
 print("|---|---|---:|---:|---:|---:|---|---:|---|---:|---:|---:|")
-for m, half in [a.split(":") for a in sys.argv[3:]]:
+for name, half in [a.split(":") for a in sys.argv[4:]]:
+    m = name if steps == "200000" else f"{name}-s{steps}"
     b = json.load(open(f"{out}/{m}-cons-bake.json")); h = b["hidden"]
-    c = json.load(open(f"{out}/{m}-cons-m{cams}.json")); q = json.load(open(f"{out}/{m}-q3-m{cams}.json"))
+    c = json.load(open(f"{out}/{m}-cons-m{cams}.json")); q = json.load(open(f"{out}/{name}-q3-m{cams}.json"))
     pe, qe, n = c["pixel_error"], q["pixel_error"], c["cameras"]["count"]
     p, cb = h["pairs"], h["cost_per_frame"]
     secs = open(f"{out}/{m}-cons.secs").read().strip()
-    print(f'| {m} | {half} | {c["frame"]["cost"] / q["frame"]["cost"]:.3f} | {pe["cameras_with_wrong_pixels"]} of {n} | '
+    print(f'| {name} | {half} | {c["frame"]["cost"] / q["frame"]["cost"]:.3f} | {pe["cameras_with_wrong_pixels"]} of {n} | '
           f'{qe["cameras_with_wrong_pixels"]} of {n} | {pe["worst_pixels"]:.0f} | {p["proven_visible"]} / {p["proven_hidden"]} / '
           f'{p["undecided"]} | {h["seen_but_proven_hidden"]} | {cb["proven_visible"]:.0f}, {cb["with_undecided"]:.0f} | '
           f'{h["floods_over_budget"]} of {h["floods"]} | {h["seconds"]:.0f} | {secs} |')

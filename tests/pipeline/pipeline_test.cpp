@@ -390,6 +390,21 @@ TEST(Pipeline, MeasureCountsACameraInNoCellAsAFrameDrawingNothing) {
   EXPECT_GE(r.error.cameras_wrong, r.error.cameras_uncovered) << "an eye in no cell sees the map";
   EXPECT_GT(r.error.worst_pixels, 1000.0);
   EXPECT_LE(r.error.p99_pixels, r.error.worst_pixels);
+  // The worst frames, as cameras to look through again: the first is the worst pixel count,
+  // each in the cell its eye is in, their objects' pixels adding up to the frame's.
+  ASSERT_FALSE(r.worst_frames.empty());
+  EXPECT_LE(r.worst_frames.size(), 10u);
+  EXPECT_DOUBLE_EQ(r.worst_frames.front().pixels, r.error.worst_pixels);
+  for (size_t i = 0; i < r.worst_frames.size(); ++i) {
+    const pipeline::WrongFrame& w = r.worst_frames[i];
+    if (i) {
+      EXPECT_LE(w.pixels, r.worst_frames[i - 1].pixels);
+    }
+    uint64_t sum = 0;
+    for (const auto& [o, px] : w.objects) sum += px;
+    EXPECT_DOUBLE_EQ(static_cast<double>(sum) * 1024 * 1024 / (64 * 48), w.pixels);
+    EXPECT_NEAR(length(w.forward), 1.0, 1e-9);
+  }
 }
 
 TEST(Pipeline, BakeTimeBoundsTheWholeBake) {

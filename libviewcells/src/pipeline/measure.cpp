@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <map>
+#include <span>
 
 #include "viewcells/cells/view_cells.h"
 #include "viewcells/core/error.h"
@@ -65,6 +67,36 @@ void frame_costs(const Scene& scene, const GlobalPvs& pvs, const std::vector<int
   std::sort(per_camera.begin(), per_camera.end());
   const size_t k = per_camera.size();
   out.median_frame_cost = k % 2 ? per_camera[k / 2] : 0.5 * (per_camera[k / 2 - 1] + per_camera[k / 2]);
+}
+
+}  // namespace
+
+namespace {
+
+/// The frames with the most wrong pixels (up to 10; ties by camera index), with their cameras.
+void worst_frames(const PixelErrorMeasure& e, std::span<const Camera> cameras, std::span<const int32_t> cells,
+                  const FrameConfig& frame, std::vector<WrongFrame>& out) {
+  std::map<uint32_t, WrongFrame> by_camera;
+  for (const WrongView& w : e.wrong) {
+    WrongFrame& f = by_camera[w.camera];
+    f.camera = w.camera;
+    f.pixels += static_cast<double>(w.pixels);
+    f.objects.emplace_back(w.object, w.pixels);
+  }
+  for (auto& [k, f] : by_camera) out.push_back(std::move(f));
+  std::sort(out.begin(), out.end(),
+            [](const WrongFrame& a, const WrongFrame& b) { return a.pixels != b.pixels ? a.pixels > b.pixels : a.camera < b.camera; });
+  if (out.size() > 10) out.resize(10);
+  const double scale = static_cast<double>(frame.resolution) / (static_cast<double>(frame.width) * frame.height);
+  for (WrongFrame& f : out) {
+    f.cell = cells[f.camera];
+    f.eye = cameras[f.camera].eye;
+    f.forward = cameras[f.camera].forward;
+    f.up = cameras[f.camera].up;
+    f.pixels *= scale;
+    std::sort(f.objects.begin(), f.objects.end(),
+              [](const auto& a, const auto& b) { return a.second != b.second ? a.second > b.second : a.first < b.first; });
+  }
 }
 
 }  // namespace
@@ -173,6 +205,7 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
   std::sort(order.begin(), order.end(), [&](uint32_t a, uint32_t b) { return pixels[a] != pixels[b] ? pixels[a] > pixels[b] : a < b; });
   if (order.size() > 10) order.resize(10);
   for (uint32_t o : order) out.worst.push_back({o, scene.objects[o].name, pixels[o], seen_by[o], cause[o]});
+  worst_frames(out.error, cameras, cells, c.frame, out.worst_frames);
 
   out.seconds = total.seconds();
   log("viewcells: " + out.measured + ": per frame " + fmt(out.frame_triangles, 4) + " triangles in " +

@@ -260,6 +260,14 @@ std::string report_json(const MeasureResult& r) {
   json worst = json::array();
   for (const WrongObject& w : r.worst)
     worst.push_back({{"object", w.object}, {"name", w.name}, {"pixels", w.pixels}, {"cameras", w.cameras}, {"cause", w.cause}});
+  json frames = json::array();
+  for (const WrongFrame& f : r.worst_frames) {
+    json objects = json::array();
+    for (const auto& [o, px] : f.objects) objects.push_back({{"object", o}, {"pixels", px}});
+    frames.push_back({{"camera", f.camera}, {"cell", f.cell}, {"eye", {f.eye.x, f.eye.y, f.eye.z}},
+                      {"forward", {f.forward.x, f.forward.y, f.forward.z}}, {"up", {f.up.x, f.up.y, f.up.z}},
+                      {"pixels", f.pixels}, {"objects", objects}});
+  }
   json report = {
       {"command", "measure"},
       {"scene", c.scene.path},
@@ -297,7 +305,8 @@ std::string report_json(const MeasureResult& r) {
                        {"worst_pixels", r.error.worst_pixels},
                        {"cameras_in_no_cell", r.error.cameras_uncovered},
                        {"by_cause", r.wrong_by_cause},
-                       {"worst_objects", worst}}},
+                       {"worst_objects", worst},
+                       {"worst_frames", frames}}},
       {"seconds", r.seconds}};
   if (r.leaf_surface_bytes) report["leaf_surface_bytes"] = r.leaf_surface_bytes;
   return text(report);

@@ -45,6 +45,15 @@ struct WrongObject {
   std::string cause;  ///< for the map's own PVS: see MeasureResult::wrong_by_cause; else "missed"
 };
 
+/// A frame with wrong pixels, as a camera to look through again (a viewer, a debugger).
+struct WrongFrame {
+  uint32_t camera = 0;  ///< its index among the cameras (seed and count give the same ones)
+  int32_t cell = -1;    ///< its view cell (-1: none)
+  Vec3 eye, forward, up;
+  double pixels = 0;  ///< wrong pixels, scaled to the resolution
+  std::vector<std::pair<uint32_t, uint64_t>> objects;  ///< (object, wrong pixels in this frame), most first
+};
+
 struct MeasureResult {
   MeasureConfig config;
   std::string measured;  ///< what was measured, in words
@@ -70,6 +79,7 @@ struct MeasureResult {
   /// For a .pvs: "missed" (what sampling did not find).
   std::map<std::string, uint64_t> wrong_by_cause;
   std::vector<WrongObject> worst;  ///< up to 10, most wrong pixels first
+  std::vector<WrongFrame> worst_frames;  ///< up to 10 frames, most wrong pixels first
   /// Primary rays a second, coherent packets against incoherent single rays, on the same
   /// frames in this run (frame_ray_rates).
   FrameRayRates ray_rates;
