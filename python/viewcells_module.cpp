@@ -616,5 +616,6 @@ PYBIND11_MODULE(viewcells, m) {
         "Bakes `scene` (a Scene, or a scene file's path) into the .pvs file `output`, with `viewcells bake`'s "
         "options as keywords and its defaults (cells=100 or memory='256K'; pixel_error, holes='1%', time, ...; "
         "report='r.json' writes the report). progress(line) receives the log lines. Ctrl-C stops the bake "
-        "within a second with KeyboardInterrupt, writing nothing. Returns the file read back.");
+        "within a second with KeyboardInterrupt, writing nothing (and stops any other bake running in the "
+        "process: the stop is process-wide). Returns the file read back.");
 }

@@ -102,32 +102,38 @@ AimedRays aim_at_undecided(const BakeConfig& c, const LoadedScene& loaded, const
       }
       if (eyes.empty()) continue;
       uint32_t sent = 0;
+      std::vector<uint8_t> seen;
       for (uint32_t round = 8; !open.empty() && sent < c.aimed_rays; round *= 2) {
         const uint32_t k = std::min(round, c.aimed_rays - sent);
         sent += k;
-        batch.clear();
-        owner.clear();
-        for (uint32_t i = 0; i < open.size(); ++i)
-          for (uint32_t j = 0; j < k; ++j) {
-            const Vec3 eye = eyes[rng.below(eyes.size())];
-            const Vec3 d = on_surface(open[i], rng) - eye;
-            const double len = length(d);
-            if (!(len > 0)) continue;
-            batch.push_back(Ray{eye, d * (1 / len), 0, len * (1 + 1e-6)});
-            owner.push_back(i);
+        seen.assign(open.size(), 0);
+        // In batches of at most about 2^20 rays, whatever the round's size.
+        const size_t per_batch = std::max<size_t>(1, (size_t{1} << 20) / k);
+        for (size_t first = 0; first < open.size(); first += per_batch) {
+          const size_t last = std::min(open.size(), first + per_batch);
+          batch.clear();
+          owner.clear();
+          for (size_t i = first; i < last; ++i)
+            for (uint32_t j = 0; j < k; ++j) {
+              const Vec3 eye = eyes[rng.below(eyes.size())];
+              const Vec3 d = on_surface(open[i], rng) - eye;
+              const double len = length(d);
+              if (!(len > 0)) continue;
+              batch.push_back(Ray{eye, d * (1 / len), 0, len * (1 + 1e-6)});
+              owner.push_back(static_cast<uint32_t>(i));
+            }
+          hits.resize(batch.size());
+          loaded.caster->intersect(batch, hits);
+          rays[cell] += batch.size();
+          for (size_t j = 0; j < batch.size(); ++j) {
+            const uint32_t o = open[owner[j]];
+            // An occluder is seen when it is what the ray meets first; a see-through object
+            // (never met: the caster skips it) when nothing is met before its point.
+            const bool reached = scene.objects[o].occluder
+                                     ? hits[j].hit() && hits[j].object == o
+                                     : !hits[j].hit() || hits[j].t >= batch[j].tfar / (1 + 1e-6) * (1 - 1e-6);
+            if (reached) seen[owner[j]] = 1;
           }
-        hits.resize(batch.size());
-        loaded.caster->intersect(batch, hits);
-        rays[cell] += batch.size();
-        std::vector<uint8_t> seen(open.size(), 0);
-        for (size_t j = 0; j < batch.size(); ++j) {
-          const uint32_t o = open[owner[j]];
-          // An occluder is seen when it is what the ray meets first; a see-through object
-          // (never met: the caster skips it) when nothing is met before its point.
-          const bool reached = scene.objects[o].occluder
-                                   ? hits[j].hit() && hits[j].object == o
-                                   : !hits[j].hit() || hits[j].t >= batch[j].tfar / (1 + 1e-6) * (1 - 1e-6);
-          if (reached) seen[owner[j]] = 1;
         }
         still.clear();
         for (uint32_t i = 0; i < open.size(); ++i) (seen[i] ? found[cell] : still).push_back(open[i]);
