@@ -11,7 +11,9 @@ cd "$(dirname "$0")/.."
 vc="${VIEWCELLS:-build/cli/viewcells}"
 out=out/bench/conservative
 cameras="${CAMERAS:-1000}"
-steps="${PROOF_STEPS:-200000}"  # --proof-steps; another value bakes files of its own (NAME-sSTEPS)
+# --proof-steps: 200,000 for the first table of docs/conservative.md (bake's default is now 2M);
+# another value bakes files of its own (NAME-sSTEPS).
+steps="${PROOF_STEPS:-200000}"
 mkdir -p "$out"
 for arg in "$@"; do
   name="${arg%%:*}"
