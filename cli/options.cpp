@@ -7,6 +7,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "viewcells/core/paths.h"
 #include "viewcells/core/ranks.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/binary_file.h"
@@ -157,11 +158,7 @@ void check_no_empty_values(const CLI::App& command) {
 void check_files(const std::vector<std::string>& inputs, const std::vector<std::string>& outputs,
                  const std::vector<std::string>& directories) {
   namespace fs = std::filesystem;
-  auto key = [](const std::string& p) {
-    std::error_code ec;
-    const fs::path k = fs::weakly_canonical(fs::absolute(p), ec);
-    return ec ? fs::absolute(p).lexically_normal().string() : k.string();
-  };
+  auto key = [](const std::string& p) { return path_key(p).string(); };
   std::vector<std::pair<std::string, std::string>> seen;  // (canonical, as given)
   for (const std::string& in : inputs)
     if (!in.empty()) seen.push_back({key(in), in});

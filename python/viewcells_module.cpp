@@ -22,7 +22,6 @@
 #include <cctype>
 #include <chrono>
 #include <condition_variable>
-#include <filesystem>
 #include <iterator>
 #include <mutex>
 #include <thread>
@@ -36,6 +35,7 @@
 #include "viewcells/core/binary_file.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/interrupt.h"
+#include "viewcells/core/paths.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pipeline/bake.h"
 #include "viewcells/pipeline/report.h"
@@ -340,13 +340,12 @@ struct Baked {
   }
   /// An output may not replace this file's scene or the .pvs itself.
   void refuse_inputs(const std::string& out) const {
-    namespace fs = std::filesystem;
-    const auto key = [](const std::string& p) {
-      std::error_code ec;
-      return fs::weakly_canonical(fs::absolute(p), ec);
-    };
-    if (key(out) == key(path)) throw Error(out, 0, "is the .pvs file read here: write elsewhere");
-    if (scene_file && key(out) == key(scene_file->path))
+    if (same_file(out, path)) throw Error(out, 0, "is the .pvs file read here: write elsewhere");
+    refuse_scene(out);
+  }
+  /// An output may not replace the scene this .pvs was baked from.
+  void refuse_scene(const std::string& out) const {
+    if (scene_file && same_file(out, scene_file->path))
       throw Error(out, 0, "is the scene this .pvs was baked from: write elsewhere");
   }
   std::vector<std::vector<uint32_t>> neighbours() const { return cells->neighbours(); }
@@ -354,12 +353,7 @@ struct Baked {
   /// reading back), and read back.
   std::shared_ptr<Baked> with_pvs(const py::object& target, const std::vector<std::vector<uint32_t>>& lists) const {
     const std::string out = path_of(target, "with_pvs: path");
-    if (scene_file) {
-      std::error_code ec;
-      if (std::filesystem::weakly_canonical(std::filesystem::absolute(out), ec) ==
-          std::filesystem::weakly_canonical(std::filesystem::absolute(scene_file->path), ec))
-        throw Error(out, 0, "is the scene this .pvs was baked from: write elsewhere");
-    }
+    refuse_scene(out);
     if (lists.size() != file.pvs.cell_count)
       throw Error(out, 0, "with_pvs needs one list per view cell: " + std::to_string(file.pvs.cell_count) +
                               " cells, " + std::to_string(lists.size()) + " lists given");
@@ -462,12 +456,7 @@ std::shared_ptr<Baked> bake(const py::object& scene, const py::object& output_pa
   if (memory) config.scene.scene = memory;
   if (!report.empty()) {
     check_output_target(report);
-    const auto same = [](const std::string& a, const std::string& b) {
-      std::error_code ec;
-      return std::filesystem::weakly_canonical(std::filesystem::absolute(a), ec) ==
-             std::filesystem::weakly_canonical(std::filesystem::absolute(b), ec);
-    };
-    if (same(report, output) || (!memory && same(report, name)))
+    if (same_file(report, output) || (!memory && same_file(report, name)))
       throw Error(report, 0, "is the .pvs or the scene of this bake: write the report elsewhere");
   }
   pipeline::Log log = [](const std::string&) {};

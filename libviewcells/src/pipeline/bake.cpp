@@ -17,6 +17,7 @@
 #include "viewcells/core/error.h"
 #include "viewcells/core/interrupt.h"
 #include "viewcells/core/parallel.h"
+#include "viewcells/core/paths.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/core/binary_file.h"
 #include "viewcells/pipeline/cut.h"
@@ -230,26 +231,13 @@ ViewCellSet first_cut(const BakeConfig& c, const SubdivisionFile& file, const Lo
 /// line): its directory exists and is writable, it is not the scene being baked, and it is not
 /// inside the work directory, whose files a later run with the same directory reads.
 void check_bake_paths(const BakeConfig& c) {
-  namespace fs = std::filesystem;
   if (c.output.empty()) return;
   check_output_target(c.output);
-  auto key = [](const std::string& p) {
-    std::error_code ec;
-    const fs::path k = fs::weakly_canonical(fs::absolute(p), ec);
-    return ec ? fs::absolute(p).lexically_normal() : k;
-  };
-  const fs::path out = key(c.output);
-  if (!c.scene.scene && !c.scene.path.empty() && out == key(c.scene.path))
+  if (!c.scene.scene && !c.scene.path.empty() && same_file(c.output, c.scene.path))
     throw Error(c.output, 0, "is the scene being baked (" + c.scene.path + "): the .pvs would replace it; write it elsewhere");
-  if (!c.work_dir.empty()) {
-    const fs::path dir = key(c.work_dir);
-    for (fs::path p = out.parent_path(); !p.empty(); p = p.parent_path()) {
-      if (p == dir)
-        throw Error(c.output, 0, "is inside the work directory " + c.work_dir +
-                                     ", whose files later runs with it read: write the .pvs elsewhere");
-      if (p == p.root_path()) break;
-    }
-  }
+  if (!c.work_dir.empty() && inside_directory(c.output, c.work_dir))
+    throw Error(c.output, 0, "is inside the work directory " + c.work_dir +
+                                 ", whose files later runs with it read: write the .pvs elsewhere");
 }
 
 /// The settings a bake refuses, before any work.
