@@ -65,6 +65,7 @@ void add_build_commands(CLI::App& app, const Common& common, Commands& commands)
   auto b = std::make_shared<BuildArgs>();
   auto* bc = app.add_subcommand("build", "Sample visibility and subdivide the view space into cells (AV-S, section 4.2)");
   add_sampling_options(bc, b->sampling);
+  add_floor_options(bc, b->sampling.floors);
   add_cell_options(bc, b->cells, "Stop at this many cells");
   bc->add_flag("--no-merge", b->no_merge, "Keep the AV-S cells: no merge history (extract and compress need one)");
   add_merge_options(bc, b->merge);

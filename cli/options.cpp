@@ -193,7 +193,62 @@ pipeline::SceneSource SamplingOptions::source() const {
   s.path = scene;
   s.grouping = parse_grouping(objects);
   s.robust = !fast;
+  s.floors = floors.floors();
   return s;
+}
+
+FloorSpaceConfig FloorOptions::floors() const {
+  FloorSpaceConfig c = config;
+  if (!eye_band.empty()) {
+    const std::vector<double> v = parse_numbers(eye_band, "--eye-band");
+    if (v.size() != 2 || !(v[0] >= 0 && v[1] > v[0]))
+      throw Error("--eye-band takes LO,HI in metres above the floor, 0 <= LO < HI (got '" + eye_band + "')");
+    c.eye_low = v[0];
+    c.eye_high = v[1];
+  }
+  for (const std::string& s : starts) {
+    const std::vector<double> v = parse_numbers(s, "--start");
+    if (v.size() != 3) throw Error("--start takes X,Y,Z in the scene's units (got '" + s + "')");
+    c.start_points.push_back({v[0], v[1], v[2]});
+  }
+  return c;
+}
+
+void add_floor_options(CLI::App* cmd, FloorOptions& a) {
+  FloorSpaceConfig& c = a.config;
+  const std::string g = "Play space from floors (scenes other than Quake 3 maps)";
+  cmd->add_option("--metres-per-unit", c.metres_per_unit,
+                  "Metres in one unit of the scene (default: the file's own: 1 for glTF, 1/32 for a Quake 3 map; "
+                  "1 when the file does not say, e.g. OBJ)")
+      ->check(CLI::PositiveNumber)
+      ->group(g);
+  cmd->add_option("--start", a.starts,
+                  "Where players start, X,Y,Z in scene units (repeatable; default: the file's spawn nodes, else every "
+                  "floor region of at least --min-region)")
+      ->group(g);
+  cmd->add_option("--player-height", c.player_height, "Free space a standing player needs above a floor, metres")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--step", c.step, "Highest step a player walks up, metres")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--eye-band", a.eye_band, "Eye heights above a floor, LO,HI metres (crouch to jump; default 1,3)")
+      ->group(g);
+  cmd->add_option("--walk-normal", c.walk_normal, "Least z of a walkable floor's unit normal (0.7: 45.6 degrees)")
+      ->check(CLI::Range(0.01, 1.0))
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--floor-cell", c.cell, "Spacing of the columns of rays that find the floors, metres")
+      ->check(CLI::Range(0.01, 100.0))
+      ->capture_default_str()
+      ->group(g);
+  cmd->add_option("--min-region", c.min_region,
+                  "With no start points: floor regions at least this large are starts, square metres")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str()
+      ->group(g);
 }
 
 SamplerConfig SamplingOptions::sampler(const Common& c) const {

@@ -80,6 +80,17 @@ void check_files(const std::vector<std::string>& inputs, const std::vector<std::
 /// Refuses an option given with an empty value (`-o ""`): no option of viewcells takes one.
 void check_no_empty_values(const CLI::App& command);
 
+/// Where players stand on a scene without a view space of its own (viewspace/floor_space.h):
+/// units, the player's body and start points, for bake, build, measure and play-space.
+struct FloorOptions {
+  FloorSpaceConfig config;  ///< the defaults, overwritten by the options given
+  std::string eye_band;     ///< "LO,HI" in metres
+  std::vector<std::string> starts;  ///< "X,Y,Z" each, in scene units
+  /// The config with eye_band and starts parsed (Error naming the option when malformed).
+  FloorSpaceConfig floors() const;
+};
+void add_floor_options(CLI::App* cmd, FloorOptions& a);
+
 /// Scene and sampling options shared by sample, build, compare and bake.
 struct SamplingOptions {
   std::string scene;
@@ -91,6 +102,7 @@ struct SamplingOptions {
   std::string empty_space = "auto";
   bool fast = false;
   int max_recasts = 8;
+  FloorOptions floors;  ///< given with add_floor_options
 
   pipeline::SceneSource source() const;
   SamplerConfig sampler(const Common& c) const;

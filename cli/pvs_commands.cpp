@@ -232,6 +232,7 @@ std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, 
       "The whole chain in one command: sample, subdivide and merge, cut view cells under the budget, compute "
       "their PVSs by AGVS to the pixel error asked for, compress and write a .pvs file for the engine");
   add_sampling_options(bk, a->sampling);
+  add_floor_options(bk, a->sampling.floors);
   auto* cells = bk->add_option("--cells", a->bound.cells, "Budget: this many view cells")->check(whole(1, kMaxCells));
   bk->add_option("--memory", a->memory,
                  "Budget: a .pvs file of at most this many bytes (K, M, G allowed); the file written is measured, "
@@ -358,6 +359,7 @@ struct MeasureArgs {
   }();
   std::string objects = "auto", cameras = "auto", report;
   bool fast = false;
+  FloorOptions floors;
 };
 
 int run_measure(const MeasureArgs& a, const Common& c) {
@@ -366,6 +368,7 @@ int run_measure(const MeasureArgs& a, const Common& c) {
   pipeline::MeasureConfig config = a.config;
   config.scene.grouping = parse_grouping(a.objects);
   config.scene.robust = !a.fast;
+  config.scene.floors = a.floors.floors();
   config.cameras.placement = pipeline::parse_camera_placement(a.cameras);
   config.model.validate();
   const pipeline::MeasureResult result = pipeline::measure(config, c.logger());
@@ -387,8 +390,9 @@ void add_measure_command(CLI::App& app, const Common& common, Commands& commands
   ms->add_option("--objects", a->objects, "Object grouping used when the .pvs file was made")->capture_default_str();
   ms->add_option("--cameras", a->cameras,
                  "Where cameras stand: play (a Quake 3 map: player eyes 50 units above walkable floors reachable "
-                 "from the spawn points, any yaw, pitch within --max-pitch), view-box (uniform random points of the "
-                 "view space, looking anywhere) or auto (play on a map)")
+                 "from the spawn points; other scenes: eyes above the floors of the play space found from the "
+                 "geometry, see the play-space options; any yaw, pitch within --max-pitch), view-box (uniform random "
+                 "points of the view space, looking anywhere) or auto (play on a map, view-box elsewhere)")
       ->capture_default_str();
   ms->add_option("--count", a->config.cameras.count, "Number of cameras")->capture_default_str()->check(whole(1, 10'000'000));
   ms->add_option("--width", a->config.frame.width,
@@ -407,6 +411,7 @@ void add_measure_command(CLI::App& app, const Common& common, Commands& commands
   ms->add_option("--cost-a", a->config.model.a, "Render cost model: r = max(a, b * triangles)")->capture_default_str();
   ms->add_option("--cost-b", a->config.model.b, "Render cost model: cost per triangle")->capture_default_str();
   ms->add_flag("--fast", a->fast, "Embree without robust mode");
+  add_floor_options(ms, a->floors);
   ms->add_option("--report", a->report, "JSON report (default: printed)");
   commands.push_back({ms, [a, &common] { return run_measure(*a, common); }});
 }

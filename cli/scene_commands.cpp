@@ -6,8 +6,10 @@
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/io/scene_io.h"
+#include "viewcells/pipeline/play.h"
 #include "viewcells/pipeline/report.h"
 #include "viewcells/scene/generators.h"
+#include "viewcells/vis/level_view.h"
 
 namespace viewcells::cli {
 
@@ -32,6 +34,50 @@ int run_generate(const GenerateArgs& a, const Common& c) {
   c.log("viewcells: generated " + std::string(to_string(config.kind)) + " (size " + std::to_string(a.size) +
         ", seed " + std::to_string(a.seed) + "): " + std::to_string(scene.object_count()) + " objects, " +
         std::to_string(scene.triangle_count()) + " triangles -> " + a.output + " in " + fmt(sw.seconds(), 2) + " s");
+  return 0;
+}
+
+struct ConvertArgs {
+  std::string scene, output;
+  std::string objects = "auto";
+  double metres_per_unit = 0;
+  bool start_points = false;
+};
+
+int run_convert(const ConvertArgs& a, const Common& c) {
+  check_files({a.scene}, {a.output});
+  if (lower_extension(a.output) != ".glb") throw Error(a.output, 0, "convert writes binary glTF: give a .glb output");
+  Stopwatch sw;
+  const Scene scene = load_scene(a.scene, parse_grouping(a.objects));
+  const bool map = pipeline::is_q3_map(a.scene);
+  SceneGltfOptions options;
+  options.metres_per_unit = a.metres_per_unit > 0 ? a.metres_per_unit
+                            : scene.metres_per_unit > 0 ? scene.metres_per_unit : 1.0;
+  if (a.start_points) options.start_points = map ? q3_spawn_points(read_q3bsp(a.scene)) : scene.start_points;
+  write_scene_gltf(a.output, scene, options);
+  size_t rendered = 0;
+  for (const ObjectInfo& o : scene.objects) rendered += o.rendered;
+  c.log("viewcells: " + a.scene + " -> " + a.output + ": " + std::to_string(rendered) + " rendered objects of " +
+        std::to_string(scene.object_count()) + ", 1 unit = " + fmt(options.metres_per_unit, 5) + " m, " +
+        std::to_string(options.start_points.size()) + " start points, in " + fmt(sw.seconds(), 2) + " s");
+  return 0;
+}
+
+struct PlayArgs {
+  pipeline::PlaySpaceRunConfig config;
+  std::string objects = "auto", report;
+  FloorOptions floors;
+};
+
+int run_play(const PlayArgs& a, const Common& c) {
+  check_files({a.config.scene.path, a.config.map}, {a.config.image, a.report});
+  ThreadLimit threads(c.threads);
+  pipeline::PlaySpaceRunConfig config = a.config;
+  config.scene.grouping = parse_grouping(a.objects);
+  config.scene.floors = a.floors.floors();
+  const pipeline::PlaySpaceRun run = pipeline::play_space(config, c.logger());
+  if (!a.report.empty()) write_text_file(a.report, pipeline::report_json(run));
+  else std::cout << pipeline::report_json(run);
   return 0;
 }
 
@@ -123,6 +169,50 @@ void add_scene_commands(CLI::App& app, const Common& common, Commands& commands)
       ->capture_default_str();
   g->add_option("-o,--output", gen->output, "Output .obj file")->required();
   commands.push_back({g, [gen, &common] { return run_generate(*gen, common); }});
+
+  auto cv = std::make_shared<ConvertArgs>();
+  auto* co = app.add_subcommand(
+      "convert", "Write a scene as a glTF level (.glb, y-up, metres): its rendered objects as meshes in object order, "
+                 "nothing else (a Quake 3 map's brushes, leaves and entities are left behind)");
+  co->add_option("scene", cv->scene, "Scene file (.obj, .ply, .off, .stl, .gltf, .glb, a Quake 3 .bsp, ...)")->required();
+  co->add_option("-o,--output", cv->output, "The .glb file to write")->required();
+  co->add_option("--objects", cv->objects, "Object grouping: auto | groups | components | triangles | nodes | meshes")
+      ->capture_default_str();
+  co->add_option("--metres-per-unit", cv->metres_per_unit,
+                 "Metres in one unit of the scene (default: the file's own; 1/32 for a Quake 3 map, whose 56-unit "
+                 "player is then 1.75 m tall; 1 when the file does not say)")
+      ->check(CLI::PositiveNumber);
+  co->add_flag("--start-points", cv->start_points,
+               "Also write where players start, as empty nodes named 'spawn N' (a Quake 3 map's spawn entities)");
+  commands.push_back({co, [cv, &common] { return run_convert(*cv, common); }});
+
+  auto pl = std::make_shared<PlayArgs>();
+  auto* ps = app.add_subcommand(
+      "play-space",
+      "Find where players stand on a scene from its geometry (walkable floors with room for a player, reachable "
+      "by walking, stepping and dropping from start points; bake's default view space where it finds one) and "
+      "report it; with --map, check it against the Quake 3 map the scene was converted from");
+  ps->add_option("scene", pl->config.scene.path, "The scene (glTF, OBJ, ...)")->required();
+  ps->add_option("--objects", pl->objects, "Object grouping: auto | groups | components | triangles | nodes | meshes")
+      ->capture_default_str();
+  ps->add_option("--map", pl->config.map,
+                 "The Quake 3 map (.bsp) the scene was converted from (viewcells convert): report how much of the "
+                 "map's play space (its eye band) the one found covers, and how much it adds outside");
+  ps->add_option("--points", pl->config.points, "With --map: uniform points that measure the volumes")
+      ->capture_default_str()
+      ->check(whole(1, 1'000'000'000));
+  ps->add_option("--seed", pl->config.seed, "With --map: seed of the points")
+      ->capture_default_str()
+      ->check(whole(0, UINT64_MAX));
+  ps->add_option("--image", pl->config.image,
+                 "With --map: a top-down PNG, green where both play spaces hold a floor's eye band, red where only "
+                 "the map's does, blue where only the one found does");
+  ps->add_option("--image-width", pl->config.image_width, "Width of the picture in pixels")
+      ->capture_default_str()
+      ->check(whole(16, 8192));
+  ps->add_option("--report", pl->report, "JSON report (default: printed)");
+  add_floor_options(ps, pl->floors);
+  commands.push_back({ps, [pl, &common] { return run_play(*pl, common); }});
 
   auto info = std::make_shared<InfoArgs>();
   auto* i = app.add_subcommand("info", "Describe a scene: objects, triangles, bounds, closedness, axis alignment");

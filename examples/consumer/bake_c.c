@@ -14,8 +14,10 @@
 
 static double vertices[MAX_OBJECTS][24];
 static char names[MAX_OBJECTS][32];
-static const uint32_t box_faces[36] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
-                                       1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+/* Corner i of a box has x from bit 0, y from bit 1, z from bit 2; each face's two triangles wind
+ * counter-clockwise seen from outside (a closed solid: empty-space detection and floors apply). */
+static const uint32_t box_faces[36] = {0, 2, 3, 0, 3, 1, 4, 5, 7, 4, 7, 6, 0, 1, 5, 0, 5, 4,
+                                       2, 6, 7, 2, 7, 3, 0, 4, 6, 0, 6, 2, 1, 3, 7, 1, 7, 5};
 static vc_bake_object objects[MAX_OBJECTS];
 static size_t count = 0;
 

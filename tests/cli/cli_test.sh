@@ -92,8 +92,21 @@ expect_error "truncated.off" "$VC" info truncated.off
 expect_error "unknown scene kind" "$VC" generate castle -o x.obj
 expect_error "view-box" "$VC" sample office.obj --view-box 1,2,3
 expect_error "min < max" "$VC" sample office.obj --view-box 0,0,0,1,1,0
-expect_error "office.obj: --play-space needs a Quake 3 map" "$VC" build office.obj --play-space -o play.vcells
-expect_error "office.obj: --play-space needs a Quake 3 map" "$VC" bake office.obj --play-space --cells 10 -o play.pvs
+# A scene with no floor a player fits on (boxes 1 m apart under a slab 1.2 m up) has no play space:
+# --play-space is an error that says why, and bake's default keeps the view box and says so.
+printf 'v 0 0 0\nv 9 0 0\nv 9 9 0\nv 0 9 0\nv 0 0 1.2\nv 9 0 1.2\nv 9 9 1.2\nv 0 9 1.2\nf 1 2 3 4\nf 8 7 6 5\n' > lowroom.obj
+expect_error "lowroom.obj: --play-space needs a view space that knows where players stand: the scene has none: no walkable floor" \
+  "$VC" build lowroom.obj --play-space -o play.vcells
+expect_error "the scene has none: no walkable floor" "$VC" bake lowroom.obj --play-space --cells 4 -o play.pvs
+expect_ok "$VC" bake lowroom.obj --cells 4 --samples 5000 --agvs-samples 5000 -o lowroom.pvs --report lowroom.json -q
+json_get lowroom.json "['settings']['view_space']" | grep -q "the whole view box: no play space (no walkable floor" && ok ||
+  bad "bake on a scene without floors: the report does not say the view box was kept and why"
+# The office has floors: bake finds its play space by default and says so; measure's play cameras stand there.
+expect_ok "$VC" play-space office.obj --report office-play.json -q
+python3 -c "
+import json; r = json.load(open('office-play.json'))
+assert r['found'] and r['floor_area_m2'] > 100 and 'no start points' in r['rule'], r
+" && ok || bad "play-space on the office"
 expect_error "empty-space" "$VC" sample office.obj --empty-space maybe
 expect_error "samples" "$VC" sample office.obj --samples 0
 
@@ -466,7 +479,7 @@ for f in ('q3m.json', 'ourm.json'):
     assert sum(r['pixel_error']['by_cause'].values()) == round(r['pixel_error']['share'] * 300 * 64 * 48), f
     assert 'spawn points' in r['cameras']['placement'], f
 " && ok || bad "measure on oa_dm2: report"
-  expect_error "play cameras need a Quake 3 map" "$VC" measure office.obj dm2.pvs --cameras play
+  expect_error "play cameras: the scene has no play space" "$VC" measure lowroom.obj lowroom.pvs --cameras play
   expect_error "was not made for the scene" "$VC" measure office.obj dm2.pvs
 elif [ -n "${VIEWCELLS_REQUIRE_MAPS:-}" ]; then
   bad "oa_dm2.bsp is missing (scripts/fetch-maps.sh)"
@@ -573,8 +586,9 @@ expect_error "file or lists" "$VC" bake office.obj --memory 3000 --memory-of eve
 expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --max-cells 60 --agvs-samples 20000 --frame-samples 8 \
   --frame-size 64x48 -o framed.pvs --report framed.json -q
 python3 -c "
-import json; e = json.load(open('framed.json'))['effects']['frame_samples']
+import json; r = json.load(open('framed.json')); e = r['effects']['frame_samples']
 assert e['enabled'] and '96 frames of 64x48' in e['reason'], e
+assert r['settings']['view_space'].startswith('the play space'), r['settings']['view_space']
 " && ok || bad "bake --frame-samples: report"
 expect_error "WIDTHxHEIGHT" "$VC" bake office.obj --cells 12 --frame-samples 8 --frame-size 64 -o x.pvs
 # Rounds: after the first, frames only where the last ones still found something. Invariant (any

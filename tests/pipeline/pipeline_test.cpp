@@ -127,14 +127,23 @@ TEST(Pipeline, AViewSpaceOfItsOwnChangesNothingInThePipeline) {
   EXPECT_EQ(lower->play_space(*r.sampling.loaded.scene, *r.sampling.loaded.caster), nullptr);
 }
 
-TEST(Pipeline, PlaySpaceNeedsAMapAndIsTheOnlyDensity) {
+TEST(Pipeline, PlaySpaceNeedsFloorsAndIsTheOnlyDensity) {
   pipeline::BuildConfig c = small_build("");
   c.subdivision.play_space = true;
+  // The office's floors: its play space weighs the cells.
+  const pipeline::BuildResult r = pipeline::build(c, quiet);
+  EXPECT_NE(r.play_space.find("walkable floors"), std::string::npos) << r.play_space;
+  // Cubes with no floor a player could reach (1 m^2 tops, no start points): none.
+  c.scene.path = test::temp_path("cubes.obj");
+  write_obj(test::cube_grid(3), c.scene.path);
   try {
     pipeline::build(c, quiet);
-    ADD_FAILURE() << "--play-space on an OBJ was accepted";
+    ADD_FAILURE() << "--play-space on cubes was accepted";
   } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("--play-space needs a Quake 3 map"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("--play-space needs a view space that knows where players stand: the scene "
+                                         "has none"),
+              std::string::npos)
+        << e.what();
   }
   c.scene.path = "level.bsp";  // checked before the file is read
   c.subdivision.density = {true, 0.0, 2.0, 0.1};

@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -97,6 +98,15 @@ aiMatrix4x4 to_z_up(const aiScene* scene) {
   return m;
 }
 
+/// Whether an empty node marks where players start: its name holds "spawn", "player start"
+/// (or player_start, PlayerStart) or "info_player" (a Quake map's spawn entities), any case.
+bool is_start_name(std::string name) {
+  for (char& c : name) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  std::erase_if(name, [](char c) { return c == ' ' || c == '_' || c == '-' || c == '.'; });
+  return name.find("spawn") != std::string::npos || name.find("playerstart") != std::string::npos ||
+         name.find("infoplayer") != std::string::npos;
+}
+
 class Builder {
  public:
   Builder(const aiScene* scene, AssimpObjects mode, const std::string& name) : scene_(scene), mode_(mode), name_(name) {}
@@ -118,6 +128,10 @@ class Builder {
       label.append(parent_path.empty() ? "node" : "/node");
     }
     const std::string node_name = unique(label);
+    if (node->mNumMeshes == 0 && is_start_name(label)) {
+      const Vec3 p{world.a4, world.b4, world.c4};  // the node's origin
+      if (std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z)) mesh_.start_points.push_back(p);
+    }
     for (unsigned i = 0; i < node->mNumMeshes; ++i) {
       const unsigned mi = node->mMeshes[i];
       if (mi >= scene_->mNumMeshes) throw Error(name_, 0, "node '" + node_name + "' references a missing mesh");
@@ -264,6 +278,9 @@ std::string encode(const RawMesh& m) {
     put(g.data(), g.size());
   }
   put(m.group_occluder.data(), m.group_occluder.size());
+  put(&m.metres_per_unit, sizeof m.metres_per_unit);
+  put_u64(m.start_points.size());
+  put(m.start_points.data(), m.start_points.size() * sizeof(Vec3));
   return out;
 }
 
@@ -294,6 +311,9 @@ RawMesh decode(const std::string& b, const std::string& name) {
   }
   m.group_occluder.resize(m.group_names.size());
   get(m.group_occluder.data(), m.group_occluder.size());
+  get(&m.metres_per_unit, sizeof m.metres_per_unit);
+  m.start_points.resize(get_u64());
+  get(m.start_points.data(), m.start_points.size() * sizeof(Vec3));
   return m;
 }
 
@@ -388,7 +408,9 @@ static RawMesh read_assimp_here(const std::string& path, AssimpObjects mode) {
   configure(importer);
   const aiScene* scene = importer.ReadFile(path, kFlags);
   warnings.check(path);
-  return convert(importer, scene, mode, path);
+  RawMesh m = convert(importer, scene, mode, path);
+  if (is_gltf(ext)) m.metres_per_unit = 1;  // glTF 2.0, 3.4: units are metres
+  return m;
 }
 
 static RawMesh read_assimp_bytes_here(std::string_view bytes, const std::string& extension, AssimpObjects mode,
@@ -401,7 +423,9 @@ static RawMesh read_assimp_bytes_here(std::string_view bytes, const std::string&
   const std::string hint = extension.empty() || extension[0] != '.' ? extension : extension.substr(1);
   const aiScene* scene = importer.ReadFileFromMemory(bytes.data(), bytes.size(), kFlags, hint.c_str());
   warnings.check(name);
-  return convert(importer, scene, mode, name);
+  RawMesh m = convert(importer, scene, mode, name);
+  if (is_gltf(extension)) m.metres_per_unit = 1;  // glTF 2.0, 3.4: units are metres
+  return m;
 }
 
 }  // namespace viewcells

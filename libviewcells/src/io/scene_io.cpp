@@ -48,6 +48,7 @@ Scene load_scene(const std::string& path, ObjectGrouping grouping) {
     // Quake 3 maps: the world's opaque surfaces, the sky and the solid brushes that close it
     // (neither rendered), patches at level 4.
     mesh = q3_world_mesh(read_q3bsp(path));
+    mesh.metres_per_unit = 1.0 / 32;  // its 56-unit player 1.75 m tall
   } else {
     throw Error(path, 0, "unknown scene format '" + ext +
                              "' (expected .obj, .ply, .off, .stl, .bsp, or through Assimp .gltf, .glb, .fbx, .dae, "

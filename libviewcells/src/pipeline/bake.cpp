@@ -95,6 +95,13 @@ SubdivisionFile hierarchy(const BakeConfig& c, LoadedScene& loaded, uint32_t max
   return std::move(built.file);
 }
 
+/// Where the bake's cameras stand (measuring, frame samples, near-object eyes): in the play
+/// space when the bake weighs cells by it (on a mesh scene its floors; on a map the same
+/// player eyes as the map's own view space gives), else in the scene's view space.
+std::shared_ptr<const ViewSpace> camera_space(const BakeConfig& c, const LoadedScene& loaded) {
+  return c.subdivision.play_space ? play_view_space(loaded) : loaded.view_space;
+}
+
 /// The AGVS PVSs of the view cells `pf` (located by `cells`), continued from the work
 /// directory's state when it belongs to them, and saved there. With `cams` and a measured
 /// error, the cameras' measurements stop it (BakeConfig::measured_error).
@@ -280,7 +287,7 @@ void frame_sample_rounds(const BakeConfig& c, const LoadedScene& loaded, const C
     CameraConfig sc = c.cameras;
     sc.count = static_cast<uint32_t>(std::min<uint64_t>(sampling_frames * lists.size() / n_active, 10'000'000));
     sc.seed = c.cameras.seed + 0x5a3'0001 + round;
-    const CameraSet drawn = loaded.view_space->cameras(
+    const CameraSet drawn = camera_space(c, loaded)->cameras(
         *loaded.scene, *loaded.caster, sc, [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
         &covered_cells);
     rule = drawn.rule;
@@ -322,7 +329,7 @@ void near_object_samples(const BakeConfig& c, const LoadedScene& loaded, const C
   // floors cannot be found), the bake goes on without them and says so.
   CameraSet drawn;
   try {
-    drawn = loaded.view_space->cameras(*loaded.scene, *loaded.caster, ec,
+    drawn = camera_space(c, loaded)->cameras(*loaded.scene, *loaded.caster, ec,
                                        [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
                                        &covered_cells);
   } catch (const Interrupted&) {
@@ -452,6 +459,30 @@ void log_bake(const BakeConfig& c, const BakeResult& out, const Log& log) {
 
 }  // namespace
 
+/// Whether the bake weighs cells by the play space (BakeConfig::play_space_where_known): sets it
+/// in `run` and out.config, and returns which view space was chosen and why, in words.
+std::string choose_play_space(const BakeConfig& c, const LoadedScene& loaded, BakeConfig& run, BakeResult& out,
+                              const Log& log) {
+  const std::string scene_space = loaded.view_space->describe();
+  if (c.subdivision.play_space) return "the play space (asked for)";
+  if (!c.play_space_where_known) return scene_space + " (the play space not asked for)";
+  if (c.subdivision.density.enabled) return scene_space + " (a density band says where viewers are)";
+  if (!c.sampling.view_box.empty()) return scene_space + " (a view box says where viewers are)";
+  if (!loaded.view_space->may_know_players()) return scene_space + " (it knows no players)";
+  Stopwatch sw;
+  const std::shared_ptr<const ViewSpace> play = loaded.view_space->play_space(*loaded.scene, *loaded.caster);
+  if (!play) {
+    const std::string why = "the whole view box: no play space (" + loaded.view_space->no_play_space_reason() + ")";
+    log("viewcells: bake: view space " + why);
+    return why;
+  }
+  run.subdivision.play_space = out.config.subdivision.play_space = true;
+  const std::string rule = play->viewpoint_rule();
+  log("viewcells: bake: view space: the play space, found in " + fmt(sw.seconds(), 2) + " s" +
+      (rule.empty() ? std::string() : ": " + rule));
+  return "the play space (where players stand, found by default): " + rule;
+}
+
 BakeResult bake(const BakeConfig& c, const Log& log) {
   check_bake(c);
   Stopwatch total;
@@ -483,9 +514,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
                                             fmt(sw.seconds(), 1) + " s)"
                                       : "nothing can be proven hidden: " + why));
   }
-  if (c.play_space_where_known && !c.subdivision.density.enabled && c.sampling.view_box.empty() &&
-      loaded.view_space->knows_players())
-    run.subdivision.play_space = out.config.subdivision.play_space = true;
+  out.view_space_choice = choose_play_space(c, loaded, run, out, log);
   SubdivisionFile file = hierarchy(run, loaded, max_cells, out, log);
   const MergeHistory& h = *file.history;
   out.hierarchy_seconds = total.seconds();
@@ -534,7 +563,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
     Stopwatch sw;
     CameraConfig cc = c.cameras;
     cc.count = c.measure_cameras;
-    cams = loaded.view_space->cameras(*loaded.scene, *loaded.caster, cc,
+    cams = camera_space(run, loaded)->cameras(*loaded.scene, *loaded.caster, cc,
                                       [&covered_cells](const Vec3& p) { return covered_cells.cell_at(p); },
                                       &covered_cells);
     out.camera_rule = cams->rule;
@@ -544,7 +573,7 @@ BakeResult bake(const BakeConfig& c, const Log& log) {
   std::vector<std::vector<uint32_t>> lists = sample_pvs(run, loaded, sampled, cells, cams, out, log);
   run.frame.deadline = deadline;  // from here on, frames stop at the bake's own limit
   if (c.frame_samples) frame_sample_rounds(run, loaded, covered_cells, sampling_frames, lists, out, log);
-  if (c.near.rays_per_object) near_object_samples(c, loaded, covered_cells, total, lists, out, log);
+  if (c.near.rays_per_object) near_object_samples(run, loaded, covered_cells, total, lists, out, log);
   if (hidden) {
     AimedRays aimed;
     if (c.aimed_rays) aimed = aim_at_undecided(c, loaded, *hidden, *proved, covered_cells, lists, deadline, log);

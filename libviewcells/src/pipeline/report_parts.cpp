@@ -185,7 +185,7 @@ json build_effects(const BuildResult& r) {
   e["geometry_aligned_candidates"] = effect(sub.stats.geometry_aligned, sub.stats.geometry_aligned_reason);
   e["pixel_cost_term"] = effect(model.pixel_term(), model.describe_pixel_term());
   e["viewpoint_density"] =
-      !r.play_space.empty() ? effect(true, "the play space (--play-space, bake's default on a Quake 3 map): p(i) is the "
+      !r.play_space.empty() ? effect(true, "the play space (--play-space, bake's default where the scene has one): p(i) is the "
                                            "share of " + r.play_space + " in the cell")
       : config.density.enabled
           ? effect(true, "--density-band: weight 1 for " + fmt(config.density.lo, 2) + " <= z <= " +

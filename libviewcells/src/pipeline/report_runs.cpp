@@ -169,6 +169,7 @@ std::string report_json(const BakeResult& r) {
                  {"seed", c.sampling.seed},
                  {"elementary_cells", r.elementary_cells},
                  {"play_space", c.subdivision.play_space},
+                 {"view_space", r.view_space_choice},
                  {"pixel_error", c.agvs.pixel_error},
                  {"measured_error", c.measured_error},
                  {"holes", c.holes},

@@ -13,6 +13,7 @@
 #include "viewcells/q3/hidden.h"
 #include "viewcells/q3/map_view_space.h"
 #include "viewcells/sampling/segments.h"
+#include "viewcells/viewspace/floor_space.h"
 
 namespace viewcells::pipeline {
 
@@ -26,8 +27,9 @@ std::shared_ptr<const Q3Map> map_of(const std::string& path) {
   return is_q3_map(path) ? std::make_shared<const Q3Map>(read_q3bsp(path)) : nullptr;
 }
 
-std::shared_ptr<const ViewSpace> view_space_of(const std::shared_ptr<const Q3Map>& map) {
-  return map ? q3_map_view_space(map) : box_view_space();
+std::shared_ptr<const ViewSpace> view_space_of(const std::shared_ptr<const Q3Map>& map,
+                                              const FloorSpaceConfig& floors) {
+  return map ? q3_map_view_space(map) : mesh_view_space(floors);
 }
 
 std::shared_ptr<const HiddenSpace> hidden_space_of(const LoadedScene& loaded, std::string& why) {
@@ -47,7 +49,7 @@ LoadedScene load_scene_for_rays(const SceneSource& source, const Log& log) {
     out.scene = std::make_unique<const Scene>(load_scene(source.path, source.grouping));
     out.map = map_of(source.path);
   }
-  out.view_space = view_space_of(out.map);
+  out.view_space = view_space_of(out.map, source.floors);
   out.load_seconds = sw.seconds();
   log("viewcells: " + source.path + ": " + std::to_string(out.scene->object_count()) + " objects, " +
       std::to_string(out.scene->triangle_count()) + " triangles, loaded in " + fmt(out.load_seconds, 2) + " s");
@@ -61,9 +63,12 @@ LoadedScene load_scene_for_rays(const SceneSource& source, const Log& log) {
 
 std::shared_ptr<const ViewSpace> play_view_space(const LoadedScene& loaded) {
   std::shared_ptr<const ViewSpace> play = loaded.view_space->play_space(*loaded.scene, *loaded.caster);
-  if (!play)
-    throw Error(loaded.source.path + ": --play-space needs a Quake 3 map (.bsp), or another view space that knows "
-                "where players stand: " + loaded.view_space->describe() + " has no spawn points and floors to find it from");
+  if (!play) {
+    const std::string why = loaded.view_space->no_play_space_reason();
+    throw Error(loaded.source.path + ": --play-space needs a view space that knows where players stand: " +
+                (why.empty() ? loaded.view_space->describe() + " has no spawn points and floors to find it from"
+                             : "the scene has none: " + why));
+  }
   return play;
 }
 

@@ -14,42 +14,11 @@
 #include "viewcells/bsp/adjacency.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/format.h"
+#include "viewcells/core/rng.h"
 #include "viewcells/q3/view_space.h"
+#include "viewcells/viewspace/floor_space.h"
 
 namespace viewcells {
-
-namespace {
-
-/// The walkable surfaces, by area: rendered occluders facing up at least `walk_normal` (sky and
-/// brush hulls are not rendered, water does not stop rays).
-class WalkableFloors {
- public:
-  WalkableFloors(const Scene& scene, double walk_normal) {
-    for (uint32_t t = 0; t < scene.triangles.size(); ++t) {
-      const ObjectInfo& o = scene.objects[scene.triangle_object[t]];
-      if (!o.rendered || !o.occluder) continue;
-      const Vec3 n = scene.triangle_normal(t);
-      const double twice_area = length(n);
-      if (!(twice_area > 0) || n.z < walk_normal * twice_area) continue;
-      total_ += 0.5 * twice_area;
-      floors_.emplace_back(total_, t);
-    }
-  }
-  bool empty() const { return floors_.empty(); }
-  /// The point of the floors for three uniform numbers in [0, 1): uniform by area.
-  Vec3 point(const Scene& scene, double pick, double u, double v) const {
-    const auto it = std::lower_bound(floors_.begin(), floors_.end(), std::make_pair(pick * total_, uint32_t{0}));
-    const auto& tri = scene.triangles[(it == floors_.end() ? floors_.back() : *it).second];
-    const double su = std::sqrt(u);
-    return scene.vertices[tri[0]] * (1 - su) + scene.vertices[tri[1]] * (su * (1 - v)) + scene.vertices[tri[2]] * (su * v);
-  }
-
- private:
-  std::vector<std::pair<double, uint32_t>> floors_;  ///< (area so far, triangle)
-  double total_ = 0;
-};
-
-}  // namespace
 
 std::vector<bool> q3_reachable_leaves(const Q3Map& map, size_t* spawn_points) {
   const Box3 box = q3_view_box(map);
@@ -194,6 +163,86 @@ PlayCameras q3_play_cameras(const Q3Map& map, const Scene& scene, const RayCaste
              " (" + std::to_string(out.reachable_leaves) + " of " + std::to_string(out.open_leaves) +
              " non-solid leaves); yaw uniform, pitch uniform within +-" + fmt(config.max_pitch_degrees, 0) +
              " degrees, no roll";
+  return out;
+}
+
+PlaySpaceOverlap q3_play_space_overlap(const Q3Map& map, const Scene& scene, const RayCaster& caster,
+                                       const PlaySpace& play, const FloorSpace& found, double found_scale,
+                                       uint64_t points, uint64_t seed, int image_width) {
+  if (!(found_scale > 0) || points == 0) throw Error("play space overlap: the scale and the points must be positive");
+  if (image_width < 0 || image_width > 8192) throw Error("play space overlap: the picture is 1 to 8192 pixels wide");
+  const FloorSpaceConfig& u = found.units();
+  const double lo = u.eye_low / found_scale, hi = u.eye_high / found_scale;  // in map units
+  const Vec3 down{0, 0, -1};
+  const auto in_map = [&](const Vec3& p) {
+    if (!play.leaves[map.leaf_at(p)] || !q3_in_view_space(map, p)) return false;
+    const Hit hit = caster.intersect(Ray{p, down, 0, hi});
+    return hit.hit() && hit.t >= lo && walkable_floor_hit(scene, hit, u.walk_normal);
+  };
+  const auto in_found = [&](const Vec3& p) { return found.contains(p * found_scale); };
+  Box3 box = q3_view_box(map);
+  if (!found.empty()) {
+    box.extend(found.box().lo * (1 / found_scale));
+    box.extend(found.box().hi * (1 / found_scale));
+  }
+  PlaySpaceOverlap out;
+  out.points = points;
+  out.box_volume = box.volume();
+  // Counts per block of points, summed in block order: the same for any number of threads.
+  constexpr uint64_t kBlock = 4096;
+  const uint64_t blocks = (points + kBlock - 1) / kBlock;
+  std::vector<std::array<uint64_t, 3>> counts(blocks, {0, 0, 0});
+  tbb::parallel_for(tbb::blocked_range<uint64_t>(0, blocks), [&](const tbb::blocked_range<uint64_t>& r) {
+    for (uint64_t k = r.begin(); k < r.end(); ++k) {
+      Rng rng(seed, (uint64_t{95} << 40) | k);
+      for (uint64_t i = k * kBlock; i < std::min(points, (k + 1) * kBlock); ++i) {
+        const Vec3 p{rng.uniform(box.lo.x, box.hi.x), rng.uniform(box.lo.y, box.hi.y), rng.uniform(box.lo.z, box.hi.z)};
+        const bool a = in_map(p), b = in_found(p);
+        counts[k][0] += a;
+        counts[k][1] += b;
+        counts[k][2] += a && b;
+      }
+    }
+  });
+  std::array<uint64_t, 3> sum{0, 0, 0};
+  for (const auto& c : counts)
+    for (int j = 0; j < 3; ++j) sum[j] += c[j];
+  const double per_point = out.box_volume / static_cast<double>(points);
+  out.map_volume = sum[0] * per_point;
+  out.found_volume = sum[1] * per_point;
+  out.both_volume = sum[2] * per_point;
+  if (image_width == 0) return out;
+  const Vec3 e = box.extent();
+  const double scale = image_width / e.x;
+  out.width = image_width;
+  out.height = std::max(1, static_cast<int>(std::ceil(e.y * scale)));
+  out.rgb.assign(static_cast<size_t>(out.width) * out.height * 3, 255);
+  tbb::parallel_for(tbb::blocked_range<int>(0, out.height), [&](const tbb::blocked_range<int>& r) {
+    for (int y = r.begin(); y < r.end(); ++y)
+      for (int x = 0; x < out.width; ++x) {
+        const double top = box.hi.z + 1;
+        const Vec3 o{box.lo.x + (x + 0.5) / scale, box.hi.y - (y + 0.5) / scale, top};
+        bool floors = false, both = false, map_only = false, found_only = false;
+        double t = 0;
+        for (int k = 0; k < 64; ++k) {
+          const Hit hit = caster.intersect(Ray{o, down, t, top - box.lo.z + 1});
+          if (!hit.hit()) break;
+          t = hit.t + 1e-3;
+          if (!walkable_floor_hit(scene, hit, u.walk_normal)) continue;
+          floors = true;
+          const Vec3 p = o + down * hit.t + Vec3{0, 0, 0.5 * (lo + hi)};
+          const bool a = in_map(p), b = in_found(p);
+          both |= a && b;
+          map_only |= a && !b;
+          found_only |= b && !a;
+        }
+        unsigned char* px = &out.rgb[3 * (static_cast<size_t>(y) * out.width + x)];
+        const unsigned char colour[3] = {static_cast<unsigned char>(map_only ? 220 : found_only ? 40 : both ? 60 : floors ? 225 : 255),
+                                         static_cast<unsigned char>(map_only ? 40 : found_only ? 90 : both ? 170 : floors ? 225 : 255),
+                                         static_cast<unsigned char>(map_only ? 40 : found_only ? 230 : both ? 60 : floors ? 225 : 255)};
+        std::copy(colour, colour + 3, px);
+      }
+  });
   return out;
 }
 

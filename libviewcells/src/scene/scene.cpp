@@ -192,6 +192,10 @@ Scene make_scene(RawMesh mesh, ObjectGrouping grouping, const std::string& sourc
     kept_group.push_back(has_groups ? mesh.triangle_group[t] : 0);
   }
   scene.vertices = std::move(mesh.vertices);
+  scene.metres_per_unit = mesh.metres_per_unit;
+  for (const Vec3& p : mesh.start_points)
+    if (!is_finite(p)) throw Error(source, 0, "a start point has a NaN or infinite coordinate");
+  scene.start_points = std::move(mesh.start_points);
 
   const size_t n = scene.triangles.size();
   scene.triangle_object.resize(n);

@@ -14,7 +14,7 @@ CameraSet ViewSpace::cameras(const Scene& scene, const RayCaster& caster, const 
 
 void ViewSpace::check_cameras(const CameraConfig& config) const {
   if (config.count == 0) throw Error("measure: the number of cameras must be positive");
-  if (config.placement == CameraPlacement::kPlay && !knows_players())
+  if (config.placement == CameraPlacement::kPlay && !may_know_players())
     throw Error("play cameras need a Quake 3 map (.bsp), or another view space that knows where players stand: " +
                 describe() + " has no floors and spawn points to place them from");
 }

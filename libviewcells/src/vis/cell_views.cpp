@@ -93,6 +93,33 @@ void write_cells_ply(const std::string& path, const Subdivision& s, const CellVi
   write_text_file(path, header + body + faces);
 }
 
+void write_rgb_png(const std::string& path, int width, int h, const std::vector<unsigned char>& rgb) {
+  check_output_target(path);
+  const std::string tmp = temporary_for(path);
+  FILE* fp = std::fopen(tmp.c_str(), "wb");
+  if (!fp) throw Error(path, 0, "cannot open for writing");
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
+  png_infop info = png ? png_create_info_struct(png) : nullptr;
+  if (!png || !info || setjmp(png_jmpbuf(png))) {
+    png_destroy_write_struct(&png, &info);
+    std::fclose(fp);
+    std::remove(tmp.c_str());
+    throw Error(path, 0, "PNG encoding failed");
+  }
+  png_init_io(png, fp);
+  png_set_IHDR(png, info, width, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
+               PNG_FILTER_TYPE_DEFAULT);
+  png_write_info(png, info);
+  for (int y = 0; y < h; ++y) png_write_row(png, &rgb[3 * static_cast<size_t>(y) * width]);
+  png_write_end(png, nullptr);
+  png_destroy_write_struct(&png, &info);
+  if (std::fclose(fp) != 0) {
+    std::remove(tmp.c_str());
+    throw Error(path, 0, "cannot write PNG");
+  }
+  install_file(tmp, path);
+}
+
 void write_slice_png(const std::string& path, const Subdivision& s, double height, int width, const Scene* scene,
                      const CellView* view) {
   check_view(s, view);
@@ -146,31 +173,7 @@ void write_slice_png(const std::string& path, const Subdivision& s, double heigh
       }
     }
   }
-  check_output_target(path);
-  const std::string tmp = temporary_for(path);
-  FILE* fp = std::fopen(tmp.c_str(), "wb");
-  if (!fp) throw Error(path, 0, "cannot open for writing");
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, nullptr, nullptr);
-  png_infop info = png ? png_create_info_struct(png) : nullptr;
-  if (!png || !info || setjmp(png_jmpbuf(png))) {
-    png_destroy_write_struct(&png, &info);
-    std::fclose(fp);
-    std::remove(tmp.c_str());
-    throw Error(path, 0, "PNG encoding failed");
-  }
-  png_init_io(png, fp);
-  png_set_IHDR(png, info, width, h, 8, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
-               PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < h; ++y) png_write_row(png, &rgb[3 * static_cast<size_t>(y) * width]);
-  png_write_end(png, nullptr);
-  png_destroy_write_struct(&png, &info);
-  if (std::fclose(fp) != 0) {
-    std::remove(tmp.c_str());
-    throw Error(path, 0, "cannot write PNG");
-  }
-  install_file(tmp, path);
+  write_rgb_png(path, width, h, rgb);
 }
-
 
 }  // namespace viewcells

@@ -288,6 +288,28 @@ void write_level_gltf(const std::string& path, const LevelView& view) {
   write_text_file(path, b.glb({scene_root, cell_root}, extras));
 }
 
+void write_scene_gltf(const std::string& path, const Scene& scene, const SceneGltfOptions& options) {
+  const double k = options.metres_per_unit;
+  if (!(k > 0 && std::isfinite(k))) throw Error(path, 0, "metres per unit must be positive");
+  check_output_target(path);
+  GroupedMesh m = scene_mesh(scene);
+  for (float& x : m.positions) x = static_cast<float>(x * k);
+  GlbBuilder b;
+  const int grey = b.add_material("scene", {0.75, 0.75, 0.72}, 1.0);
+  const int glass = b.add_material("scene see-through", {0.6, 0.8, 0.95}, 0.4);
+  std::vector<int> roots;
+  for (size_t o = 0; o < m.group_count(); ++o) {
+    const ObjectInfo& info = scene.objects[o];
+    if (!info.rendered || m.first_index[o] == m.first_index[o + 1]) continue;
+    roots.push_back(b.add_node({{"name", info.name}, {"mesh", b.add_mesh(m, o, info.occluder ? grey : glass)}}));
+  }
+  for (size_t i = 0; i < options.start_points.size(); ++i) {
+    const Vec3 p = options.start_points[i] * k;  // y-up, as the meshes
+    roots.push_back(b.add_node({{"name", "spawn " + std::to_string(i + 1)}, {"translation", {p.x, p.z, -p.y}}}));
+  }
+  write_text_file(path, b.glb(roots, json{{"viewcells", {{"source", scene.source}}}}));
+}
+
 void require_web_viewer() {
   if (!web_assets::available())
     throw Error(

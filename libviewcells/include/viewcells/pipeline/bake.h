@@ -24,10 +24,11 @@ struct BakeConfig {
   SamplerConfig sampling;          ///< construction samples
   CostModel model;
   SubdivisionConfig subdivision;   ///< max_cells 0: derived from the budget
-  /// Weigh cells and draw AGVS's points where players are (subdivision.play_space) whenever the
-  /// scene's view space knows them (a Quake 3 map), unless subdivision.density or
-  /// sampling.view_box says where viewers are: the command line's default, since a map's frames
-  /// are seen from where players stand. The report's settings give what was decided.
+  /// Weigh cells, draw AGVS's points and place cameras where players are (subdivision.play_space)
+  /// whenever the scene's view space knows them (a Quake 3 map's leaves, or a mesh scene's
+  /// walkable floors, viewspace/floor_space.h), unless subdivision.density or sampling.view_box
+  /// says where viewers are: the command line's default, since a level's frames are seen from
+  /// where players stand. The report gives what was decided and why (view_space_choice).
   bool play_space_where_known = false;
   std::optional<AgvsConfig> merge_agvs;  ///< as BuildConfig::merge_agvs
   uint32_t cells = 0;              ///< budget: this many view cells ...
@@ -114,6 +115,8 @@ struct BakeResult {
   double pixel_error = 0, pixel_error_bound = 0;  ///< NaN: not known
   std::optional<PixelErrorMeasure> measured;  ///< of the file written, by the measuring cameras
   std::string camera_rule;                    ///< how they were placed
+  /// Which view space weighed the cells and placed the cameras, and why, in words.
+  std::string view_space_choice;
   std::vector<MeasuredPoint> measured_curve;  ///< with measured_error: every measurement of the run
   bool measured_stop = false;                 ///< the measured error stopped AGVS
   bool agvs_resumed = false;

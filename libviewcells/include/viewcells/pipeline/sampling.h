@@ -11,6 +11,7 @@
 
 #include "viewcells/agvs/agvs.h"
 #include "viewcells/hidden/hidden_space.h"
+#include "viewcells/viewspace/floor_space.h"
 #include "viewcells/viewspace/view_space.h"
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/raycast/ray_caster.h"
@@ -29,6 +30,9 @@ struct SceneSource {
   /// A scene made in memory (an editor's meshes, Python's arrays): used instead of reading
   /// `path`, with its own objects (`grouping` does not apply). Shared, never modified.
   std::shared_ptr<const Scene> scene;
+  /// How a scene without a view space of its own finds where players stand (units, the
+  /// player's body, start points): viewspace/floor_space.h.
+  FloorSpaceConfig floors;
 };
 
 /// True for a Quake 3 map (.bsp).
@@ -37,8 +41,10 @@ bool is_q3_map(const std::string& path);
 /// What a scene file brings besides its geometry: its Quake 3 map (.bsp; null for other files).
 std::shared_ptr<const Q3Map> map_of(const std::string& path);
 /// The view space a scene brings (viewspace/view_space.h): a Quake 3 map's (`map` not null), else
-/// the whole view box. The one place that picks a view space by the kind of scene.
-std::shared_ptr<const ViewSpace> view_space_of(const std::shared_ptr<const Q3Map>& map);
+/// the whole view box with a play space found from the scene's floors when asked
+/// (viewspace/floor_space.h). The one place that picks a view space by the kind of scene.
+std::shared_ptr<const ViewSpace> view_space_of(const std::shared_ptr<const Q3Map>& map,
+                                              const FloorSpaceConfig& floors = {});
 
 /// A scene ready for rays. The scene is held by pointer: the caster refers to it, so it must
 /// not move when the LoadedScene does.

@@ -12,6 +12,7 @@
 #include "viewcells/io/q3bsp.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/scene/scene.h"
+#include "viewcells/viewspace/floor_space.h"
 
 namespace viewcells {
 
@@ -64,5 +65,29 @@ PlaySpace q3_play_space(const Q3Map& map, const Scene& scene, const RayCaster& c
 /// made from the map (brush hulls included). Error when the map has too few such floors.
 PlayCameras q3_play_cameras(const Q3Map& map, const Scene& scene, const RayCaster& caster,
                             const PlayCameraConfig& config);
+
+/// How a play space found from meshes (find_floor_space on the map converted to glTF, scaled by
+/// `found_scale` map units to its units) matches the map's own, over one eye band: the band of
+/// `found` (its eye_low to eye_high above a walkable floor, taken from the map's scene). A point
+/// is in the map's play space when its leaf is a play leaf (`play`, q3_play_space), it lies in
+/// non-solid space, and the first surface below it is a walkable floor in the band; in the
+/// found one when found.contains() says so. Volumes by `points` uniform points of the union of
+/// both boxes (serially from `seed`), so each has a standard error of about
+/// sqrt(volume * box / points). With `image_width`, also a top-down picture: per pixel column,
+/// the floors of the map's scene below it, each tested at the middle of the band: green where
+/// both hold it, red where only the map's does (missed), blue where only the found one does
+/// (added), light grey where neither, white without floors.
+struct PlaySpaceOverlap {
+  double map_volume = 0, found_volume = 0, both_volume = 0;  ///< in map units^3
+  double box_volume = 0;
+  uint64_t points = 0;
+  double coverage() const { return map_volume > 0 ? both_volume / map_volume : 0; }
+  double excess() const { return map_volume > 0 ? (found_volume - both_volume) / map_volume : 0; }
+  int width = 0, height = 0;
+  std::vector<unsigned char> rgb;  ///< the picture, rows from +y down
+};
+PlaySpaceOverlap q3_play_space_overlap(const Q3Map& map, const Scene& scene, const RayCaster& caster,
+                                       const PlaySpace& play, const FloorSpace& found, double found_scale,
+                                       uint64_t points, uint64_t seed, int image_width = 0);
 
 }  // namespace viewcells

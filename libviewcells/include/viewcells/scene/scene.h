@@ -60,6 +60,10 @@ struct RawMesh {
   /// the ids in every PVS are the caller's (arrays from Python, the C API). Otherwise objects
   /// are the groups with triangles, in order of first appearance.
   bool keep_group_ids = false;
+  /// Metres in one unit, when the file says (glTF: 1); 0: unknown.
+  double metres_per_unit = 0;
+  /// Where players start (spawn points), when the file marks them (glTF nodes named so).
+  std::vector<Vec3> start_points;
 };
 
 class Scene {
@@ -71,6 +75,12 @@ class Scene {
   std::string source;                ///< file it came from, or generator description
   uint64_t degenerate_dropped = 0;   ///< zero-area triangles removed while loading
   ObjectGrouping grouping = ObjectGrouping::kAuto;
+  /// Metres in one unit, when the file says (glTF: 1; a Quake 3 map: 1/32); 0: unknown. Not
+  /// part of the fingerprint.
+  double metres_per_unit = 0;
+  /// Where players start (spawn points) when the file marks them: a glTF's nodes named
+  /// "spawn", "player start" and the like (io/scene_io.h). Not part of the fingerprint.
+  std::vector<Vec3> start_points;
 
   // Derived by finalize():
   Box3 bounds;

@@ -102,9 +102,15 @@ class ViewSpace {
   void check_cameras(const CameraConfig& config) const;
   /// Whether cameras stand where players do with placement kPlay (and kAuto picks them).
   virtual bool knows_players() const { return false; }
+  /// Whether play cameras may be asked for: knows_players(), or a view space that finds its
+  /// players when asked (a mesh scene's floors; kAuto then keeps its own placement).
+  virtual bool may_know_players() const { return knows_players(); }
+  /// Why play_space() found none, in words, once it was asked; empty otherwise.
+  virtual std::string no_play_space_reason() const { return {}; }
 
   /// The part of this view space where players stand, as a view space of its own; null when
-  /// this one knows no players. Found once (the same object for later calls).
+  /// this one knows no players (or, for a mesh scene, finds no floor a player can reach). Found
+  /// once (the same object for later calls).
   virtual std::shared_ptr<const ViewSpace> play_space(const Scene& scene, const RayCaster& caster) const {
     (void)scene;
     (void)caster;

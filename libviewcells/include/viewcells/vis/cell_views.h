@@ -29,6 +29,10 @@ CellView merged_cell_view(const Subdivision& s, const MergeHistory& h, const std
 void write_cells_ply(const std::string& path, const Subdivision& s, const CellView* view = nullptr,
                      double shrink = 0.97);
 
+/// Writes an 8-bit RGB PNG of width x height pixels (rows top first, three bytes a pixel).
+/// Written atomically.
+void write_rgb_png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb);
+
 /// Writes a PNG of the horizontal slice z = height through the view space: each cell filled
 /// with its render-cost colour, cell borders dark, and (when scene is given) the scene's
 /// cross-section in black. `width` pixels along x. `view` as for write_cells_ply.

@@ -49,6 +49,20 @@ LevelView make_level_view(PvsFile f, const Scene& scene, const CostModel& model)
 /// rule the cells were cut by. Written atomically.
 void write_level_gltf(const std::string& path, const LevelView& view);
 
+/// How write_scene_gltf writes a scene.
+struct SceneGltfOptions {
+  /// Metres in one unit of the scene: vertices are scaled by it (glTF is in metres).
+  double metres_per_unit = 1;
+  /// Where players start, in scene units: written as empty nodes named "spawn N", as a level
+  /// editor marks them (read back into Scene::start_points).
+  std::vector<Vec3> start_points;
+};
+/// Writes `scene` as a binary glTF 2.0 (.glb) level, y-up in metres: one node per rendered
+/// object, in the scene's object order (named as the object; see-through objects translucent),
+/// and nothing else of the source (no brushes, leaves or entities beyond the start points
+/// asked for). Written atomically.
+void write_scene_gltf(const std::string& path, const Scene& scene, const SceneGltfOptions& options);
+
 /// Writes the static web viewer into directory `dir` (created when missing): index.html,
 /// viewer.js (three.js and the viewer, bundled when viewcells was built) and data.js (the
 /// level). It opens from the file system without a server. Throws Error when this build has

@@ -1,0 +1,49 @@
+#pragma once
+/// `viewcells play-space`: the play space found from a scene's floors (viewspace/floor_space.h),
+/// to look at (a top-down picture) and, for a level converted from a Quake 3 map, to check
+/// against the map's own play space (q3/play.h).
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "viewcells/pipeline/sampling.h"
+#include "viewcells/viewspace/floor_space.h"
+
+namespace viewcells::pipeline {
+
+struct PlaySpaceRunConfig {
+  SceneSource scene;  ///< with the body, units and start points in scene.floors
+  /// A Quake 3 map the scene was converted from (`viewcells convert`): its play space is the
+  /// reference. Empty: none.
+  std::string map;
+  uint64_t points = 2'000'000;  ///< uniform points that measure the two volumes
+  uint64_t seed = 1;
+  std::string image;            ///< with `map`: a top-down PNG of where the two agree
+  int image_width = 768;
+};
+
+struct PlaySpaceRun {
+  PlaySpaceRunConfig config;
+  std::string rule;  ///< what was found, in words
+  bool found = false;
+  double metres_per_unit = 1;
+  double volume_m3 = 0, floor_area_m2 = 0;
+  size_t spans = 0, reached_spans = 0;
+  Box3 box;  ///< in the scene's units
+  double seconds = 0;
+  /// Against the map: volumes in m^3 of the eye band in the map's play space, in the one found,
+  /// in both; the map's play leaves' rule.
+  struct Overlap {
+    double map_m3 = 0, found_m3 = 0, both_m3 = 0, coverage = 0, excess = 0;
+    uint64_t points = 0;
+    std::string map_rule;
+    double seconds = 0;
+  };
+  std::optional<Overlap> overlap;
+};
+
+PlaySpaceRun play_space(const PlaySpaceRunConfig& config, const Log& log);
+/// The run's JSON report (indented, with a final newline).
+std::string report_json(const PlaySpaceRun& run);
+
+}  // namespace viewcells::pipeline
