@@ -166,8 +166,10 @@ FloorSpace find_floor_space(const Scene& scene, const RayCaster& caster, const F
   const double columns = std::ceil(e.x / cell + 1) * std::ceil(e.y / cell + 1);
   if (columns > c.max_columns) cell *= std::sqrt(columns / c.max_columns) * 1.001;
   out.cell_ = cell;
-  out.x0_ = b.lo.x - 0.5 * cell;
-  out.y0_ = b.lo.y - 0.5 * cell;
+  // Column centres off the round numbers a level is modelled on (walls, edges and stair risers at
+  // whole or half units), so that no column runs down an edge or a face.
+  out.x0_ = b.lo.x - 0.6180339887 * cell;
+  out.y0_ = b.lo.y - 0.3819660113 * cell;
   out.nx_ = static_cast<int64_t>(std::ceil((b.hi.x - out.x0_) / cell)) + 1;
   out.ny_ = static_cast<int64_t>(std::ceil((b.hi.y - out.y0_) / cell)) + 1;
   const int64_t n = out.nx_ * out.ny_;
