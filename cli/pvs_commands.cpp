@@ -363,7 +363,7 @@ struct MeasureArgs {
 };
 
 int run_measure(const MeasureArgs& a, const Common& c) {
-  check_files({a.config.scene.path, a.config.pvs_path}, {a.report});
+  check_files({a.config.scene.path, a.config.pvs_path, a.config.cameras_in}, {a.report, a.config.cameras_out});
   ThreadLimit threads(c.threads);
   pipeline::MeasureConfig config = a.config;
   config.scene.grouping = parse_grouping(a.objects);
@@ -411,6 +411,12 @@ void add_measure_command(CLI::App& app, const Common& common, Commands& commands
   ms->add_option("--cost-a", a->config.model.a, "Render cost model: r = max(a, b * triangles)")->capture_default_str();
   ms->add_option("--cost-b", a->config.model.b, "Render cost model: cost per triangle")->capture_default_str();
   ms->add_flag("--fast", a->fast, "Embree without robust mode");
+  ms->add_option("--cameras-out", a->config.cameras_out,
+                 "Write the cameras measured to this JSON file (eyes in metres, forward and up), to measure "
+                 "another version of the level with the same frames");
+  ms->add_option("--cameras-from", a->config.cameras_in,
+                 "Measure with the cameras of this file (from --cameras-out) instead of placing them; eyes are "
+                 "turned from metres into the scene's units (a Quake 3 map: 1/32 m)");
   add_floor_options(ms, a->floors);
   ms->add_option("--report", a->report, "JSON report (default: printed)");
   commands.push_back({ms, [a, &common] { return run_measure(*a, common); }});

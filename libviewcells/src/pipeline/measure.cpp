@@ -3,11 +3,14 @@
 #include "viewcells/pipeline/measure.h"
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
+#include <nlohmann/json.hpp>
 #include <map>
 #include <span>
 
 #include "viewcells/cells/view_cells.h"
+#include "viewcells/core/binary_file.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/format.h"
 #include "viewcells/core/parallel.h"
@@ -101,6 +104,54 @@ void worst_frames(const PixelErrorMeasure& e, std::span<const Camera> cameras, s
 
 }  // namespace
 
+std::vector<Camera> read_cameras(const std::string& path, double metres_per_unit, std::string* rule) {
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(read_file_bytes(path));
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(path, 0, std::string("not a cameras file: ") + e.what());
+  }
+  const double k = metres_per_unit > 0 ? metres_per_unit : 1.0;
+  std::vector<Camera> out;
+  try {
+    if (j.at("format").get<std::string>() != "viewcells cameras 1") throw Error(path, 0, "not a viewcells cameras file");
+    if (rule) *rule = j.value("rule", std::string());
+    const auto& list = j.at("cameras");
+    if (!list.is_array() || list.empty() || list.size() > 10'000'000)
+      throw Error(path, 0, "'cameras' must list 1 to 10,000,000 cameras");
+    for (size_t i = 0; i < list.size(); ++i) {
+      const std::vector<double> v = list[i].get<std::vector<double>>();
+      const auto bad = [&](const std::string& why) {
+        return Error(path, 0, "camera " + std::to_string(i) + ": " + why);
+      };
+      if (v.size() != 9) throw bad("give 9 numbers: eye (metres), forward, up");
+      for (double x : v)
+        if (!std::isfinite(x)) throw bad("a number is not finite");
+      const Vec3 eye{v[0] / k, v[1] / k, v[2] / k}, f{v[3], v[4], v[5]}, u{v[6], v[7], v[8]};
+      const Vec3 right = cross(f, u);
+      if (!(length(f) > 0.5 && length(u) > 0.5 && length(right) > 0.5))
+        throw bad("forward and up must be unit vectors at right angles");
+      const Vec3 fn = normalize(f), rn = normalize(right);
+      out.push_back({eye, fn, rn, cross(rn, fn)});
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(path, 0, std::string("malformed cameras file: ") + e.what());
+  }
+  return out;
+}
+
+void write_cameras(const std::string& path, const std::vector<Camera>& cameras, double metres_per_unit,
+                   const std::string& rule) {
+  const double k = metres_per_unit > 0 ? metres_per_unit : 1.0;
+  nlohmann::json list = nlohmann::json::array();
+  for (const Camera& c : cameras)
+    list.push_back({c.eye.x * k, c.eye.y * k, c.eye.z * k, c.forward.x, c.forward.y, c.forward.z, c.up.x, c.up.y, c.up.z});
+  write_text_file(path, nlohmann::json{{"format", "viewcells cameras 1"}, {"rule", rule}, {"units", "metres, z up"},
+                                       {"cameras", list}}
+                            .dump() +
+                            "\n");
+}
+
 MeasureResult measure(const MeasureConfig& c, const Log& log) {
   Stopwatch total;
   check_frame_budget(c.cameras.count, c.frame.width, c.frame.height);  // before any work
@@ -145,7 +196,18 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
   out.pvs_entries = m.pvs.entries();
 
   Stopwatch sw;
-  const CameraSet cams = loaded.view_space->cameras(scene, *loaded.caster, c.cameras, m.cell_at, m.locator.get());
+  CameraSet cams;
+  const double mpu = scene.metres_per_unit > 0 ? scene.metres_per_unit : 1.0;
+  if (!c.cameras_in.empty()) {
+    std::string rule;
+    cams.cameras = read_cameras(c.cameras_in, mpu, &rule);
+    check_frame_budget(cams.cameras.size(), c.frame.width, c.frame.height);
+    for (const Camera& cam : cams.cameras) cams.cells.push_back(m.cell_at(cam.eye));
+    cams.rule = "read from " + c.cameras_in + " (" + rule + ")";
+  } else {
+    cams = loaded.view_space->cameras(scene, *loaded.caster, c.cameras, m.cell_at, m.locator.get());
+  }
+  if (!c.cameras_out.empty()) write_cameras(c.cameras_out, cams.cameras, mpu, cams.rule);
   const auto uncovered = std::count(cams.cells.begin(), cams.cells.end(), -1);
   if (uncovered)
     log("viewcells: warning: " + std::to_string(uncovered) + " of " + std::to_string(cams.cameras.size()) +

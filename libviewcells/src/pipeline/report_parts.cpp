@@ -245,9 +245,9 @@ json agvs_curve(const AgvsStats& st, size_t references) {
 }
 
 json agvs_view_space(bool restricted, bool play) {
-  return effect(restricted, play         ? "the play space (--play-space, bake's default on a Quake 3 map): AGVS's "
-                                           "points are drawn in its leaves (those reachable from the spawn points with "
-                                           "a point at most 112 units above a walkable floor)"
+  return effect(restricted, play         ? "the play space (--play-space, bake's default where the scene has one): "
+                                           "AGVS's points are drawn where a player's eye can be (settings.view_space "
+                                           "says how it was found)"
                             : restricted ? "a Quake 3 map: AGVS's points are drawn in its non-solid space"
                                          : "AGVS's points are drawn in the whole view box");
 }

@@ -392,10 +392,32 @@ class MeshViewSpace final : public ViewSpace {
     if (!asked_) {
       asked_ = true;
       auto space = std::make_shared<const FloorSpace>(find_floor_space(scene, caster, config_));
-      if (space->empty()) why_ = space->rule();
-      else play_ = floor_view_space(std::move(space));
+      if (space->empty()) {
+        why_ = space->rule();
+      } else {
+        play_box_ = space->box();
+        scene_box_ = scene.bounds;
+        play_ = floor_view_space(std::move(space));
+      }
     }
     return play_;
+  }
+  /// Once the play space is found (a bake asks before it samples), segments are sampled in its
+  /// box, as a map's in its non-solid leaves: the construction samples where players are.
+  void restrict(SamplerConfig& config) const override {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (play_ && config.view_box.empty()) config.view_box = play_box_;
+  }
+  std::string box_rule() const override {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    return play_ ? "the play space's box" : "scene bounds";
+  }
+  /// The file still covers the whole scene: an engine finds a cell wherever a camera goes.
+  Box3 covered_box(const Box3& box) const override {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    Box3 out = box;
+    if (play_) out.extend(scene_box_);
+    return out;
   }
   std::string no_play_space_reason() const override {
     const std::lock_guard<std::mutex> lock(mutex_);
@@ -420,6 +442,7 @@ class MeshViewSpace final : public ViewSpace {
   mutable bool asked_ = false;
   mutable std::string why_;
   mutable std::shared_ptr<const ViewSpace> play_;
+  mutable Box3 play_box_, scene_box_;
 };
 
 }  // namespace

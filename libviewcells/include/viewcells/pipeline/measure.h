@@ -34,7 +34,20 @@ struct MeasureConfig {
   CameraConfig cameras;
   FrameConfig frame{1024, 768, 90.0, 1024 * 1024};  ///< what players see (wrong pixels reported per 1024x1024)
   CostModel model;  ///< r(o) of the frame cost (the pixel term is not used)
+  /// Cameras from a file written by cameras_out (JSON: eyes, forward and up vectors, in metres),
+  /// instead of placing them: the same frames for two versions of a level (a map and its glTF
+  /// conversion: the positions are turned into this scene's units, Scene::metres_per_unit, 1
+  /// when it does not say). Empty: placed as `cameras` says.
+  std::string cameras_in;
+  std::string cameras_out;  ///< writes the cameras measured (and their rule) there; empty: not
 };
+
+/// Reads cameras written by write_cameras, turned into a scene of `metres_per_unit` (0: 1).
+/// Error naming the file on anything malformed.
+std::vector<Camera> read_cameras(const std::string& path, double metres_per_unit, std::string* rule = nullptr);
+/// Writes cameras of a scene of `metres_per_unit` (0: 1) in metres, with their rule (atomically).
+void write_cameras(const std::string& path, const std::vector<Camera>& cameras, double metres_per_unit,
+                   const std::string& rule);
 
 /// The objects with the most wrong pixels.
 struct WrongObject {
