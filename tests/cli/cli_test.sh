@@ -581,6 +581,19 @@ expect_ok "$VC" bake office.obj --memory 3000 --samples 20000 --max-cells 300 --
   bad "3000 bytes of lists hold fewer cells than a 3000-byte file"
 expect_ok "$VC" measure office.obj meml.pvs --count 20 --width 8 --height 8 --report memlm.json -q
 [ "$(json_get memlm.json "['pvs_bytes']")" = "$(json_get meml.json "['list_bytes']")" ] && ok || bad "measure's pvs_bytes differ from bake's list_bytes"
+# The same cameras again from a file: the same frames, the same cost and wrong pixels; in another
+# unit (the file is in metres), the eyes move with the scene.
+expect_ok "$VC" measure office.obj meml.pvs --count 20 --width 8 --height 8 --cameras-out cams.json --report camo.json -q
+expect_ok "$VC" measure office.obj meml.pvs --cameras-from cams.json --width 8 --height 8 --report cami.json -q
+python3 -c "
+import json; a = json.load(open('camo.json')); b = json.load(open('cami.json')); c = json.load(open('cams.json'))
+assert a['frame'] == b['frame'] and a['pixel_error']['pixels'] == b['pixel_error']['pixels'], (a['frame'], b['frame'])
+assert len(c['cameras']) == 20 and all(len(x) == 9 for x in c['cameras']), c
+" && ok || bad "measure --cameras-from: not the same frames"
+echo '{"format": "viewcells cameras 1", "cameras": [[0, 0, 1, 0, 0, 0, 0, 0, 1]]}' > badcams.json
+expect_error "camera 0: forward and up must be unit vectors" "$VC" measure office.obj meml.pvs --cameras-from badcams.json
+echo '{"cameras": []' > badcams.json
+expect_error "badcams.json: not a cameras file" "$VC" measure office.obj meml.pvs --cameras-from badcams.json
 expect_error "file or lists" "$VC" bake office.obj --memory 3000 --memory-of everything -o x.pvs
 # Frames as a sampler: the report says how many frames added how many entries.
 expect_ok "$VC" bake office.obj --cells 12 --samples 20000 --max-cells 60 --agvs-samples 20000 --frame-samples 8 \
