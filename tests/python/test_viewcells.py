@@ -423,3 +423,20 @@ def test_ctrl_c_stops_a_bake_and_writes_nothing(office, tmp_path):
                          capture_output=True, text=True, timeout=240, env=os.environ)
     assert "interrupted after" in out.stdout and "written: False" in out.stdout, out.stdout + out.stderr
     assert not (tmp_path / "i.pvs").exists()
+
+
+def test_play_space_keywords(office, tmp_path):
+    """The play space's options are keywords: a start point and a body change what bake finds,
+    and the report says which view space was chosen and why."""
+    def view_space(**kw):
+        report = tmp_path / "play.json"
+        viewcells.bake(str(office / "office.obj"), str(tmp_path / "play.pvs"), cells=4, samples=5000,
+                       agvs_samples=5000, report=str(report), **kw)
+        return json.load(open(report))["settings"]["view_space"]
+    default = view_space()
+    assert default.startswith("the play space") and "no start points" in default, default
+    started = view_space(start="2,2,0.5", eye_band="1,2")
+    assert "reachable from 1 of 1 start points" in started and "1.00-2.00 m" in started, started
+    assert "the whole view box" in view_space(no_play_space=True)
+    with pytest.raises(viewcells.Error, match="eye_band \\(keyword\\) takes LO,HI"):
+        view_space(eye_band="2,1")
