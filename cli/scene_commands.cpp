@@ -66,6 +66,7 @@ int run_convert(const ConvertArgs& a, const Common& c) {
 struct PlayArgs {
   pipeline::PlaySpaceRunConfig config;
   std::string objects = "auto", report;
+  std::vector<std::string> probes;
   FloorOptions floors;
 };
 
@@ -75,6 +76,11 @@ int run_play(const PlayArgs& a, const Common& c) {
   pipeline::PlaySpaceRunConfig config = a.config;
   config.scene.grouping = parse_grouping(a.objects);
   config.scene.floors = a.floors.floors();
+  for (const std::string& p : a.probes) {
+    const std::vector<double> v = parse_numbers(p, "--at");
+    if (v.size() != 3) throw Error("--at takes X,Y,Z in the scene's units (got '" + p + "')");
+    config.probes.push_back({v[0], v[1], v[2]});
+  }
   const pipeline::PlaySpaceRun run = pipeline::play_space(config, c.logger());
   if (!a.report.empty()) write_text_file(a.report, pipeline::report_json(run));
   else std::cout << pipeline::report_json(run);
@@ -210,6 +216,7 @@ void add_scene_commands(CLI::App& app, const Common& common, Commands& commands)
   ps->add_option("--image-width", pl->config.image_width, "Width of the picture in pixels")
       ->capture_default_str()
       ->check(whole(16, 8192));
+  ps->add_option("--at", pl->probes, "Say whether a player's eye can be at X,Y,Z (scene units; repeatable)");
   ps->add_option("--report", pl->report, "JSON report (default: printed)");
   add_floor_options(ps, pl->floors);
   commands.push_back({ps, [pl, &common] { return run_play(*pl, common); }});

@@ -33,6 +33,11 @@ PlaySpaceRun play_space(const PlaySpaceRunConfig& config, const Log& log) {
   out.spans = found.spans();
   out.reached_spans = found.reached_spans();
   out.box = found.box();
+  for (const Vec3& p : config.probes) {
+    out.probes_in.push_back(found.contains(p));
+    log("viewcells: (" + fmt(p.x) + ", " + fmt(p.y) + ", " + fmt(p.z) + ") is " +
+        (out.probes_in.back() ? "in" : "not in") + " the play space");
+  }
   log(std::string("viewcells: play space ") + (out.found ? "found" : "not found") + " in " + fmt(out.seconds, 2) + " s: " + out.rule +
       (out.found ? "; eye band " + fmt(out.volume_m3, 1) + " m^3" : std::string()));
   if (config.map.empty()) return out;
@@ -92,6 +97,12 @@ std::string report_json(const PlaySpaceRun& run) {
             {"spans", run.spans},
             {"reached_spans", run.reached_spans},
             {"seconds", run.seconds}};
+  json probes = json::array();
+  for (size_t i = 0; i < run.probes_in.size(); ++i) {
+    const Vec3& p = run.config.probes[i];
+    probes.push_back({{"at", {p.x, p.y, p.z}}, {"in", static_cast<bool>(run.probes_in[i])}});
+  }
+  j["probes"] = probes;
   if (run.overlap) {
     const PlaySpaceRun::Overlap& o = *run.overlap;
     j["against_map"] = {{"map", run.config.map},

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "viewcells/pipeline/sampling.h"
 #include "viewcells/viewspace/floor_space.h"
@@ -20,6 +21,7 @@ struct PlaySpaceRunConfig {
   uint64_t seed = 1;
   std::string image;            ///< with `map`: a top-down PNG of where the two agree
   int image_width = 768;
+  std::vector<Vec3> probes;     ///< points (scene units) to ask whether a player's eye can be there
 };
 
 struct PlaySpaceRun {
@@ -30,6 +32,7 @@ struct PlaySpaceRun {
   double volume_m3 = 0, floor_area_m2 = 0;
   size_t spans = 0, reached_spans = 0;
   Box3 box;  ///< in the scene's units
+  std::vector<bool> probes_in;  ///< per probe: in the play space
   double seconds = 0;
   /// Against the map: volumes in m^3 of the eye band in the map's play space, in the one found,
   /// in both; the map's play leaves' rule.
