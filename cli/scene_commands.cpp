@@ -54,10 +54,16 @@ int run_convert(const ConvertArgs& a, const Common& c) {
   options.metres_per_unit = a.metres_per_unit > 0 ? a.metres_per_unit
                             : scene.metres_per_unit > 0 ? scene.metres_per_unit : 1.0;
   if (a.start_points) options.start_points = map ? q3_spawn_points(read_q3bsp(a.scene)) : scene.start_points;
+  if (map) {
+    // The map's sky is drawn (with a sky shader) and closes the level: it is written as meshes;
+    // the solid brushes that close the map for rays are not surfaces, and are left behind.
+    for (const ObjectInfo& o : scene.objects) options.keep.push_back(o.name != "solid brushes");
+  }
   write_scene_gltf(a.output, scene, options);
-  size_t rendered = 0;
-  for (const ObjectInfo& o : scene.objects) rendered += o.rendered;
-  c.log("viewcells: " + a.scene + " -> " + a.output + ": " + std::to_string(rendered) + " rendered objects of " +
+  size_t written = 0;
+  for (size_t o = 0; o < scene.object_count(); ++o)
+    written += options.keep.empty() ? scene.objects[o].rendered : options.keep[o];
+  c.log("viewcells: " + a.scene + " -> " + a.output + ": " + std::to_string(written) + " objects of " +
         std::to_string(scene.object_count()) + ", 1 unit = " + fmt(options.metres_per_unit, 5) + " m, " +
         std::to_string(options.start_points.size()) + " start points, in " + fmt(sw.seconds(), 2) + " s");
   return 0;
@@ -178,8 +184,9 @@ void add_scene_commands(CLI::App& app, const Common& common, Commands& commands)
 
   auto cv = std::make_shared<ConvertArgs>();
   auto* co = app.add_subcommand(
-      "convert", "Write a scene as a glTF level (.glb, y-up, metres): its rendered objects as meshes in object order, "
-                 "nothing else (a Quake 3 map's brushes, leaves and entities are left behind)");
+      "convert", "Write a scene as a glTF level (.glb, y-up, metres): its rendered objects as meshes in object order "
+                 "(a Quake 3 map's surfaces, its sky included), nothing else (a map's brushes, leaves and entities "
+                 "are left behind)");
   co->add_option("scene", cv->scene, "Scene file (.obj, .ply, .off, .stl, .gltf, .glb, a Quake 3 .bsp, ...)")->required();
   co->add_option("-o,--output", cv->output, "The .glb file to write")->required();
   co->add_option("--objects", cv->objects, "Object grouping: auto | groups | components | triangles | nodes | meshes")

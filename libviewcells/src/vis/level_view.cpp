@@ -300,7 +300,8 @@ void write_scene_gltf(const std::string& path, const Scene& scene, const SceneGl
   std::vector<int> roots;
   for (size_t o = 0; o < m.group_count(); ++o) {
     const ObjectInfo& info = scene.objects[o];
-    if (!info.rendered || m.first_index[o] == m.first_index[o + 1]) continue;
+    const bool kept = options.keep.empty() ? info.rendered : o < options.keep.size() && options.keep[o];
+    if (!kept || m.first_index[o] == m.first_index[o + 1]) continue;
     roots.push_back(b.add_node({{"name", info.name}, {"mesh", b.add_mesh(m, o, info.occluder ? grey : glass)}}));
   }
   for (size_t i = 0; i < options.start_points.size(); ++i) {

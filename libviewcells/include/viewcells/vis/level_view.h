@@ -56,11 +56,14 @@ struct SceneGltfOptions {
   /// Where players start, in scene units: written as empty nodes named "spawn N", as a level
   /// editor marks them (read back into Scene::start_points).
   std::vector<Vec3> start_points;
+  /// Per object: written (empty: the rendered objects). A glTF level has no objects that stop
+  /// rays unseen: what is written is rendered.
+  std::vector<uint8_t> keep;
 };
-/// Writes `scene` as a binary glTF 2.0 (.glb) level, y-up in metres: one node per rendered
-/// object, in the scene's object order (named as the object; see-through objects translucent),
-/// and nothing else of the source (no brushes, leaves or entities beyond the start points
-/// asked for). Written atomically.
+/// Writes `scene` as a binary glTF 2.0 (.glb) level, y-up in metres: one node per object kept,
+/// in the scene's object order (named as the object; see-through objects translucent), and
+/// nothing else of the source (no brushes, leaves or entities beyond the start points asked
+/// for). Written atomically.
 void write_scene_gltf(const std::string& path, const Scene& scene, const SceneGltfOptions& options);
 
 /// Writes the static web viewer into directory `dir` (created when missing): index.html,
