@@ -226,6 +226,10 @@ void add_floor_options(CLI::App* cmd, FloorOptions& a) {
                   "Where players start, X,Y,Z in scene units (repeatable; default: the file's spawn nodes, else every "
                   "floor region of at least --min-region)")
       ->group(g);
+  cmd->add_flag("--only-from-starts", c.only_from_starts,
+               "With start points: only what they reach (default: also every floor region of at least --min-region, "
+               "since walking misses jump pads and teleporters)")
+      ->group(g);
   cmd->add_option("--player-height", c.player_height, "Free space a standing player needs above a floor, metres")
       ->check(CLI::PositiveNumber)
       ->capture_default_str()
@@ -245,7 +249,8 @@ void add_floor_options(CLI::App* cmd, FloorOptions& a) {
       ->capture_default_str()
       ->group(g);
   cmd->add_option("--min-region", c.min_region,
-                  "With no start points: floor regions at least this large are starts, square metres")
+                  "Floor regions at least this large are starts (with start points too, unless --only-from-starts), "
+                  "square metres")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str()
       ->group(g);

@@ -60,7 +60,7 @@ RawMesh level(double k, bool stairs = true) {
 }
 
 struct Level {
-  explicit Level(double k, bool stairs = true, std::vector<Vec3> starts = {{15 * 1.0, 4, 0.5}})
+  explicit Level(double k, bool stairs = true, std::vector<Vec3> starts = {{15 * 1.0, 4, 0.5}}, bool only = true)
       : scene(make_scene(level(k, stairs), ObjectGrouping::kGroups, "level")),
         // The exact caster: Embree's SSE4.2 and AVX2 kernels were seen to report the ground under
         // (7, 5) as another object's back face (not understood yet); these invariants are about
@@ -69,6 +69,7 @@ struct Level {
     config.metres_per_unit = 1 / k;
     for (Vec3& p : starts) p = p * k;
     config.start_points = starts;
+    config.only_from_starts = only;
     space = find_floor_space(scene, *caster, config);
   }
   Scene scene;
@@ -111,6 +112,17 @@ TEST(FloorSpace, WithoutStartPointsEveryLargeRegionIsAStart) {
   EXPECT_TRUE(l.space.contains({1.5, 8.5, 1.6}));   // the walled-off room is a region of its own
   EXPECT_FALSE(l.space.contains({7, 5, 6.2 + 1.6}));  // the roof too, but eyes above the scene's top are never in
   EXPECT_FALSE(l.space.contains({4.5, 4.5, 2 + 1.6}));  // the pedestal's 1 m^2 is not
+}
+
+TEST(FloorSpace, ByDefaultLargeRegionsJoinWhatTheStartsReach) {
+  // What walking from the start misses (the walled-off room) is in by default, as a region of
+  // its own; the pedestal's 1 m^2 is not; the rule says both.
+  const Level l(1, true, {{15, 4, 0.5}}, false);
+  EXPECT_TRUE(l.space.contains({1.5, 8.5, 1.6}));
+  EXPECT_TRUE(l.space.contains({15, 5, 4.6}));
+  EXPECT_FALSE(l.space.contains({4.5, 4.5, 2 + 1.6}));
+  EXPECT_NE(l.space.rule().find("reachable from 1 of 1 start points and from every floor region"), std::string::npos)
+      << l.space.rule();
 }
 
 TEST(FloorSpace, QuakeUnitsGiveTheSameSpaceAsMetres) {
@@ -183,8 +195,11 @@ TEST(FloorSpace, AGltfLevelKeepsItsStartPointsAndUnits) {
   EXPECT_NEAR(back.start_points[0].z, 0.5, 1e-4);
   EXPECT_NEAR(back.bounds.hi.z, 6.2, 1e-4);
   const auto caster = make_embree_caster(back, {});
-  const FloorSpace s = find_floor_space(back, *caster, {});
+  FloorSpaceConfig only;
+  only.only_from_starts = true;  // the file's start point alone: the walled-off room is out
+  const FloorSpace s = find_floor_space(back, *caster, only);
   EXPECT_NE(s.rule().find("from the file"), std::string::npos) << s.rule();
+  EXPECT_NE(s.rule().find("reachable from 1 of 1 start points"), std::string::npos) << s.rule();
   EXPECT_TRUE(s.contains({15, 5, 4.6}));
   EXPECT_FALSE(s.contains({1.5, 8.5, 1.6}));
 }

@@ -264,10 +264,10 @@ FloorSpace find_floor_space(const Scene& scene, const RayCaster& caster, const F
     }
   }
   std::string start_words;
-  if (!u.start_points.empty()) {
+  if (!u.start_points.empty())
     start_words = "reachable from " + std::to_string(starts_found) + " of " + std::to_string(u.start_points.size()) +
                   " start points";
-  } else {
+  if (u.start_points.empty() || !u.only_from_starts) {
     Regions regions(spans);
     for (uint32_t a = 0; a < spans; ++a)
       for (uint32_t bs : moves[a])
@@ -280,8 +280,12 @@ FloorSpace find_floor_space(const Scene& scene, const RayCaster& caster, const F
       if (regions.find(a) == a && size[a] * cell_area >= u.min_region) ++kept;
     for (uint32_t a = 0; a < spans; ++a)
       if (size[regions.find(a)] * cell_area >= u.min_region) stack.push_back(a);
-    start_words = "no start points: from every floor region of at least " + fmt(c.min_region, 1) + " m^2 (" +
-                  std::to_string(kept) + ")";
+    const std::string regions_words =
+        "every floor region of at least " + fmt(c.min_region, 1) + " m^2 (" + std::to_string(kept) + ")";
+    start_words = u.start_points.empty() ? "no start points: from " + regions_words
+                                         : start_words + " and from " + regions_words +
+                                               " (places start points miss, such as jump pads' and teleporters' "
+                                               "destinations)";
   }
   out.reached_.assign(spans, 0);
   for (uint32_t s : stack) out.reached_[s] = 1;

@@ -53,13 +53,17 @@ struct FloorSpaceConfig {
   double step = 0.6;            ///< the highest step a player walks up, m (stairs, kerbs)
   double eye_low = 1.0;         ///< the eye band above a floor: from a crouch, m
   double eye_high = 3.0;        ///< to the top of a jump, m
-  /// With no start points: every floor region (spans joined by walking both ways) of at least
-  /// this area is a start, m^2.
+  /// A floor region (spans joined by walking both ways) of at least this area is a start, m^2
+  /// (see start_points).
   double min_region = 4;
   uint32_t max_columns = 4'000'000;  ///< more: the cell grows until the grid fits
   /// Where players start, in scene units (spawn points); empty: the scene's own
-  /// (Scene::start_points), and with none of those, every large enough floor region.
+  /// (Scene::start_points). What they reach is in the play space, and so is every floor region
+  /// of at least min_region: walking from spawn points misses what jump pads and teleporters
+  /// reach, and a bake that leaves out where players stand draws far more there (a region too
+  /// many costs little). With only_from_starts and start points, only what they reach.
   std::vector<Vec3> start_points;
+  bool only_from_starts = false;
 };
 
 /// The play space found (find_floor_space): columns of floor spans on a grid over the scene.
