@@ -101,6 +101,15 @@ expect_error "the scene has none: no walkable floor" "$VC" bake lowroom.obj --pl
 expect_ok "$VC" bake lowroom.obj --cells 4 --samples 5000 --agvs-samples 5000 -o lowroom.pvs --report lowroom.json -q
 json_get lowroom.json "['settings']['view_space']" | grep -q "the whole view box: no play space (no walkable floor" && ok ||
   bad "bake on a scene without floors: the report does not say the view box was kept and why"
+# convert: a glTF level of a scene, read back with the same objects; bad outputs are errors.
+expect_ok "$VC" convert office.obj -o office-level.glb -q
+expect_ok "$VC" info office-level.glb --json office-level.json -q
+python3 -c "
+import json; a = json.load(open('office-level.json')); b = json.load(open('info.json'))
+assert a['objects'] == b['objects'] and a['triangles'] == b['triangles'], (a['objects'], b['objects'])
+" && ok || bad "convert: the level does not read back with the office's objects and triangles"
+expect_error "give a .glb output" "$VC" convert office.obj -o office-level.obj
+expect_error "no such file" "$VC" convert missing.obj -o x.glb
 # The office has floors: bake finds its play space by default and says so; measure's play cameras stand there.
 expect_ok "$VC" play-space office.obj --report office-play.json -q
 python3 -c "
