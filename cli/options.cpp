@@ -227,8 +227,13 @@ void add_floor_options(CLI::App* cmd, FloorOptions& a) {
                   "floor region of at least --min-region)")
       ->group(g);
   cmd->add_flag("--only-from-starts", c.only_from_starts,
-               "With start points: only what they reach (default: also every floor region of at least --min-region, "
-               "since walking misses jump pads and teleporters)")
+               "With start points: only what they reach (default: also every floor region of at least --min-region "
+               "within --region-margin of it, since walking misses jump pads and teleporters)")
+      ->group(g);
+  cmd->add_option("--region-margin", c.region_margin,
+                  "With start points: floor regions join within this many metres (horizontally) of what they reach")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str()
       ->group(g);
   cmd->add_option("--player-height", c.player_height, "Free space a standing player needs above a floor, metres")
       ->check(CLI::PositiveNumber)

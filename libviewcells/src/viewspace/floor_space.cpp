@@ -6,6 +6,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -46,8 +47,18 @@ constexpr uint32_t kViewpoints = 200000;
 
 }  // namespace
 
+bool sky_name(const std::string& name) {
+  for (size_t i = 0; i + 3 <= name.size(); ++i)
+    if (std::tolower(static_cast<unsigned char>(name[i])) == 's' &&
+        std::tolower(static_cast<unsigned char>(name[i + 1])) == 'k' &&
+        std::tolower(static_cast<unsigned char>(name[i + 2])) == 'y')
+      return true;
+  return false;
+}
+
 bool walkable_floor_hit(const Scene& scene, const Hit& hit, double walk_normal) {
   const ObjectInfo& o = scene.objects[hit.object];
+  if (sky_name(o.name)) return false;
   // A closed object wound inside out (all its normals inward) has its outside on their backs.
   const bool inward = o.closed && o.oriented && o.signed_volume < 0;
   if (hit.front == inward || !o.rendered) return false;
@@ -145,7 +156,7 @@ FloorSpace find_floor_space(const Scene& scene, const RayCaster& caster, const F
   if (!(mpu > 0 && std::isfinite(mpu))) throw Error("play space: metres per unit must be positive");
   const FloorSpaceConfig& c = config;
   if (!(c.cell > 0 && c.player_height > 0 && c.step >= 0 && c.eye_low >= 0 && c.eye_high > c.eye_low &&
-        c.walk_normal > 0 && c.walk_normal <= 1 && c.min_region >= 0 && c.max_columns > 0))
+        c.walk_normal > 0 && c.walk_normal <= 1 && c.min_region >= 0 && c.region_margin >= 0 && c.max_columns > 0))
     throw Error("play space: cell, player height and eye band must be positive (eye_low < eye_high), the step and "
                 "region size not negative, the walkable normal in (0, 1]");
   FloorSpace out;
@@ -154,7 +165,7 @@ FloorSpace find_floor_space(const Scene& scene, const RayCaster& caster, const F
   out.u_ = config;
   out.mpu_ = mpu;
   FloorSpaceConfig& u = out.u_;
-  for (double* d : {&u.cell, &u.player_height, &u.step, &u.eye_low, &u.eye_high}) *d /= mpu;
+  for (double* d : {&u.cell, &u.player_height, &u.step, &u.eye_low, &u.eye_high, &u.region_margin}) *d /= mpu;
   u.min_region /= mpu * mpu;
   if (u.start_points.empty()) u.start_points = scene.start_points;
   const Box3& b = scene.bounds;
@@ -267,7 +278,38 @@ FloorSpace find_floor_space(const Scene& scene, const RayCaster& caster, const F
   if (!u.start_points.empty())
     start_words = "reachable from " + std::to_string(starts_found) + " of " + std::to_string(u.start_points.size()) +
                   " start points";
+  // What the start points reach, flooded first: its box, grown by region_margin, bounds where
+  // regions join it (a level's backdrop around the playable part is a region too).
+  out.reached_.assign(spans, 0);
+  const auto flood = [&](std::vector<uint32_t>& from, const Box3* within) {
+    for (uint32_t s : from) out.reached_[s] = 1;
+    while (!from.empty()) {
+      const uint32_t a = from.back();
+      from.pop_back();
+      for (uint32_t bs : moves[a]) {
+        if (out.reached_[bs]) continue;
+        if (within) {
+          const int64_t col = std::upper_bound(out.first_.begin(), out.first_.end(), bs) - out.first_.begin() - 1;
+          if (!within->contains(centre(col, out.spans_[bs].floor))) continue;
+        }
+        out.reached_[bs] = 1;
+        from.push_back(bs);
+      }
+    }
+  };
+  flood(stack, nullptr);
   if (u.start_points.empty() || !u.only_from_starts) {
+    Box3 near;  // empty: no start points, every region joins
+    if (!u.start_points.empty()) {
+      for (int64_t col = 0; col < n; ++col)
+        for (uint32_t s = out.first_[col]; s < out.first_[col + 1]; ++s)
+          if (out.reached_[s]) near.extend(centre(col, out.spans_[s].floor));
+      if (near.empty()) near.extend(Vec3{0, 0, 0});  // no start point found a floor: nothing joins
+      const double m = u.region_margin;
+      near = Box3{near.lo - Vec3{m, m, std::numeric_limits<double>::infinity()},
+                  near.hi + Vec3{m, m, std::numeric_limits<double>::infinity()}};
+      if (starts_found == 0) near = Box3{};
+    }
     Regions regions(spans);
     for (uint32_t a = 0; a < spans; ++a)
       for (uint32_t bs : moves[a])
@@ -275,28 +317,24 @@ FloorSpace find_floor_space(const Scene& scene, const RayCaster& caster, const F
     std::vector<uint32_t> size(spans, 0);
     for (uint32_t a = 0; a < spans; ++a) ++size[regions.find(a)];
     const double cell_area = cell * cell;
-    size_t kept = 0;
-    for (uint32_t a = 0; a < spans; ++a)
-      if (regions.find(a) == a && size[a] * cell_area >= u.min_region) ++kept;
-    for (uint32_t a = 0; a < spans; ++a)
-      if (size[regions.find(a)] * cell_area >= u.min_region) stack.push_back(a);
+    const bool bounded = !u.start_points.empty();
+    std::vector<uint8_t> joined(spans, 0);
+    for (int64_t col = 0; col < n; ++col)
+      for (uint32_t a = out.first_[col]; a < out.first_[col + 1]; ++a)
+        if (size[regions.find(a)] * cell_area >= u.min_region && !out.reached_[a] &&
+            (!bounded || (!near.empty() && near.contains(centre(col, out.spans_[a].floor))))) {
+          stack.push_back(a);
+          joined[regions.find(a)] = 1;
+        }
+    const size_t kept = static_cast<size_t>(std::count(joined.begin(), joined.end(), 1));
+    if (bounded && !near.empty()) flood(stack, &near);
+    else if (!bounded) flood(stack, nullptr);
     const std::string regions_words =
         "every floor region of at least " + fmt(c.min_region, 1) + " m^2 (" + std::to_string(kept) + ")";
-    start_words = u.start_points.empty() ? "no start points: from " + regions_words
-                                         : start_words + " and from " + regions_words +
-                                               " (places start points miss, such as jump pads' and teleporters' "
-                                               "destinations)";
-  }
-  out.reached_.assign(spans, 0);
-  for (uint32_t s : stack) out.reached_[s] = 1;
-  while (!stack.empty()) {
-    const uint32_t a = stack.back();
-    stack.pop_back();
-    for (uint32_t bs : moves[a])
-      if (!out.reached_[bs]) {
-        out.reached_[bs] = 1;
-        stack.push_back(bs);
-      }
+    start_words = !bounded ? "no start points: from " + regions_words
+                           : start_words + " and from " + regions_words + " within " + fmt(c.region_margin, 1) +
+                                 " m of what they reach (places walking misses, such as jump pads' and "
+                                 "teleporters' destinations)";
   }
   for (int64_t col = 0; col < n; ++col)
     for (uint32_t s = out.first_[col]; s < out.first_[col + 1]; ++s) {

@@ -35,10 +35,14 @@ class WalkableFloors {
   double total_ = 0;
 };
 
+/// Whether a name marks a sky ("sky" in it, any case: a level's sky, a skybox, a Quake 3 map's
+/// textures/skies/... surfaces): a sky is never a floor (below a level it is a death pit).
+bool sky_name(const std::string& name);
+
 /// Whether a ray going down met a floor a player can stand on: the front of a rendered surface
 /// whose normal points up by at least walk_normal (the back, for a closed object wound inside
-/// out). The back of an open surface is never a floor: the top of a ceiling or of a sky seen
-/// from above is the inside of the level's shell.
+/// out) and whose object is not a sky (sky_name). The back of an open surface is never a floor:
+/// the top of a ceiling or of a sky seen from above is the inside of the level's shell.
 bool walkable_floor_hit(const Scene& scene, const Hit& hit, double walk_normal);
 
 /// A player's body and moves, in metres (see metres_per_unit). The defaults were chosen on the
@@ -59,11 +63,14 @@ struct FloorSpaceConfig {
   uint32_t max_columns = 4'000'000;  ///< more: the cell grows until the grid fits
   /// Where players start, in scene units (spawn points); empty: the scene's own
   /// (Scene::start_points). What they reach is in the play space, and so is every floor region
-  /// of at least min_region: walking from spawn points misses what jump pads and teleporters
-  /// reach, and a bake that leaves out where players stand draws far more there (a region too
-  /// many costs little). With only_from_starts and start points, only what they reach.
+  /// of at least min_region within region_margin (horizontally) of what they reach: walking
+  /// from spawn points misses what jump pads and teleporters reach, and a bake that leaves out
+  /// where players stand draws far more there, while a level's backdrop around its playable
+  /// part stays out. With only_from_starts, only what they reach. With no start points, every
+  /// region of at least min_region.
   std::vector<Vec3> start_points;
   bool only_from_starts = false;
+  double region_margin = 10;  ///< m
 };
 
 /// The play space found (find_floor_space): columns of floor spans on a grid over the scene.
