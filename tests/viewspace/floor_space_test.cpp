@@ -125,6 +125,40 @@ TEST(FloorSpace, ByDefaultLargeRegionsJoinWhatTheStartsReach) {
       << l.space.rule();
 }
 
+TEST(FloorSpace, ABackdropFarFromWhatTheStartsReachStaysOut) {
+  // A landscape 30 m beyond the level (a map's backdrop): a region of its own, far from what
+  // the start reaches: out by default, in without start points or with a wider margin.
+  RawMesh m = level(1);
+  add_floor(m, 50, 0, 70, 20, 0, "backdrop");
+  const Scene scene = make_scene(m, ObjectGrouping::kGroups, "level and backdrop");
+  const auto caster = make_brute_force_caster(scene);
+  FloorSpaceConfig c;
+  c.start_points = {{15, 4, 0.5}};
+  const Vec3 backdrop{60, 10, 1.6}, room{1.5, 8.5, 1.6};
+  const FloorSpace near = find_floor_space(scene, *caster, c);
+  EXPECT_TRUE(near.contains(room)) << near.rule();
+  EXPECT_FALSE(near.contains(backdrop)) << near.rule();
+  c.region_margin = 40;
+  EXPECT_TRUE(find_floor_space(scene, *caster, c).contains(backdrop));
+  c.start_points.clear();
+  c.region_margin = 10;
+  EXPECT_TRUE(find_floor_space(scene, *caster, c).contains(backdrop));
+}
+
+TEST(FloorSpace, ASkyIsNoFloor) {
+  // A sky below the level (a death pit): its surface faces up, but a sky is never a floor.
+  RawMesh m = level(1);
+  add_floor(m, -20, -20, 40, 30, -10, "textures/skies/pit");
+  const Scene scene = make_scene(m, ObjectGrouping::kGroups, "level over a sky");
+  const auto caster = make_brute_force_caster(scene);
+  FloorSpaceConfig c;
+  c.start_points = {{15, 4, 0.5}};
+  const FloorSpace s = find_floor_space(scene, *caster, c);
+  EXPECT_TRUE(s.contains({7, 5, 1.6}));
+  EXPECT_FALSE(s.contains({30, 25, -10 + 1.6}));  // drops from the level's edge land on the sky
+  EXPECT_TRUE(sky_name("textures/skies/pit") && sky_name("SkyBox") && !sky_name("floor"));
+}
+
 TEST(FloorSpace, QuakeUnitsGiveTheSameSpaceAsMetres) {
   const Level m(1), q(32);
   ASSERT_FALSE(q.space.empty()) << q.space.rule();

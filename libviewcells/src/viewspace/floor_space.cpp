@@ -48,12 +48,9 @@ constexpr uint32_t kViewpoints = 200000;
 }  // namespace
 
 bool sky_name(const std::string& name) {
-  for (size_t i = 0; i + 3 <= name.size(); ++i)
-    if (std::tolower(static_cast<unsigned char>(name[i])) == 's' &&
-        std::tolower(static_cast<unsigned char>(name[i + 1])) == 'k' &&
-        std::tolower(static_cast<unsigned char>(name[i + 2])) == 'y')
-      return true;
-  return false;
+  std::string lower(name);
+  for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+  return lower.find("sky") != std::string::npos || lower.find("skies") != std::string::npos;
 }
 
 bool walkable_floor_hit(const Scene& scene, const Hit& hit, double walk_normal) {

@@ -35,8 +35,9 @@ class WalkableFloors {
   double total_ = 0;
 };
 
-/// Whether a name marks a sky ("sky" in it, any case: a level's sky, a skybox, a Quake 3 map's
-/// textures/skies/... surfaces): a sky is never a floor (below a level it is a death pit).
+/// Whether a name marks a sky ("sky" or "skies" in it, any case: a level's sky, a skybox, a
+/// Quake 3 map's textures/skies/... surfaces): a sky is never a floor (below a level it is a
+/// death pit).
 bool sky_name(const std::string& name);
 
 /// Whether a ray going down met a floor a player can stand on: the front of a rendered surface
