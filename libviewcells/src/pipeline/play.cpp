@@ -89,6 +89,8 @@ std::string report_json(const PlaySpaceRun& run) {
               {"step_m", f.step},
               {"eye_band_m", {f.eye_low, f.eye_high}},
               {"min_region_m2", f.min_region},
+              {"region_margin_m", f.region_margin},
+              {"only_from_starts", f.only_from_starts},
               {"start_points_given", f.start_points.size()}}},
             {"found", run.found},
             {"rule", run.rule},

@@ -247,8 +247,8 @@ FloorSpace find_floor_space(const Scene& scene, const RayCaster& caster, const F
   });
 
   // 3. Starts: the span under each start point (the highest floor at most a step above it: a
-  // start in the air falls to the floor below, in its column or the nearest ones around); with
-  // none, every region of spans joined by walking both ways that is large enough.
+  // start in the air falls to the floor below, in its column or the nearest ones around), then
+  // the large enough regions of spans joined by walking both ways (FloorSpaceConfig::start_points).
   std::vector<uint32_t> stack;
   size_t starts_found = 0;
   for (const Vec3& p : u.start_points) {
