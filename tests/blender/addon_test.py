@@ -73,6 +73,9 @@ window.data.materials.append(glass)
 for p in window.data.polygons:  # the faces across x are glass
     if abs(p.normal.x) > 0.5:
         p.material_index = 1
+# Where players start: an empty the glTF export carries as a node, and the add-on as --start.
+bpy.ops.object.empty_add(location=(-2.0, -3.5, 0.1))
+bpy.context.active_object.name = "PlayerStart"
 # Transforms applied, so that the add-on (which applies them in double) and the glTF file
 # (which stores them in float) hold the very same coordinates.
 bpy.ops.object.select_all(action="SELECT")
@@ -119,6 +122,14 @@ for c in range(ours.cell_count):
         if not np.array_equal(va, vb) or fa != fb:
             fail(f"cell {c}: its pieces differ")
 print("the add-on's cells and PVSs equal the command line's bake of the glTF export")
+# The add-on hands the empty to the bake as a start point, as the glTF reader reads the node.
+_vc, scene_for_report, _out, start_options, _m = addon.VIEWCELLS_OT_bake.prepare(None, bpy.context)
+if len(start_options.get("start", [])) != 1:
+    fail(f"the add-on's bake options have no start point: {start_options}")
+start_options.update(cells=2, samples=2000, agvs_samples=2000, max_cells=8)
+view_space = vc.bake(scene_for_report, os.path.join(work, "start.pvs"), **start_options).report["settings"]["view_space"]
+if "reachable from 1 of 1 start points" not in view_space:
+    fail(f"the bake did not take the add-on's start point: {view_space}")
 
 # The cells: one translucent mesh each, coloured by render cost, holding id, cost and PVS.
 cells = bpy.data.collections.get(addon.CELLS_COLLECTION)

@@ -108,6 +108,21 @@ def level_meshes(context, exclude=CELLS_COLLECTION):
     return out
 
 
+def start_points(context):
+    """Where players start, as the glTF reader takes them from an export: the world positions of
+    the empties whose names hold "spawn", "player start" or "info_player" (any case; spaces,
+    underscores, dashes and dots ignored), as `--start` words."""
+    out = []
+    for o in context.view_layer.objects:
+        if o.type != "EMPTY":
+            continue
+        name = "".join(ch for ch in o.name.lower() if ch not in " _-.")
+        if "spawn" in name or "playerstart" in name or "infoplayer" in name:
+            p = o.matrix_world.translation
+            out.append(f"{p.x!r},{p.y!r},{p.z!r}")
+    return out
+
+
 def owner_name(obj, per):
     """The name of the PVS object a Blender object belongs to: itself, or (per collection) its
     first collection other than the scene's own."""
@@ -371,7 +386,11 @@ class VIEWCELLS_OT_bake(bpy.types.Operator):
         scene = vc.Scene(v, t, objects=o, names=names, see_through=see_through,
                          name=bpy.path.basename(bpy.data.filepath) or "blender scene")
         output = bpy.path.abspath(settings.output)
-        return vc, scene, output, bake_options(settings), dict(zip(names, members))
+        options = bake_options(settings)
+        starts = start_points(context)
+        if starts and "start" not in options:
+            options["start"] = starts  # the play space's start points, as a glTF export carries them
+        return vc, scene, output, options, dict(zip(names, members))
 
     def execute(self, context):  # blocking: scripts and the headless test
         try:
