@@ -457,8 +457,6 @@ void log_bake(const BakeConfig& c, const BakeResult& out, const Log& log) {
       std::to_string(out.file_bytes) + " bytes in " + fmt(out.seconds, 1) + " s");
 }
 
-}  // namespace
-
 /// Whether the bake weighs cells by the play space (BakeConfig::play_space_where_known): sets it
 /// in `run` and out.config, and returns which view space was chosen and why, in words.
 std::string choose_play_space(const BakeConfig& c, const LoadedScene& loaded, BakeConfig& run, BakeResult& out,
@@ -482,6 +480,8 @@ std::string choose_play_space(const BakeConfig& c, const LoadedScene& loaded, Ba
       (rule.empty() ? std::string() : ": " + rule));
   return "the play space (where players stand, found by default): " + rule;
 }
+
+}  // namespace
 
 BakeResult bake(const BakeConfig& c, const Log& log) {
   check_bake(c);
