@@ -11,11 +11,12 @@
 #include <limits>
 #include <mutex>
 #include <numbers>
-#include <numeric>
+#include <string_view>
 
 #include "viewcells/core/error.h"
 #include "viewcells/core/format.h"
 #include "viewcells/core/rng.h"
+#include "viewcells/core/union_find.h"
 
 namespace viewcells {
 
@@ -48,9 +49,13 @@ constexpr uint32_t kViewpoints = 200000;
 }  // namespace
 
 bool sky_name(const std::string& name) {
-  std::string lower(name);
-  for (char& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  return lower.find("sky") != std::string::npos || lower.find("skies") != std::string::npos;
+  // "skies" holds no "sky": both are looked for, case aside, with no copy (this runs per hit).
+  const auto holds = [&](std::string_view word) {
+    return std::search(name.begin(), name.end(), word.begin(), word.end(), [](char a, char b) {
+             return std::tolower(static_cast<unsigned char>(a)) == b;
+           }) != name.end();
+  };
+  return holds("sky") || holds("skies");
 }
 
 bool walkable_floor_hit(const Scene& scene, const Hit& hit, double walk_normal) {
@@ -62,25 +67,6 @@ bool walkable_floor_hit(const Scene& scene, const Hit& hit, double walk_normal) 
   const Vec3 n = scene.triangle_normal(hit.triangle) * (inward ? -1.0 : 1.0);
   return n.z >= walk_normal * length(n) && n.z > 0;
 }
-
-namespace {
-
-/// Union-find over span ids (path halving).
-struct Regions {
-  std::vector<uint32_t> parent;
-  explicit Regions(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-  uint32_t find(uint32_t a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  }
-  void join(uint32_t a, uint32_t b) {
-    a = find(a);
-    b = find(b);
-    if (a != b) parent[std::max(a, b)] = std::min(a, b);
-  }
-};
-
-}  // namespace
 
 int64_t FloorSpace::column_of(double x, double y) const {
   const double fx = std::floor((x - x0_) / cell_), fy = std::floor((y - y0_) / cell_);
@@ -307,10 +293,10 @@ FloorSpace find_floor_space(const Scene& scene, const RayCaster& caster, const F
                   near.hi + Vec3{m, m, std::numeric_limits<double>::infinity()}};
       if (starts_found == 0) near = Box3{};
     }
-    Regions regions(spans);
+    UnionFind regions(spans);
     for (uint32_t a = 0; a < spans; ++a)
       for (uint32_t bs : moves[a])
-        if (std::find(moves[bs].begin(), moves[bs].end(), a) != moves[bs].end()) regions.join(a, bs);
+        if (std::find(moves[bs].begin(), moves[bs].end(), a) != moves[bs].end()) regions.unite(a, bs);
     std::vector<uint32_t> size(spans, 0);
     for (uint32_t a = 0; a < spans; ++a) ++size[regions.find(a)];
     const double cell_area = cell * cell;
