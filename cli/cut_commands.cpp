@@ -8,6 +8,7 @@
 #include "viewcells/io/scene_io.h"
 #include "viewcells/vis/level_view.h"
 #include "viewcells/pipeline/cut.h"
+#include "viewcells/pipeline/play.h"
 #include "viewcells/pipeline/report.h"
 
 namespace viewcells::cli {
@@ -90,6 +91,8 @@ int run_recode(const RecodeArgs& a, const Common& c) {
 struct ViewArgs {
   std::string input, scene, site, gltf, objects = "auto";
   double cost_a = CostModel{}.a, cost_b = CostModel{}.b;
+  bool no_play_space = false;
+  FloorOptions floors;
 };
 
 int run_view(const ViewArgs& a, const Common& c) {
@@ -101,8 +104,17 @@ int run_view(const ViewArgs& a, const Common& c) {
   model.b = a.cost_b;
   model.validate();
   PvsFile f = read_pvs(a.input);
-  const Scene scene = load_scene(a.scene, parse_grouping(a.objects));
-  const LevelView view = make_level_view(std::move(f), scene, model);
+  const auto scene = std::make_shared<const Scene>(load_scene(a.scene, parse_grouping(a.objects)));
+  LevelView view = make_level_view(std::move(f), *scene, model);
+  if (!a.no_play_space) {
+    pipeline::SceneSource source;
+    source.path = a.scene;
+    source.scene = scene;
+    source.floors = a.floors.floors();
+    pipeline::add_play_space(view, source, c.logger());
+    c.log("viewcells: play space " + std::string(view.play_space.indices.empty() ? "" : "drawn (green): ") +
+          view.play_space_rule);
+  }
   if (!a.gltf.empty()) {
     write_level_gltf(a.gltf, view);
     c.log("viewcells: wrote " + a.gltf + " (" + std::to_string(view.pvs.size()) + " view cells, " +
@@ -175,6 +187,10 @@ void add_cut_commands(CLI::App& app, const Common& common, Commands& commands) {
   vw->add_option("--cost-a", v->cost_a, "Render cost model for the colours: r = max(a, b * triangles)")
       ->capture_default_str();
   vw->add_option("--cost-b", v->cost_b, "Render cost model: cost per triangle")->capture_default_str();
+  vw->add_flag("--no-play-space", v->no_play_space,
+               "Do not draw the play space (scenes other than Quake 3 maps: the floors players are assumed to stand "
+               "on, found as bake finds them; give bake's floor options again if the bake had any)");
+  add_floor_options(vw, v->floors);
   commands.push_back({vw, [v, &common] { return run_view(*v, common); }});
 }
 

@@ -324,6 +324,22 @@ const sun = new THREE.DirectionalLight(0xffffff, 1.4);
 sun.position.set(0.4, -0.6, 1);
 scene.add(sun, sceneGroup, cellMesh, selectedGroup, sectionMesh, sceneSection);
 
+// The play space (where the bake assumed players stand): its floors in green, a little above
+// them, clipped by the cutaway like the scene. Absent in data from before it (format 1 without
+// play_space) and on maps (their play space is BSP leaves).
+const playData = D.play_space || { rule: '', positions: '', indices: '' };
+const playIndices = playData.indices ? decode(playData.indices, Uint32Array) : new Uint32Array(0);
+const playMesh = new THREE.Mesh(new THREE.BufferGeometry(), new THREE.MeshBasicMaterial({
+  color: 0x33d94d, transparent: true, opacity: 0.45, depthWrite: false, side: THREE.DoubleSide,
+  clippingPlanes: clipping }));
+if (playIndices.length) {
+  playMesh.geometry.setAttribute('position',
+    new THREE.BufferAttribute(decode(playData.positions, Float32Array), 3));
+  playMesh.geometry.setIndex(new THREE.BufferAttribute(playIndices, 1));
+}
+playMesh.renderOrder = 2;
+scene.add(playMesh);
+
 // The cut's controls: on by default at the middle of the view box's height; #cut=Z or #cut=off.
 const cutaway = document.getElementById('cutaway'), cutSlider = document.getElementById('cut');
 cutSlider.min = box[2];
@@ -341,9 +357,10 @@ function applyCut() {
   document.getElementById('cutz').textContent = on ? `z = ${Number(cutSlider.value).toFixed(2)}` : 'off';
   clipping.length = 0;
   if (on) clipping.push(cut);
-  sectionMesh.visible = sceneSection.visible = on;
+  sceneSection.visible = on;
+  sectionMesh.visible = on && cellsMode() !== 'none';
   if (on) buildSections(Number(cutSlider.value));
-  for (const m of [sceneMaterial, cellMesh.material]) m.needsUpdate = true;
+  for (const m of [sceneMaterial, cellMesh.material, playMesh.material]) m.needsUpdate = true;
   dirty = true;
 }
 
@@ -420,6 +437,7 @@ function selectCell(point) {
 const cellsMode = () => document.getElementById('cells').value;
 document.getElementById('cells').addEventListener('change', () => {
   cellMesh.visible = cellsMode() === 'all';
+  sectionMesh.visible = cutaway.checked && cellsMode() !== 'none';
   showSelectedCell(state.selected && cellsMode() !== 'none' ? state.selected.cell : -1);
   dirty = true;
 });
@@ -505,6 +523,7 @@ for (const [key, id] of [['cells', 'cells'], ['colour', 'colour'], ['draw', 'dra
   if (value && [...el.options].some((o) => o.value === value)) el.value = value;
 }
 cellMesh.visible = cellsMode() === 'all';
+sectionMesh.visible = cutaway.checked && cellsMode() !== 'none';
 renderer.setPixelRatio(pixelRatio());
 document.getElementById('scale').addEventListener('change', () => {
   renderer.setPixelRatio(pixelRatio());
@@ -516,6 +535,16 @@ paintCells(document.getElementById('colour').value);
 cutaway.addEventListener('change', applyCut);
 cutSlider.addEventListener('input', applyCut);
 applyCut();
+// #play=0 hides the play space; the checkbox is off and says why when there is none.
+{
+  const box = document.getElementById('play'), why = document.getElementById('playrule');
+  box.checked = playIndices.length > 0 && hash.get('play') !== '0';
+  box.disabled = playIndices.length === 0;
+  why.textContent = playIndices.length ? '' : (playData.rule ? `(none: ${playData.rule})` : '(none)');
+  why.title = playData.rule;
+  playMesh.visible = box.checked;
+  box.addEventListener('change', () => { playMesh.visible = box.checked; dirty = true; });
+}
 window.viewcells = {
   get ready() { return state.ready; },
   get selected() { return state.selected; },
@@ -529,6 +558,8 @@ window.viewcells = {
   get cut() { return cutaway.checked ? Number(cutSlider.value) : null; },
   get sectionCells() { return sectionCells.slice(); },
   get cellCount() { return cells.count; },
+  // The play space's floors: triangles, and whether they are drawn.
+  get playSpace() { return { triangles: playIndices.length / 3, visible: playMesh.visible, rule: playData.rule }; },
   cellColour: (c) => {
     const v = 3 * cells.firstVertex[c];
     const col = new THREE.Color(cellColours[v], cellColours[v + 1], cellColours[v + 2]).convertLinearToSRGB();

@@ -94,6 +94,36 @@ try {
     await page.close();
   }
 
+  // The play space (the office's floors, found as bake finds them) is drawn in green: without the
+  // cells (#cells=none: neither they nor their cross-sections), the first view has clearly more
+  // green pixels than with #play=0 too.
+  const greens = [];
+  for (const h of ['cells=none', 'cells=none&play=0']) {
+    const { page, errors } = await openSite(browser, join(work, 'site', 'index.html'), h);
+    await page.waitForTimeout(300);
+    const play = await page.evaluate(() => window.viewcells.playSpace);
+    const png = await page.screenshot({ path: join(work, `viewer-${h.replace(/[=&]/g, '-')}.png`) });
+    greens.push(await page.evaluate(async (data) => {
+      const img = new Image();
+      img.src = 'data:image/png;base64,' + data;
+      await img.decode();
+      const cv = document.createElement('canvas');
+      cv.width = img.width; cv.height = img.height;
+      const g = cv.getContext('2d');
+      g.drawImage(img, 0, 0);
+      const d = g.getImageData(0, 0, cv.width, cv.height).data;
+      let n = 0;
+      for (let i = 0; i < d.length; i += 4) if (d[i + 1] > d[i] + 40 && d[i + 1] > d[i + 2] + 40) ++n;
+      return n / (d.length / 4);
+    }, png.toString('base64')));
+    if (!(play.triangles > 0)) fail(`no play space drawn: ${play.rule}`);
+    if (play.visible !== !h.includes('play=0')) fail(`play space visible ${play.visible} with '${h}'`);
+    if (errors.length) fail('the page logged errors: ' + errors.join('; '));
+    await page.close();
+  }
+  console.log(`play space: ${(100 * greens[0]).toFixed(1)}% green pixels drawn, ${(100 * greens[1]).toFixed(1)}% without it`);
+  if (!(greens[0] > greens[1] + 0.02)) fail('the play space does not show as green floors');
+
   const { page, errors } = await openSite(browser, join(work, 'site', 'index.html'), hash);
   const box = await page.locator('canvas').boundingBox();
   await page.mouse.click(box.x + box.width / 2, box.y + box.height / 2);

@@ -75,6 +75,49 @@ PlaySpaceRun play_space(const PlaySpaceRunConfig& config, const Log& log) {
   return out;
 }
 
+namespace {
+constexpr const char* kMapPlaySpace =
+    "not drawn: a Quake 3 map's play space is the BSP leaves a player's eye reaches, not found from floors";
+}  // namespace
+
+FoundPlaySpace find_play_space(const SceneSource& source, const Log& log) {
+  FoundPlaySpace out;
+  out.loaded = load_scene_for_rays(source, log);
+  if (out.loaded.map) {
+    out.why = kMapPlaySpace;
+    return out;
+  }
+  auto space = std::make_shared<FloorSpace>(find_floor_space(*out.loaded.scene, *out.loaded.caster, source.floors));
+  out.why = space->rule();
+  if (!space->empty()) out.space = std::move(space);
+  return out;
+}
+
+GroupedMesh floor_mesh(const FloorSpace& space, double lift_m) {
+  GroupedMesh m;
+  const double lift = lift_m / space.metres_per_unit();
+  for (const FloorSpace::FloorRect& r : space.floor_rects()) {
+    const auto base = static_cast<uint32_t>(m.positions.size() / 3);
+    const float z = static_cast<float>(r.z + lift);
+    for (const auto& [x, y] : {std::pair{r.x0, r.y0}, {r.x1, r.y0}, {r.x1, r.y1}, {r.x0, r.y1}})
+      m.positions.insert(m.positions.end(), {static_cast<float>(x), static_cast<float>(y), z});
+    m.indices.insert(m.indices.end(), {base, base + 1, base + 2, base, base + 2, base + 3});
+  }
+  m.first_vertex = {0, static_cast<uint32_t>(m.positions.size() / 3)};
+  m.first_index = {0, static_cast<uint32_t>(m.indices.size())};
+  return m;
+}
+
+void add_play_space(LevelView& view, const SceneSource& source, const Log& log) {
+  if (!source.scene && is_q3_map(source.path)) {
+    view.play_space_rule = kMapPlaySpace;
+    return;
+  }
+  const FoundPlaySpace found = find_play_space(source, log);
+  view.play_space_rule = found.why;
+  if (found.space) view.play_space = floor_mesh(*found.space);
+}
+
 std::string report_json(const PlaySpaceRun& run) {
   using nlohmann::json;
   const FloorSpaceConfig& f = run.config.scene.floors;

@@ -12,6 +12,7 @@
 #include <mutex>
 #include <numbers>
 #include <string_view>
+#include <tuple>
 
 #include "viewcells/core/error.h"
 #include "viewcells/core/format.h"
@@ -66,6 +67,32 @@ bool walkable_floor_hit(const Scene& scene, const Hit& hit, double walk_normal) 
   if (hit.front == inward || !o.rendered) return false;
   const Vec3 n = scene.triangle_normal(hit.triangle) * (inward ? -1.0 : 1.0);
   return n.z >= walk_normal * length(n) && n.z > 0;
+}
+
+std::vector<FloorSpace::FloorRect> FloorSpace::floor_rects() const {
+  // Per row, the reached spans by (height, column): a run of next columns at one height is a
+  // rectangle.
+  std::vector<FloorRect> out;
+  const double same = 0.001 / mpu_;
+  std::vector<std::tuple<int64_t, int64_t, double>> row;  // (height in mm, column, height)
+  for (int64_t y = 0; y < ny_; ++y) {
+    row.clear();
+    for (int64_t x = 0; x < nx_; ++x)
+      for (uint32_t s = first_[y * nx_ + x]; s < first_[y * nx_ + x + 1]; ++s)
+        if (reached_[s]) row.emplace_back(std::llround(spans_[s].floor / same), x, spans_[s].floor);
+    std::sort(row.begin(), row.end());
+    for (size_t i = 0; i < row.size();) {
+      size_t j = i + 1;
+      while (j < row.size() && std::get<0>(row[j]) == std::get<0>(row[i]) &&
+             std::get<1>(row[j]) == std::get<1>(row[j - 1]) + 1)
+        ++j;
+      const double yl = y0_ + static_cast<double>(y) * cell_;
+      out.push_back({x0_ + static_cast<double>(std::get<1>(row[i])) * cell_, yl,
+                     x0_ + static_cast<double>(std::get<1>(row[j - 1]) + 1) * cell_, yl + cell_, std::get<2>(row[i])});
+      i = j;
+    }
+  }
+  return out;
 }
 
 int64_t FloorSpace::column_of(double x, double y) const {

@@ -279,13 +279,20 @@ void write_level_gltf(const std::string& path, const LevelView& view) {
   const int cell_root = b.add_node({{"name", "view cells"}, {"children", cells}});
   if (objects.empty()) b.node(scene_root).erase("children");
   if (cells.empty()) b.node(cell_root).erase("children");
+  std::vector<int> roots = {scene_root, cell_root};
+  if (view.play_space.group_count() == 1 && !view.play_space.indices.empty()) {
+    const int green = b.add_material("play space", {0.2, 0.85, 0.3}, 0.5);
+    roots.push_back(b.add_node({{"name", "play space"},
+                                {"mesh", b.add_mesh(view.play_space, 0, green)},
+                                {"extras", {{"rule", view.play_space_rule}}}}));
+  }
   const json extras = {{"viewcells",
                         {{"scene", view.scene_source},
                          {"rule", view.file.rule},
                          {"cells", view.file.pvs.cell_count},
                          {"cost_model", {{"a", view.model.a}, {"b", view.model.b}}},
                          {"objects", view.object_names}}}};
-  write_text_file(path, b.glb({scene_root, cell_root}, extras));
+  write_text_file(path, b.glb(roots, extras));
 }
 
 void write_scene_gltf(const std::string& path, const Scene& scene, const SceneGltfOptions& options) {
@@ -356,7 +363,11 @@ void write_web_viewer(const std::string& dir, const LevelView& view) {
         {"positions", base64(view.cells.positions)},
         {"indices", base64(view.cells.indices)},
         {"first_vertex", base64(view.cells.first_vertex)},
-        {"first_index", base64(view.cells.first_index)}}}};
+        {"first_index", base64(view.cells.first_index)}}},
+      {"play_space",
+       {{"rule", view.play_space_rule},
+        {"positions", base64(view.play_space.positions)},
+        {"indices", base64(view.play_space.indices)}}}};
   const std::filesystem::path d(dir);
   write_text_file((d / "data.js").string(), "window.VIEWCELLS_DATA = " + data.dump() + ";\n");
   write_text_file((d / "viewer.js").string(), web_assets::viewer_js());

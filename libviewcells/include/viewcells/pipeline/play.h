@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "viewcells/pipeline/sampling.h"
+#include "viewcells/vis/level_view.h"
 #include "viewcells/viewspace/floor_space.h"
 
 namespace viewcells::pipeline {
@@ -46,6 +47,25 @@ struct PlaySpaceRun {
 };
 
 PlaySpaceRun play_space(const PlaySpaceRunConfig& config, const Log& log);
+
+/// A play space found from a scene's floors (as bake finds it), with the scene and ray caster
+/// it refers to kept alive. A Quake 3 map gets none here: its play space is its BSP's leaves
+/// (q3/play.h); `space` is then null and `why` says so, as it does when no floor is found.
+struct FoundPlaySpace {
+  LoadedScene loaded;
+  std::shared_ptr<const FloorSpace> space;  ///< null when none was found
+  std::string why;                          ///< the rule found, or why there is none
+};
+FoundPlaySpace find_play_space(const SceneSource& source, const Log& log);
+
+/// The reached floors for people to look at: FloorSpace::floor_rects() as one group of
+/// triangles, lifted `lift_m` metres above the floors (so that they show over them).
+GroupedMesh floor_mesh(const FloorSpace& space, double lift_m = 0.03);
+
+/// The play space of `scene_path`'s floors (floor_mesh) added to a view of its cells, for the
+/// web page and glTF (`viewcells view`); nothing, with the reason in view.play_space_rule, on a
+/// map or a scene without floors.
+void add_play_space(LevelView& view, const SceneSource& source, const Log& log);
 /// The run's JSON report (indented, with a final newline).
 std::string report_json(const PlaySpaceRun& run);
 

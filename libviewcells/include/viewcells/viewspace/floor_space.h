@@ -101,6 +101,12 @@ class FloorSpace {
   double floor_area() const { return reached_area_; }
   size_t spans() const { return spans_.size(); }
   size_t reached_spans() const { return reached_count_; }
+  /// The reached floors for people to look at: rectangles of columns in a row whose reached
+  /// spans stand at the same height (within 1 mm), scene units.
+  struct FloorRect {
+    double x0 = 0, y0 = 0, x1 = 0, y1 = 0, z = 0;
+  };
+  std::vector<FloorRect> floor_rects() const;
   /// What was found and how, in words (for logs and reports).
   const std::string& rule() const { return rule_; }
   /// The body in scene units.

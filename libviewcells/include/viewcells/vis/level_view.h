@@ -35,6 +35,10 @@ struct LevelView {
   CostModel model;
   PvsFile file;                              ///< point location (BSP, leaf -> cell) and the rule
   std::string scene_source;
+  /// Where players are assumed to stand (pipeline::add_play_space): the play space's floors, one
+  /// group (empty: none drawn), and its rule or why there is none.
+  GroupedMesh play_space;
+  std::string play_space_rule;
 };
 
 /// Builds the views' content. Throws Error when `scene` is not the scene `f` was made for
@@ -46,7 +50,8 @@ LevelView make_level_view(PvsFile f, const Scene& scene, const CostModel& model)
 /// see-through objects translucent), node "view cells" with one child per view cell (colour
 /// from blue to red by render cost, translucent), whose extras hold its id, render cost, PVS
 /// size and PVS (object ids); the asset's extras hold the object names, the cost model and the
-/// rule the cells were cut by. Written atomically.
+/// rule the cells were cut by; with a play space, node "play space" (its floors, green,
+/// translucent; extras: the rule). Written atomically.
 void write_level_gltf(const std::string& path, const LevelView& view);
 
 /// How write_scene_gltf writes a scene.
