@@ -38,6 +38,7 @@
 #include "viewcells/core/paths.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pipeline/bake.h"
+#include "viewcells/pipeline/play.h"
 #include "viewcells/pipeline/report.h"
 #include "viewcells/pvs/pvs.h"
 #include "viewcells/vis/level_view.h"
@@ -422,6 +423,53 @@ void run_interruptible(const std::function<void()>& work) {
   if (failed) std::rethrow_exception(failed);
 }
 
+/// The play space found from a scene's floors (pipeline::find_play_space), for Python.
+struct PlaySpacePy {
+  pipeline::FoundPlaySpace found;
+  bool has() const { return found.space != nullptr; }
+  const FloorSpace& space() const {
+    if (!found.space) throw Error("no play space: " + found.why);
+    return *found.space;
+  }
+};
+
+/// A scene argument (a Scene, or a scene file's path) as a source.
+pipeline::SceneSource source_of(const py::object& scene, const std::string& what) {
+  pipeline::SceneSource source;
+  if (py::isinstance<Scene>(scene)) {
+    source.scene = scene.cast<std::shared_ptr<Scene>>();
+    source.path = source.scene->source;
+  } else if (py::isinstance<py::str>(scene) || py::hasattr(scene, "__fspath__")) {
+    source.path = path_of(scene, what.c_str());
+  } else {
+    throw py::type_error(what + " must be a viewcells.Scene or a scene file's path, not " +
+                         py::str(py::type::of(scene).attr("__name__")).cast<std::string>());
+  }
+  return source;
+}
+
+std::shared_ptr<PlaySpacePy> play_space(const py::object& scene, const std::vector<std::array<double, 3>>& start,
+                                        double metres_per_unit, bool only_from_starts, double region_margin,
+                                        double player_height, double step, std::array<double, 2> eye_band,
+                                        double walk_normal, double floor_cell, double min_region) {
+  pipeline::SceneSource source = source_of(scene, "play_space: scene");
+  FloorSpaceConfig& f = source.floors;
+  f.metres_per_unit = metres_per_unit;
+  for (const auto& p : start) f.start_points.push_back({p[0], p[1], p[2]});
+  f.only_from_starts = only_from_starts;
+  f.region_margin = region_margin;
+  f.player_height = player_height;
+  f.step = step;
+  f.eye_low = eye_band[0];
+  f.eye_high = eye_band[1];
+  f.walk_normal = walk_normal;
+  f.cell = floor_cell;
+  f.min_region = min_region;
+  auto out = std::make_shared<PlaySpacePy>();
+  run_interruptible([&] { out->found = pipeline::find_play_space(source, [](const std::string&) {}); });
+  return out;
+}
+
 std::shared_ptr<Baked> bake(const py::object& scene, const py::object& output_path, const py::object& progress,
                             const py::kwargs& options) {
   std::shared_ptr<const Scene> memory;
@@ -600,6 +648,59 @@ PYBIND11_MODULE(viewcells, m) {
   m.def("read", &read_baked, py::arg("path"), py::arg("scene") = py::none(), py::arg("objects") = "auto",
         "Reads a .pvs file; `scene` (a Scene or its file's path, with the grouping `objects` it was baked with) "
         "is needed for cell_meshes, cell_costs and write_gltf");
+
+  const FloorSpaceConfig floors;
+  py::class_<PlaySpacePy, std::shared_ptr<PlaySpacePy>>(
+      m, "PlaySpace", "Where players stand, found from a scene's floors as bake finds its default view space")
+      .def_property_readonly("found", &PlaySpacePy::has, "Whether the scene has a play space")
+      .def_property_readonly("rule", [](const PlaySpacePy& p) { return p.found.why; },
+                             "What was found and how (or why nothing was), in words")
+      .def_property_readonly("metres_per_unit", [](const PlaySpacePy& p) { return p.space().metres_per_unit(); })
+      .def_property_readonly("volume_m3", [](const PlaySpacePy& p) {
+        const double k = p.space().metres_per_unit();
+        return p.space().volume() * k * k * k;
+      }, "The eye band's volume over the reached floors, m^3")
+      .def_property_readonly("floor_area_m2", [](const PlaySpacePy& p) {
+        const double k = p.space().metres_per_unit();
+        return p.space().floor_area() * k * k;
+      }, "The reached floors' area, m^2")
+      .def_property_readonly("box", [](const PlaySpacePy& p) {
+        const Box3& b = p.space().box();
+        return std::array<std::array<double, 3>, 2>{{{b.lo.x, b.lo.y, b.lo.z}, {b.hi.x, b.hi.y, b.hi.z}}};
+      }, "((xmin, ymin, zmin), (xmax, ymax, zmax)) of the eye band, scene units")
+      .def("contains", [](const PlaySpacePy& p, const std::array<double, 3>& x) {
+        return p.space().contains({x[0], x[1], x[2]});
+      }, py::arg("point"), "Whether a player's eye can be at the point (scene units)")
+      .def("points", [](const PlaySpacePy& p, uint32_t count, uint64_t seed) {
+        const std::vector<Vec3> v = p.space().uniform_points(count, seed);
+        py::array_t<double> a({static_cast<py::ssize_t>(v.size()), py::ssize_t{3}});
+        auto w = a.mutable_unchecked<2>();
+        for (size_t i = 0; i < v.size(); ++i) {
+          w(i, 0) = v[i].x;
+          w(i, 1) = v[i].y;
+          w(i, 2) = v[i].z;
+        }
+        return a;
+      }, py::arg("count"), py::arg("seed") = 1, "(count, 3) points uniform in the play space")
+      .def_property_readonly("floors", [](const PlaySpacePy& p) {
+        const GroupedMesh g = pipeline::floor_mesh(p.space());
+        py::array_t<float> v({static_cast<py::ssize_t>(g.positions.size() / 3), py::ssize_t{3}});
+        std::copy(g.positions.begin(), g.positions.end(), v.mutable_data());
+        py::array_t<uint32_t> t({static_cast<py::ssize_t>(g.indices.size() / 3), py::ssize_t{3}});
+        std::copy(g.indices.begin(), g.indices.end(), t.mutable_data());
+        return py::make_tuple(v, t);
+      }, "The reached floors to draw, 3 cm above them: (vertices (V, 3) float32, triangles (T, 3))");
+
+  m.def("play_space", &play_space, py::arg("scene"), py::kw_only(), py::arg("start") = std::vector<std::array<double, 3>>{},
+        py::arg("metres_per_unit") = floors.metres_per_unit, py::arg("only_from_starts") = floors.only_from_starts,
+        py::arg("region_margin") = floors.region_margin, py::arg("player_height") = floors.player_height,
+        py::arg("step") = floors.step, py::arg("eye_band") = std::array<double, 2>{floors.eye_low, floors.eye_high},
+        py::arg("walk_normal") = floors.walk_normal, py::arg("floor_cell") = floors.cell,
+        py::arg("min_region") = floors.min_region,
+        "Finds where players stand on `scene` (a Scene or a scene file's path) from its walkable floors, as "
+        "bake does for its default view space: the keywords are bake's (start points in scene units, the "
+        "rest in metres; metres_per_unit 0: the file's own). A Quake 3 map's play space is its BSP's "
+        "leaves: found is False there, and rule says so.");
 
   m.def("bake", &bake, py::arg("scene"), py::arg("output"), py::kw_only(), py::arg("progress") = py::none(),
         "Bakes `scene` (a Scene, or a scene file's path) into the .pvs file `output`, with `viewcells bake`'s "

@@ -95,6 +95,27 @@ if object_names != gltf.names:
 if not (np.array_equal(v[t], gltf.vertices[gltf.triangles]) and np.array_equal(objects, gltf.triangle_objects)):
     fail("the add-on's triangles differ from the glTF reader's")
 
+# The play space, drawn: green floors 3 cm over the room's floor (z = 0; the crates, 0.8 m high,
+# are neither stepped on nor 4 m^2), reached from the PlayerStart through the doorway, so both
+# halves of the room. Drawn before the bake: the bake must leave the drawing out of the level
+# (else its objects differ from the export's, below).
+if bpy.ops.viewcells.show_play_space() != {"FINISHED"}:
+    fail("Show play space failed")
+play_obj = bpy.data.objects.get("viewcells play space")
+if play_obj is None or addon.PLAY_COLLECTION not in [c.name for c in play_obj.users_collection]:
+    fail("no play space object in its collection")
+zs = np.array([p.co.z for p in play_obj.data.vertices])
+xs = np.array([p.co.x for p in play_obj.data.vertices])
+area = play_obj["floor_area_m2"]
+print(f"play space: {len(play_obj.data.polygons)} faces, z {zs.min():.3f}-{zs.max():.3f}, {area:.1f} m^2 of floor, "
+      f"x {xs.min():.2f} to {xs.max():.2f}")
+if not (len(zs) and np.all(np.abs(zs - 0.03) < 1e-3)):
+    fail("the play space's floors are not the room's floor")
+if not (60 < area < 100 and xs.min() < -4 and xs.max() > 4):
+    fail(f"the play space does not cover the room ({area:.1f} m^2, x {xs.min():.2f}..{xs.max():.2f})")
+if "reachable from 1 of 1 start points" not in play_obj["rule"]:
+    fail("the play space did not start from the PlayerStart: " + play_obj["rule"])
+
 options = ["--samples", "30000", "--max-cells", "24", "--agvs-samples", "30000"]
 s = bpy.context.scene.viewcells
 s.cells = 6
@@ -130,6 +151,14 @@ start_options.update(cells=2, samples=2000, agvs_samples=2000, max_cells=8)
 view_space = vc.bake(scene_for_report, os.path.join(work, "start.pvs"), **start_options).report["settings"]["view_space"]
 if "reachable from 1 of 1 start points" not in view_space:
     fail(f"the bake did not take the add-on's start point: {view_space}")
+# "Add start point" puts a PlayerStart at the 3D cursor, which bakes then start from.
+bpy.context.scene.cursor.location = (3.0, 3.0, 0.5)
+if bpy.ops.viewcells.add_start() != {"FINISHED"}:
+    fail("Add start point failed")
+if sorted(addon.start_positions(bpy.context))[-1] != (3.0, 3.0, 0.5) or len(addon.start_positions(bpy.context)) != 2:
+    fail(f"the new start point is not where the cursor was: {addon.start_positions(bpy.context)}")
+for o in [o for o in bpy.data.objects if o.type == "EMPTY" and o.name != "PlayerStart"]:
+    bpy.data.objects.remove(o)
 
 # The cells: one translucent mesh each, coloured by render cost, holding id, cost and PVS.
 cells = bpy.data.collections.get(addon.CELLS_COLLECTION)

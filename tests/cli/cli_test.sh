@@ -241,6 +241,11 @@ expect_ok "$VC" view office.pvs --scene office.obj -o site --gltf cells.glb -q
 [ -s site/index.html ] && [ -s site/viewer.js ] && grep -q "^window.VIEWCELLS_DATA = " site/data.js && ok || bad "view: site"
 expect_ok "$VC" info cells.glb --list
 [ "$(grep -c '	cell [0-9]* (see-through)$' out.txt)" = 16 ] && ok || bad "view: glTF cells: $(grep -c cell out.txt)"
+# ... and the play space (the office's floors) as one more object, which --no-play-space leaves out.
+grep -q '	play space (see-through)$' out.txt && ok || bad "view: no play space in the glTF"
+expect_ok "$VC" view office.pvs --scene office.obj --gltf noplay.glb --no-play-space -q
+expect_ok "$VC" info noplay.glb --list
+! grep -q 'play space' out.txt && ok || bad "view --no-play-space: the glTF has a play space"
 cp cells.glb cells-before.glb
 expect_error "fingerprints differ" "$VC" view office.pvs --scene rotated.obj --gltf cells.glb
 cmp -s cells.glb cells-before.glb && ok || bad "a failed view changed the earlier glTF"

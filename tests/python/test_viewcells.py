@@ -440,3 +440,32 @@ def test_play_space_keywords(office, tmp_path):
     assert "the whole view box" in view_space(no_play_space=True)
     with pytest.raises(viewcells.Error, match="eye_band \\(keyword\\) takes LO,HI"):
         view_space(eye_band="2,1")
+
+
+def test_play_space_from_python(office, tmp_path):
+    """viewcells.play_space finds what bake uses: the office's floors (its slab top, z = 0.3),
+    drawable; a start point far outside reaches nothing, and a Quake 3 map has none from floors."""
+    play = viewcells.play_space(str(office / "office.obj"))
+    assert play.found, play.rule
+    v, t = play.floors
+    assert v.shape[1] == 3 and t.shape[1] == 3 and len(t) > 0 and t.max() < len(v)
+    assert np.all(v[:, 2] >= 0.3 + 0.03 - 1e-3), v[:, 2].min()  # never below the ground floor
+    assert np.count_nonzero(np.abs(v[:, 2] - 0.33) < 1e-3) > len(v) // 2  # mostly the floor itself
+    # The floors' rectangles are the reached floor area with an eye band (the roof, at the scene's
+    # top, has none).
+    tri = v[t].astype(np.float64)
+    drawn = 0.5 * np.abs(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])[:, 2]).sum()
+    assert abs(drawn - play.floor_area_m2) < 1e-4 * play.floor_area_m2, (drawn, play.floor_area_m2)
+    points = play.points(200, seed=3)
+    assert points.shape == (200, 3) and all(play.contains(p) for p in points)
+    lo, hi = np.array(play.box)
+    assert np.all(points >= lo - 1e-9) and np.all(points <= hi + 1e-9)
+    assert play.volume_m3 > 0 and play.metres_per_unit == 1
+    nowhere = viewcells.play_space(str(office / "office.obj"), start=[(1e4, 0, 0)], only_from_starts=True)
+    assert not nowhere.found and "reachable from 0 of 1 start points" in nowhere.rule
+    with pytest.raises(viewcells.Error, match="no play space"):
+        nowhere.floors
+    with pytest.raises(viewcells.Error, match="eye band"):
+        viewcells.play_space(str(office / "office.obj"), eye_band=(2, 1))
+    with pytest.raises(TypeError, match="play_space: scene must be"):
+        viewcells.play_space(3)

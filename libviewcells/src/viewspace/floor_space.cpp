@@ -79,7 +79,7 @@ std::vector<FloorSpace::FloorRect> FloorSpace::floor_rects() const {
     row.clear();
     for (int64_t x = 0; x < nx_; ++x)
       for (uint32_t s = first_[y * nx_ + x]; s < first_[y * nx_ + x + 1]; ++s)
-        if (reached_[s]) row.emplace_back(std::llround(spans_[s].floor / same), x, spans_[s].floor);
+        if (reached_[s] && band_of(spans_[s]) > 0) row.emplace_back(std::llround(spans_[s].floor / same), x, spans_[s].floor);
     std::sort(row.begin(), row.end());
     for (size_t i = 0; i < row.size();) {
       size_t j = i + 1;
@@ -350,9 +350,9 @@ FloorSpace find_floor_space(const Scene& scene, const RayCaster& caster, const F
     for (uint32_t s = out.first_[col]; s < out.first_[col + 1]; ++s) {
       if (!out.reached_[s]) continue;
       ++out.reached_count_;
-      out.reached_area_ += cell * cell;
       const double band = out.band_of(out.spans_[s]);
-      if (!(band > 0)) continue;
+      if (!(band > 0)) continue;  // a roof at the scene's top: no eye above it
+      out.reached_area_ += cell * cell;
       out.band_volume_ += band * cell * cell;
       out.by_band_.emplace_back(out.band_volume_, s);
       const Vec3 lo = centre(col, out.spans_[s].floor + u.eye_low) - Vec3{0.5 * cell, 0.5 * cell, 0};

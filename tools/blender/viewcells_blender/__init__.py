@@ -35,6 +35,7 @@ import numpy as np
 from bpy.props import BoolProperty, EnumProperty, FloatProperty, IntProperty, PointerProperty, StringProperty
 
 CELLS_COLLECTION = "viewcells cells"
+PLAY_COLLECTION = "viewcells play space"
 CELL_MATERIAL = "viewcells cell"
 _baked = {}  # .pvs path (absolute) -> viewcells.Baked of this session
 _job = None  # the bake running in the background (a modal run from the panel)
@@ -95,23 +96,24 @@ def material_is_see_through(m):
     return False
 
 
-def level_meshes(context, exclude=CELLS_COLLECTION):
-    """The visible mesh objects of the view layer, outside the cells' collection, in its order."""
-    cells = bpy.data.collections.get(exclude)
+def level_meshes(context, exclude=(CELLS_COLLECTION, PLAY_COLLECTION)):
+    """The visible mesh objects of the view layer, outside the add-on's own collections (the
+    cells, the play space), in its order."""
+    own = [c for c in (bpy.data.collections.get(name) for name in exclude) if c is not None]
     out = []
     for o in context.view_layer.objects:
         if o.type != "MESH" or not o.visible_get():
             continue
-        if cells is not None and cells in o.users_collection:
+        if any(c in o.users_collection for c in own):
             continue
         out.append(o)
     return out
 
 
-def start_points(context):
+def start_positions(context):
     """Where players start, as the glTF reader takes them from an export: the world positions of
     the empties whose names hold "spawn", "player start" or "info_player" (any case; spaces,
-    underscores, dashes and dots ignored), as `--start` words."""
+    underscores, dashes and dots ignored), as (x, y, z) tuples."""
     out = []
     for o in context.view_layer.objects:
         if o.type != "EMPTY":
@@ -119,8 +121,13 @@ def start_points(context):
         name = "".join(ch for ch in o.name.lower() if ch not in " _-.")
         if "spawn" in name or "playerstart" in name or "infoplayer" in name:
             p = o.matrix_world.translation
-            out.append(f"{p.x!r},{p.y!r},{p.z!r}")
+            out.append((p.x, p.y, p.z))
     return out
+
+
+def start_points(context):
+    """start_positions() as `--start` words."""
+    return [f"{x!r},{y!r},{z!r}" for x, y, z in start_positions(context)]
 
 
 def owner_name(obj, per):
@@ -574,6 +581,7 @@ class ViewcellsSettings(bpy.types.PropertyGroup):
                          description="The level and its cells as binary glTF (empty: none)")
     follow_selection: BoolProperty(name="Clicking a cell selects its PVS", default=True)
     status: StringProperty(name="Status", default="")
+    play_status: StringProperty(name="Play space", default="")
     progress: FloatProperty(name="Progress", default=0.0, min=0.0, max=1.0, subtype="FACTOR")
 
 
@@ -609,6 +617,12 @@ class VIEWCELLS_PT_panel(bpy.types.Panel):
         row = col.row()
         row.operator("viewcells.show_from_here", icon="HIDE_OFF")
         row.operator("viewcells.show_all")
+        col.separator()
+        row = col.row()
+        row.operator("viewcells.show_play_space", icon="MOD_FLUIDSIM")
+        row.operator("viewcells.add_start", icon="EMPTY_SINGLE_ARROW")
+        if s.play_status:
+            col.label(text=s.play_status)
 
 
 class ViewcellsPreferences(bpy.types.AddonPreferences):
@@ -620,8 +634,11 @@ class ViewcellsPreferences(bpy.types.AddonPreferences):
         self.layout.prop(self, "module_dir")
 
 
+from .play_space import VIEWCELLS_OT_add_start, VIEWCELLS_OT_show_play_space  # noqa: E402 (needs the helpers above)
+
 CLASSES = (ViewcellsSettings, ViewcellsPreferences, VIEWCELLS_OT_bake, VIEWCELLS_OT_select_pvs,
-           VIEWCELLS_OT_show_from_here, VIEWCELLS_OT_show_all, VIEWCELLS_PT_panel)
+           VIEWCELLS_OT_show_from_here, VIEWCELLS_OT_show_all, VIEWCELLS_OT_show_play_space,
+           VIEWCELLS_OT_add_start, VIEWCELLS_PT_panel)
 _owner = object()
 
 

@@ -96,13 +96,15 @@ class FloorSpace {
   bool empty() const { return band_volume_ <= 0; }
   /// Box of the reached spans' eye bands.
   const Box3& box() const { return box_; }
-  /// The reached spans' eye band's volume, and their floor area, in scene units.
+  /// The reached spans' eye band's volume, and the floor area under it (spans with room for an
+  /// eye: not a roof at the scene's top), in scene units.
   double volume() const { return band_volume_; }
   double floor_area() const { return reached_area_; }
   size_t spans() const { return spans_.size(); }
   size_t reached_spans() const { return reached_count_; }
   /// The reached floors for people to look at: rectangles of columns in a row whose reached
-  /// spans stand at the same height (within 1 mm), scene units.
+  /// spans stand at the same height (within 1 mm) and have an eye band (not a roof at the
+  /// scene's top), scene units.
   struct FloorRect {
     double x0 = 0, y0 = 0, x1 = 0, y1 = 0, z = 0;
   };
