@@ -187,25 +187,17 @@ pipeline::BakeConfig bake_config(BakeArgs a, const Common& c) {
   config.play_space_where_known = a.cells.play_space_by_default && !a.cells.no_play_space;
   config.scene = a.sampling.source();
   config.sampling = a.sampling.sampler(c);
+  config.merge_on_agvs = a.merge.pvs == "agvs";
   config.merge_agvs = a.merge.agvs(c, a.sampling.seed, config.sampling.samples);
   config.memory = a.memory.empty() ? 0 : parse_bytes(a.memory);
   if (!a.memory.empty() && config.memory == 0) throw Error("--memory must be above 0 bytes (got '" + a.memory + "')");
   if (a.memory_of != "file" && a.memory_of != "lists") throw Error("--memory-of is file or lists, not '" + a.memory_of + "'");
   config.memory_of_lists = a.memory_of == "lists";
   config.holes = a.holes.empty() ? 0.0 : parse_percent(a.holes, "--holes");
-  if (!a.agvs.bound.max_samples && !(a.agvs.bound.max_seconds > 0) && !(a.agvs.bound.pixel_error > 0) &&
-      !(config.measured_error > 0) && !(config.max_seconds > 0) && !(config.holes > 0))
-    a.agvs.bound.pixel_error = 10;
-  // Holes are what a player sees at the resolution played: 1,000 frames of 1024x768 by
-  // default; a mean error alone keeps 5,000 frames of 64x48 (its estimator's cost).
-  const bool by_holes = config.holes > 0;
-  if (!config.measure_cameras) config.measure_cameras = by_holes ? 1000 : config.measured_error > 0 ? 5000 : 0;
-  if (!a.measure_size.empty()) {
+  // The stop rule, the measuring cameras and their frames when not given: the library decides
+  // (pipeline::resolve).
+  if (!a.measure_size.empty())
     std::tie(config.frame.width, config.frame.height) = parse_size(a.measure_size, "--measure-size", 2048);
-  } else if (by_holes) {
-    config.frame.width = 1024;
-    config.frame.height = 768;
-  }
   std::tie(config.sample_frame.width, config.sample_frame.height) = parse_size(a.frame_size, "--frame-size", 2048);
   config.agvs = a.agvs.config(c);
   config.agvs.seed = a.sampling.seed;

@@ -252,3 +252,66 @@ TEST(BakeApi, ObjectIdsArePositionsAlsoPastAnEmptyObject) {
 
 }  // namespace
 }  // namespace viewcells
+
+namespace viewcells {
+namespace {
+
+/// What decides a bake in a config, as words, field by field (progress flags and callbacks
+/// aside): two configs that print the same bake the same.
+std::string describe(const pipeline::BakeConfig& c) {
+  std::ostringstream k;
+  k << "scene " << c.scene.path << ' ' << static_cast<int>(c.scene.grouping) << ' ' << c.scene.robust << '\n';
+  const FloorSpaceConfig& f = c.scene.floors;
+  k << "floors " << f.metres_per_unit << ' ' << f.cell << ' ' << f.walk_normal << ' ' << f.player_height << ' ' << f.step
+    << ' ' << f.eye_low << ' ' << f.eye_high << ' ' << f.min_region << ' ' << f.start_points.size() << ' '
+    << f.only_from_starts << ' ' << f.region_margin << '\n';
+  const SamplerConfig& s = c.sampling;
+  k << "sampling " << s.samples << ' ' << s.target_segments << ' ' << s.seed << ' ' << static_cast<int>(s.empty_space)
+    << ' ' << s.max_recasts << ' ' << s.batch_size << ' ' << s.view_box.empty() << '\n';
+  k << "model " << c.model.a << ' ' << c.model.b << ' ' << c.model.c << '\n';
+  const SubdivisionConfig& d = c.subdivision;
+  k << "subdivision " << static_cast<int>(d.strategy) << ' ' << d.max_cells << ' ' << d.max_axis_candidates << ' '
+    << d.exact_candidates << ' ' << static_cast<int>(d.geometry_aligned) << ' ' << d.ga_candidates << ' '
+    << d.min_reduction << ' ' << d.stagnation_steps << ' ' << d.seed << ' ' << d.density.enabled << ' '
+    << d.play_space << '\n';
+  k << "play_space_where_known " << c.play_space_where_known << '\n';
+  if (c.merge_agvs)
+    k << "merge_agvs " << c.merge_agvs->seed << ' ' << c.merge_agvs->max_samples << ' ' << c.merge_agvs->pixel_error
+      << ' ' << c.merge_agvs->mutation_lanes << ' ' << c.merge_agvs->batch_size << '\n';
+  else
+    k << "merge on the construction samples\n";
+  k << "budget " << c.cells << ' ' << c.memory << ' ' << c.memory_of_lists << '\n';
+  const AgvsConfig& a = c.agvs;
+  k << "agvs " << a.seed << ' ' << a.batch_size << ' ' << a.max_samples << ' ' << a.max_seconds << ' ' << a.pixel_error
+    << ' ' << a.mutation_lanes << ' ' << a.min_share << ' ' << static_cast<int>(a.empty_space) << '\n';
+  k << "time " << c.max_seconds << '\n';
+  k << "measure " << c.measure_cameras << ' ' << static_cast<int>(c.cameras.placement) << ' ' << c.cameras.seed << ' '
+    << c.frame.width << 'x' << c.frame.height << ' ' << c.measured_error << ' ' << c.holes << '\n';
+  k << "frames " << c.frame_samples << ' ' << c.sample_frame.width << 'x' << c.sample_frame.height << ' '
+    << c.frame_rounds << '\n';
+  k << "near " << c.near.rays_per_object << ' ' << c.near.rounds << ' ' << c.near.distance << ' ' << c.near_eyes
+    << '\n';
+  k << "hidden " << c.prove_hidden << ' ' << c.conservative << ' ' << c.hidden_max_steps << ' ' << c.aimed_rays
+    << '\n';
+  k << "output " << c.output << ' ' << c.work_dir << ' ' << c.checkpoint_seconds << '\n';
+  return k.str();
+}
+
+// The library decides: `viewcells bake SCENE -o OUT` (no other option) is BakeConfig{} with the
+// scene and output, field for field, both resolved the same way (what depends on the budget and
+// the stop rule: pipeline::resolve).
+TEST(BakeDefaults, AnEmptyCommandLineIsTheLibrarysDefault) {
+  pipeline::BakeConfig library;
+  library.scene.path = "level.obj";
+  library.output = "level.pvs";
+  library.cells = 100;
+  const pipeline::BakeConfig command = cli::bake_config_from_args({"level.obj", "-o", "level.pvs", "--cells", "100"});
+  EXPECT_EQ(describe(pipeline::resolve(command)), describe(pipeline::resolve(library)));
+  // The check can fail: one option given changes the words.
+  const pipeline::BakeConfig other =
+      cli::bake_config_from_args({"level.obj", "-o", "level.pvs", "--cells", "100", "--near-samples", "0"});
+  EXPECT_NE(describe(pipeline::resolve(other)), describe(pipeline::resolve(library)));
+}
+
+}  // namespace
+}  // namespace viewcells

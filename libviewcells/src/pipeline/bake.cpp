@@ -483,10 +483,52 @@ std::string choose_play_space(const BakeConfig& c, const LoadedScene& loaded, Ba
 
 }  // namespace
 
-BakeResult bake(const BakeConfig& c, const Log& log) {
+SubdivisionConfig bake_subdivision() {
+  SubdivisionConfig s;
+  s.max_cells = 0;
+  return s;
+}
+
+BakeConfig resolve(BakeConfig c, std::vector<std::string>* decided) {
+  const auto say = [&](const std::string& words) {
+    if (decided) decided->push_back(words);
+  };
+  if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0) && !(c.measured_error > 0) &&
+      !(c.holes > 0) && !(c.max_seconds > 0)) {
+    c.agvs.pixel_error = 10;
+    say("AGVS stops at an estimated pixel error of 10 (of 1024x1024): no other stop was given");
+  }
+  // Holes are what a player sees at the resolution played: 1,000 frames of 1024x768; a mean
+  // error alone keeps 5,000 frames of 64x48 (its estimator's cost).
+  const bool by_holes = c.holes > 0;
+  if (!c.measure_cameras && (by_holes || c.measured_error > 0)) {
+    c.measure_cameras = by_holes ? 1000 : 5000;
+    say(std::to_string(c.measure_cameras) + " measuring cameras (for the " +
+        (by_holes ? "share of frames with holes" : "measured pixel error") + ")");
+  }
+  if (c.frame.width == 0 || c.frame.height == 0) {
+    c.frame.width = by_holes ? 1024 : 64;
+    c.frame.height = by_holes ? 768 : 48;
+    if (c.measure_cameras)
+      say("measuring frames of " + std::to_string(c.frame.width) + "x" + std::to_string(c.frame.height) +
+          (by_holes ? " (holes as a player sees them)" : " (the mean error's estimator)"));
+  }
+  if (c.merge_on_agvs && !c.merge_agvs) {
+    AgvsConfig a;
+    a.seed = c.sampling.seed + 7'000'001;  // not the construction samples' stream
+    a.max_samples = std::max<uint64_t>(c.sampling.samples, 1);
+    a.show_progress = c.agvs.show_progress;
+    c.merge_agvs = a;
+    say("merging on AGVS's PVSs of the elementary cells, " + std::to_string(a.max_samples) + " samples a run");
+  }
+  return c;
+}
+
+BakeResult bake(const BakeConfig& config, const Log& log) {
+  BakeResult out;
+  const BakeConfig c = resolve(config, &out.decided);
   check_bake(c);
   Stopwatch total;
-  BakeResult out;
   out.config = c;
   // The whole bake's clock (BakeConfig::max_seconds): a quarter for each of the merge's AGVS
   // runs (the hierarchy's only stages without a bound of their own); the later shares are set

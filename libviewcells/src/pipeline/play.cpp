@@ -11,6 +11,7 @@
 #include "viewcells/io/scene_io.h"
 #include "viewcells/q3/play.h"
 #include "viewcells/vis/cell_views.h"
+#include "viewcells/vis/level_view.h"
 
 namespace viewcells::pipeline {
 

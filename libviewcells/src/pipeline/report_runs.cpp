@@ -170,6 +170,7 @@ std::string report_json(const BakeResult& r) {
                  {"elementary_cells", r.elementary_cells},
                  {"play_space", c.subdivision.play_space},
                  {"view_space", r.view_space_choice},
+                 {"decided", r.decided},
                  {"pixel_error", c.agvs.pixel_error},
                  {"measured_error", c.measured_error},
                  {"holes", c.holes},

@@ -19,24 +19,35 @@
 
 namespace viewcells::pipeline {
 
+/// The subdivision's settings for a bake: SubdivisionConfig's, with max_cells 0 (from the budget).
+SubdivisionConfig bake_subdivision();
+
 struct BakeConfig {
   SceneSource scene;
   SamplerConfig sampling;          ///< construction samples
   CostModel model;
-  SubdivisionConfig subdivision;   ///< max_cells 0: derived from the budget
+  /// max_cells 0 (the default here): derived from the budget (4 x cells, or 4096 with memory).
+  SubdivisionConfig subdivision = bake_subdivision();
   /// Weigh cells, draw AGVS's points and place cameras where players are (subdivision.play_space)
   /// whenever the scene's view space knows them (a Quake 3 map's leaves, or a mesh scene's
   /// walkable floors, viewspace/floor_space.h), unless subdivision.density or sampling.view_box
   /// says where viewers are: the command line's default, since a level's frames are seen from
   /// where players stand. The report gives what was decided and why (view_space_choice).
-  bool play_space_where_known = false;
+  bool play_space_where_known = true;
+  /// Merge on AGVS's PVSs of the elementary cells (BuildConfig::merge_agvs; the validated
+  /// merge): when merge_agvs is unset, resolve() makes it (seed: the construction samples' +
+  /// 7000001, as many samples as the construction drew). False, with merge_agvs unset: greedy
+  /// merging on the construction samples alone. A merge_agvs given is always used.
+  bool merge_on_agvs = true;
   std::optional<AgvsConfig> merge_agvs;  ///< as BuildConfig::merge_agvs
   uint32_t cells = 0;              ///< budget: this many view cells ...
   uint64_t memory = 0;             ///< ... or a .pvs file of at most this many bytes
   /// The memory budget counts the compressed PVS lists alone (what stands against a map
   /// compiler's vis rows), not the whole file with point location and object names.
   bool memory_of_lists = false;
-  AgvsConfig agvs;                 ///< stopping rule (pixel error, time, samples), seed, batch
+  /// Stopping rule (pixel error, time, samples), seed, batch. With no stop at all (none here,
+  /// no measured_error, holes or max_seconds) resolve() stops at an estimated pixel error of 10.
+  AgvsConfig agvs;
   /// The whole bake's time limit in seconds (0: none): each of the merge's two AGVS runs
   /// stops at a quarter of it; the proof at half of what the hierarchy left (cells not begun
   /// prove nothing); the PVSs' AGVS, with its measurements, at what is then left, less a quarter
@@ -47,11 +58,14 @@ struct BakeConfig {
   /// leaves nothing is an Error (its --work copy is kept).
   double max_seconds = 0;
   /// Cameras that measure the PVSs as `viewcells measure` does (its placement, seed and
-  /// frames: on a Quake 3 map player eyes above reachable floors); 0: none. The file
-  /// written is measured, and its measured pixel error reported.
+  /// frames: on a Quake 3 map player eyes above reachable floors); 0: none, unless resolve()
+  /// decides (1,000 with holes, 5,000 with measured_error). The file written is measured, and
+  /// its measured pixel error reported.
   uint32_t measure_cameras = 0;
   CameraConfig cameras;                      ///< placement and seed (count: measure_cameras)
-  FrameConfig frame{64, 48, 90.0, 1024 * 1024};  ///< the measuring frames, as `measure`'s
+  /// The measuring frames, as `measure`'s; width 0: resolve() decides (1024x768 with holes:
+  /// what a player sees; else 64x48, the mean error estimator's cost).
+  FrameConfig frame{0, 0, 90.0, 1024 * 1024};
   /// With measure_cameras: stop AGVS once the cameras' mean wrong pixels per 1024 x 1024
   /// frame are at most this (measured after one batch and at every doubling of the samples;
   /// the other limits still apply). Coarsening for a memory budget only unites PVSs, so the
@@ -100,6 +114,7 @@ struct BakeConfig {
 
 struct BakeResult {
   BakeConfig config;
+  std::vector<std::string> decided;  ///< what resolve() decided, in words
   uint64_t scene_fingerprint = 0;
   uint32_t object_count = 0;
   // The hierarchy.
@@ -155,6 +170,14 @@ struct BakeResult {
   int threads = 1;
 };
 
+/// What a bake decides from the rest of its config (every front end's bake goes through it, and
+/// bake() calls it again: it changes nothing it has decided): the stop rule, the measuring
+/// cameras and their frames, the merge's AGVS run. `decided` (when given) gets each decision in
+/// words, for the report.
+BakeConfig resolve(BakeConfig config, std::vector<std::string>* decided = nullptr);
+
+/// Bakes: resolve(), then the chain. BakeResult::config is the config resolved, and
+/// BakeResult::decided says what resolve() decided.
 BakeResult bake(const BakeConfig& config, const Log& log);
 
 /// The PVSs of the view cells `coarse` (MHT nodes of a cut at or above the cut `fine`): each

@@ -8,8 +8,12 @@
 #include <vector>
 
 #include "viewcells/pipeline/sampling.h"
-#include "viewcells/vis/level_view.h"
 #include "viewcells/viewspace/floor_space.h"
+
+namespace viewcells {
+struct GroupedMesh;  // vis/level_view.h (not installed): callers of floor_mesh and add_play_space include it
+struct LevelView;
+}  // namespace viewcells
 
 namespace viewcells::pipeline {
 
