@@ -3,7 +3,7 @@
 
 #include "options.h"
 #include "viewcells/core/parallel.h"
-#include "viewcells/pipeline/compare.h"
+#include "viewcells/studies/compare.h"
 
 namespace viewcells::cli {
 
@@ -13,7 +13,7 @@ namespace {
 /// sampling and merge options are shared with other commands, and the method list and the cell
 /// count have defaults that depend on the scene (decided when the command runs).
 struct CompareArgs {
-  pipeline::CompareRunConfig bound;
+  studies::CompareRunConfig bound;
   SamplingOptions sampling;
   std::string methods = "av-m,av-m-samples,av-s,kd-casm,kd-lasm,kd-vt,kd-vt-star,bsp";
   bool methods_given = false;
@@ -25,13 +25,13 @@ struct CompareArgs {
 int run_compare(const CompareArgs& a, const Common& c) {
   check_files({a.sampling.scene}, {}, {a.bound.output_dir});
   ThreadLimit threads(c.threads);
-  pipeline::CompareRunConfig config = a.bound;
+  studies::CompareRunConfig config = a.bound;
   config.scene = a.sampling.source();
   if (a.methods_given || !pipeline::is_q3_map(a.sampling.scene)) config.methods = split_list(a.methods);
   config.max_cells = a.max_cells_given ? a.max_cells : 0;
   config.construction = a.sampling.sampler(c);
   config.merge_agvs = a.merge.agvs(c, config.construction.seed, config.construction.samples);
-  pipeline::compare(config, c.logger());
+  studies::compare(config, c.logger());
   return 0;
 }
 

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """The include graph of the project's modules as a Mermaid flowchart, at a git revision.
 
-A module is a directory of libviewcells (include/viewcells/M/ and src/M/), or format, runtime
-and cli. An arrow A --> B with a count says that many #include lines of A's files name a header
+A module is a directory of libviewcells (include/viewcells/M/ and src/M/), or format, runtime,
+studies and cli. An arrow A --> B with a count says that many #include lines of A's files name a header
 of B. Arrows that run up the layers (the order of libviewcells/CMakeLists.txt's vc_layer calls
 at the working tree; format at the bottom, then the library, the runtime beside it, the CLI on
 top) or into another module's private sources are drawn red: with one-way layers there are none.
@@ -25,7 +25,7 @@ def git(*args):
 
 
 def files():
-    roots = ["libviewcells", "runtime", "format", "cli"]
+    roots = ["libviewcells", "runtime", "format", "studies", "cli"]
     if rev:
         names = git("ls-tree", "-r", "--name-only", rev, "--", *roots).split()
     else:
@@ -46,7 +46,7 @@ def module_of_file(name):
         return parts[3]
     if parts[0] == "libviewcells" and len(parts) > 2 and parts[1] == "src":
         return parts[2]
-    return parts[0] if parts[0] in ("runtime", "format", "cli") else None
+    return parts[0] if parts[0] in ("runtime", "format", "studies", "cli") else None
 
 
 def module_of_include(path):
@@ -72,7 +72,8 @@ for i, m in enumerate(re.finditer(r"vc_layer\((\w+)(.*?)\)", cmake, re.S), 1):
 top = max(rank.values())
 rank.setdefault("cluster", rank.get("core", 1))  # core/cluster before it was core/ranks
 rank["runtime"] = 1
-rank["cli"] = top + 1
+rank["studies"] = top + 1  # studies/: above the pipeline, beside the product
+rank["cli"] = top + 2
 
 edges = collections.Counter()
 red = set()

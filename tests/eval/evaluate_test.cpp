@@ -10,7 +10,7 @@
 
 #include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/core/error.h"
-#include "viewcells/eval/compare.h"
+#include "viewcells/studies/methods.h"
 #include "viewcells/eval/evaluate.h"
 #include "viewcells/validated/merge.h"
 #include "validated/merge_choice.h"  // libviewcells/src: the choice inside it

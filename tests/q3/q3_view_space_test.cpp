@@ -13,7 +13,7 @@
 #include "viewcells/core/error.h"
 #include "viewcells/core/rng.h"
 #include "viewcells/io/scene_io.h"
-#include "viewcells/q3/compare.h"
+#include "viewcells/studies/q3map2.h"
 #include "viewcells/q3/view_space.h"
 #include "viewcells/raycast/ray_caster.h"
 

@@ -179,7 +179,6 @@ template void write_report(const std::string&, const BuildResult&);
 template void write_report(const std::string&, const ExtractResult&);
 template void write_report(const std::string&, const CompressResult&);
 template void write_report(const std::string&, const PvsResult&);
-template void write_report(const std::string&, const CompareRunResult&);
 template void write_report(const std::string&, const BakeResult&);
 template void write_report(const std::string&, const MeasureResult&);
 

@@ -59,8 +59,4 @@ json agvs_view_space(bool restricted, bool play = false);
 
 json pvs_effects(const PvsResult& r);
 
-json compare_methods_json(const Comparison& cmp);
-
-json q3_summary(const Q3Comparison& q, const Q3Map& map);
-
 }  // namespace viewcells::pipeline::report_detail

@@ -92,46 +92,6 @@ std::string report_json(const PvsResult& r) {
                {"curve", agvs_curve(st, c.references.size())}});
 }
 
-std::string report_json(const CompareRunResult& r) {
-  const CompareConfig& config = r.compared;
-  const Comparison& cmp = r.comparison();
-  json summary = {
-      {"command", "compare"},
-      {"scene", scene_summary(*r.loaded.scene)},
-      {"settings",
-       {{"methods", config.methods},
-        {"max_cells", config.max_cells},
-        {"construction_samples", config.construction.samples},
-        {"construction_seed", config.construction.seed},
-        {"evaluation_samples", config.evaluation.samples},
-        {"evaluation_seed", config.evaluation.seed},
-        {"evaluation_sets", config.evaluation_sets},
-        {"histogram_cells", config.histogram_cells ? config.histogram_cells : config.max_cells},
-        {"cost_model", {{"a", config.model.a}, {"b", config.model.b}, {"c", 0}}},
-        {"axis_candidates", config.subdivision.max_axis_candidates},
-        {"axis_candidates_choice", config.subdivision.exact_candidates ? "exact" : "fast"},
-        {"ga_candidates", config.subdivision.ga_candidates},
-        {"geometry_aligned", r.config.geometry_aligned_off ? "off" : "auto"},
-        {"robust_ray_casting", r.config.scene.robust},
-        {"merge_pvs", config.merge_agvs ? "agvs" : "samples"},
-        {"merge_agvs_samples_per_run", config.merge_agvs ? json(config.merge_agvs->max_samples) : json(nullptr)},
-        {"merge_agvs_pixel_error", config.merge_agvs ? json(config.merge_agvs->pixel_error) : json(nullptr)},
-        {"threads", r.threads}}},
-      {"effects",
-       {{"empty_space_detection", effect(cmp.construction.empty_space.enabled, cmp.construction.empty_space.reason)},
-        {"pixel_cost_term", effect(false, "c = 0: the comparison uses r(o) = max(a, b t)")}}},
-      {"methods", compare_methods_json(cmp)},
-      {"view_space", r.loaded.view_space->describe()},
-      {"timings",
-       {{"load_seconds", r.loaded.load_seconds},
-        {"bvh_build_seconds", r.loaded.bvh_seconds},
-        {"construction_sampling_seconds", cmp.construction.seconds},
-        {"evaluation_sampling_seconds", cmp.evaluation.seconds},
-        {"evaluation_seconds", cmp.evaluation_seconds}}}};
-  if (r.q3) summary["q3map2"] = q3_summary(*r.q3, *r.loaded.map);
-  return text(summary);
-}
-
 /// The three answers per (view cell, object) pair (BakeResult::HiddenClasses).
 json hidden_classes(const BakeResult::HiddenClasses& h, const BakeConfig& c) {
   if (!h.proved)

@@ -6,7 +6,6 @@
 
 #include "viewcells/pipeline/bake.h"
 #include "viewcells/pipeline/build.h"
-#include "viewcells/pipeline/compare.h"
 #include "viewcells/pipeline/cut.h"
 #include "viewcells/pipeline/info.h"
 #include "viewcells/pipeline/measure.h"
@@ -22,7 +21,6 @@ std::string report_json(const BuildResult& result);
 std::string report_json(const ExtractResult& result);
 std::string report_json(const CompressResult& result);
 std::string report_json(const PvsResult& result);
-std::string report_json(const CompareRunResult& result);
 std::string report_json(const BakeResult& result);
 std::string report_json(const MeasureResult& result);
 

@@ -1,6 +1,6 @@
 /// Our view cells against q3map2's clusters on a Quake 3 map: render cost, PVS agreement and
 /// storage.
-#include "viewcells/q3/compare.h"
+#include "viewcells/studies/q3map2.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>

@@ -1,5 +1,5 @@
 /// Construction methods compared on the same samples (view-cell-construction paper, section 6.3).
-#include "viewcells/eval/compare.h"
+#include "viewcells/studies/methods.h"
 
 #include <chrono>
 #include <cmath>

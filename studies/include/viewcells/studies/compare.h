@@ -8,11 +8,15 @@
 #include <string>
 #include <vector>
 
-#include "viewcells/eval/compare.h"
+#include "viewcells/studies/methods.h"
 #include "viewcells/pipeline/sampling.h"
-#include "viewcells/q3/compare.h"
+#include "viewcells/studies/q3map2.h"
 
-namespace viewcells::pipeline {
+namespace viewcells::studies {
+
+using pipeline::LoadedScene;
+using pipeline::Log;
+using pipeline::SceneSource;
 
 struct CompareRunConfig {
   SceneSource scene;
@@ -42,7 +46,10 @@ struct CompareRunResult {
   const Comparison& comparison() const { return q3 ? q3->ours : plain; }
 };
 
-/// Runs the comparison and writes the directory's files (report.h writes summary.json).
+/// Runs the comparison and writes the directory's files (summary.json: report_json).
 CompareRunResult compare(const CompareRunConfig& config, const Log& log);
 
-}  // namespace viewcells::pipeline
+/// The run's summary.json (indented, with a final newline).
+std::string report_json(const CompareRunResult& result);
+
+}  // namespace viewcells::studies

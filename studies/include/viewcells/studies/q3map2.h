@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "viewcells/eval/compare.h"
+#include "viewcells/studies/methods.h"
 #include "viewcells/q3/view_space.h"
 
 namespace viewcells {

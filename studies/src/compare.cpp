@@ -1,6 +1,6 @@
 /// `viewcells compare`: methods built from the same samples and scored on independent ones
 /// (view-cell-construction paper, section 6).
-#include "viewcells/pipeline/compare.h"
+#include "viewcells/studies/compare.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,7 +13,9 @@
 #include "viewcells/core/binary_file.h"
 #include "viewcells/pipeline/report.h"
 
-namespace viewcells::pipeline {
+namespace viewcells::studies {
+
+using namespace pipeline;
 
 namespace {
 
@@ -220,11 +222,11 @@ CompareRunResult compare(const CompareRunConfig& c, const Log& log) {
   write_curves(out, c.output_dir + "/curves.csv");
   write_histograms(out.comparison(), c.output_dir + "/histogram.csv");
   if (out.q3) write_q3(out, c.output_dir, log);
-  write_report(c.output_dir + "/summary.json", out);
+  write_text_file(c.output_dir + "/summary.json", report_json(out));
   log_methods(out, log);
   log("viewcells: curves -> " + c.output_dir + "/curves.csv, histograms -> " + c.output_dir +
       "/histogram.csv; plots: bash scripts/plot-compare.sh " + c.output_dir);
   return out;
 }
 
-}  // namespace viewcells::pipeline
+}  // namespace viewcells::studies
