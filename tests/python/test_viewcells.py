@@ -208,7 +208,7 @@ def cost_colour(t):
 
 
 def test_a_slice_through_the_cells_from_python(office):
-    """The README's picture for Python: the office's cells at eye height, drawn from query() and
+    """docs/python.md's picture: the office's cells at eye height, drawn from query() and
     cell_costs alone (blue cheapest to red costliest, borders between cells and the walls' cut
     dark), written to $VIEWCELLS_TEST_OUT/python-slice.png."""
     scene = viewcells.Scene.load(str(office / "office.obj"))

@@ -1,4 +1,4 @@
-"""scripts/check-layers.py: an include that runs up the layers, or across to a layer beside, is
+"""tools/check-layers.py: an include that runs up the layers, or across to a layer beside, is
 named with its file and line and fails; the library itself passes."""
 import os
 import subprocess
@@ -7,7 +7,7 @@ import tempfile
 import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-CHECK = os.path.join(HERE, "..", "..", "scripts", "check-layers.py")
+CHECK = os.path.join(HERE, "..", "..", "tools", "check-layers.py")
 LIBRARY = os.path.join(HERE, "..", "..", "libviewcells")
 
 CMAKE = """

@@ -7,7 +7,7 @@ its sources, under src/ and include/viewcells/. A file may include the headers o
 layer, of the layers below it (transitively) and of the format (viewcells/format/), and nothing
 else of the project's: not a layer above or beside it, not the runtime's sources.
 
-Usage: scripts/check-layers.py [LIBVIEWCELLS_DIR]   (default: libviewcells beside this script)
+Usage: tools/check-layers.py [LIBVIEWCELLS_DIR]   (default: libviewcells beside this script)
 Prints FILE:LINE: what runs up, for each such include, and exits 1 if there is any.
 """
 import os

@@ -3,7 +3,7 @@
 their readers) and every header they include, transitively; nothing else. Internals that no
 stable header needs (threads, progress, MPI ranks, file staging, ...) stay private.
 
-Usage: scripts/installed-headers.py INCLUDE_DIR MODULE...   (e.g. libviewcells/include pipeline scene io)
+Usage: tools/installed-headers.py INCLUDE_DIR MODULE...   (e.g. libviewcells/include pipeline scene io)
 Prints the headers, relative to INCLUDE_DIR, separated by semicolons (a CMake list).
 """
 import os
