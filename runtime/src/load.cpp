@@ -1,7 +1,7 @@
-// The payload of a .pvs file read into a handle (handle.h): the BSP, the general planes, the
-// visible sets (expanded, or kept coded for a compact handle), names, and the grid where
-// location starts. Every count and index is checked before it is used; nothing in a file can
-// make the reader read out of bounds, loop or allocate beyond what the file's own size implies.
+// The payload of a .pvs file read into a handle (handle.h): decoded and checked by the format's
+// codec (format/pvs_payload.h, the toolkit's reader too), then laid out for location: the BSP in
+// preorder, the general planes, the visible sets (expanded, or kept coded for a compact handle),
+// names, and the grid where location starts.
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -12,73 +12,28 @@
 #include "handle.h"
 #include "viewcells/format/id_lists.h"
 #include "viewcells/format/orientation.h"
+#include "viewcells/format/pvs_payload.h"
 
 namespace viewcells::runtime_detail {
 
 namespace {
 
-bool finite(const Vec& p) { return std::isfinite(p.v[0]) && std::isfinite(p.v[1]) && std::isfinite(p.v[2]); }
-
-Vec get_vec(Reader& r) {
-  Vec p;
-  for (double& x : p.v) x = r.get<double>();
-  return p;
-}
-
-/// Planes and nodes: every inner node has a valid plane and two later children, every node
-/// but the root one parent, every leaf a view cell.
-void read_bsp(Reader& r, vc_pvs& f, uint64_t max_items) {
-  std::vector<int32_t> leaf_cell;
-  const uint64_t plane_count = r.get<uint64_t>();
-  if (plane_count < 6 || plane_count > max_items) throw FileError("corrupt file: invalid plane count");
-  std::vector<int32_t> axis(plane_count), general(plane_count, -1);
-  std::vector<double> offset(plane_count);
-  for (uint64_t i = 0; i < plane_count; ++i) {
-    axis[i] = r.get<int32_t>();
-    const Vec normal = get_vec(r);
-    offset[i] = r.get<double>();
-    GeneralPlane g{get_vec(r), get_vec(r), get_vec(r)};
-    if (axis[i] < -1 || axis[i] > 2 || !finite(normal) || !std::isfinite(offset[i]))
-      throw FileError("corrupt file: invalid plane");
-    if (axis[i] < 0) {
-      if (!finite(g.a) || !finite(g.b) || !finite(g.c)) throw FileError("corrupt file: invalid plane");
-      general[i] = static_cast<int32_t>(f.planes.size());
-      f.planes.push_back(g);
-    }
+/// The BSP in preorder (the codec checked that it is a tree whose leaves are view cells), and
+/// the general planes, within what a handle indexes.
+void read_bsp(const format::PvsPayload& p, vc_pvs& f) {
+  std::vector<int32_t> general(p.planes.size(), -1);
+  for (size_t i = 0; i < p.planes.size(); ++i) {
+    const format::PvsPlane& q = p.planes[i];
+    if (q.axis >= 0) continue;
+    general[i] = static_cast<int32_t>(f.planes.size());
+    f.planes.push_back(GeneralPlane{{{q.points[0][0], q.points[0][1], q.points[0][2]}},
+                                    {{q.points[1][0], q.points[1][1], q.points[1][2]}},
+                                    {{q.points[2][0], q.points[2][1], q.points[2][2]}}});
   }
-  const uint64_t count = r.get<uint64_t>();
-  if (count == 0 || count > max_items || count % 2 == 0 || count >= kIndex)
-    throw FileError("corrupt file: invalid node count");
+  if (p.nodes.size() >= kIndex) throw FileError("corrupt file: invalid node count");
   if (f.planes.size() > kIndex) throw FileError("corrupt file: invalid plane count");
-  struct Raw {
-    int32_t plane, child[2];
-  };
-  std::vector<Raw> raw(count);
-  leaf_cell.resize(count);
-  std::vector<int> parents(count, 0);
-  for (uint64_t n = 0; n < count; ++n) {
-    Raw& b = raw[n];
-    b.plane = r.get<int32_t>();
-    b.child[0] = r.get<int32_t>();
-    b.child[1] = r.get<int32_t>();
-    leaf_cell[n] = r.get<int32_t>();
-    if (b.plane < 0) {
-      if (b.child[0] != -1 || b.child[1] != -1)
-        throw FileError("corrupt file: BSP leaf " + std::to_string(n) + " has children");
-      continue;
-    }
-    if (static_cast<uint64_t>(b.plane) >= plane_count || leaf_cell[n] != -1)
-      throw FileError("corrupt file: BSP node " + std::to_string(n) + " is invalid");
-    for (int32_t ch : b.child) {
-      if (ch <= static_cast<int64_t>(n) || static_cast<uint64_t>(ch) >= count)
-        throw FileError("corrupt file: BSP node " + std::to_string(n) + " has a bad child");
-      ++parents[ch];
-    }
-  }
-  for (uint64_t n = 1; n < count; ++n)
-    if (parents[n] != 1) throw FileError("corrupt file: BSP node " + std::to_string(n) + " is not in the tree once");
-  // Preorder layout (a tree, checked above): the negative child right after its parent.
-  f.nodes.reserve(count);
+  // Preorder layout (a tree): the negative child right after its parent.
+  f.nodes.reserve(p.nodes.size());
   std::vector<std::pair<int32_t, int64_t>> stack = {{0, -1}};  // (file node, parent's slot for `right`)
   while (!stack.empty()) {
     const auto [old, slot] = stack.back();
@@ -87,101 +42,45 @@ void read_bsp(Reader& r, vc_pvs& f, uint64_t max_items) {
     if (slot >= 0) f.nodes[slot].right = me;
     Node node{};
     node.right = 0;
-    const Raw& b = raw[old];
+    const format::PvsNode& b = p.nodes[old];
     if (b.plane < 0) {
-      node.meta = static_cast<uint32_t>(leaf_cell[old]);  // checked against the cell count later
+      node.meta = static_cast<uint32_t>(b.cell);
       node.list[0] = node.list[1] = 0;
       f.nodes.push_back(node);
       continue;
     }
-    node.offset = offset[b.plane];
-    node.meta = axis[b.plane] >= 0 ? static_cast<uint32_t>(axis[b.plane]) << 30
-                                   : (3u << 30) | static_cast<uint32_t>(general[b.plane]);
+    const format::PvsPlane& q = p.planes[b.plane];
+    node.offset = q.offset;
+    node.meta = q.axis >= 0 ? static_cast<uint32_t>(q.axis) << 30 : (3u << 30) | static_cast<uint32_t>(general[b.plane]);
     f.nodes.push_back(node);
     stack.push_back({b.child[1], me});
     stack.push_back({b.child[0], -1});  // popped next: lands at me + 1
   }
 }
 
-/// Decodes the kept lists of the hierarchy and checks them; then expands every cell's visible
-/// set, or for a compact handle keeps the lists coded (format 2) with where each starts.
-void read_lists(Reader& r, vc_pvs& f, uint64_t max_items, uint32_t version) {
-  f.cell_count = r.get<uint32_t>();
-  const std::vector<int32_t> parent = r.get_array<int32_t>(max_items);
-  const std::vector<uint32_t> mht = r.get_array<uint32_t>(max_items);
-  const std::string lists = r.get_string();
-  if (!r.at_end()) throw FileError("corrupt file: trailing bytes");
-  const size_t total = parent.size();
-  if (f.cell_count == 0 || f.cell_count > total || mht.size() != f.cell_count)
-    throw FileError("corrupt file: invalid view cell count");
-  for (size_t n = 0; n < total; ++n)
-    if (parent[n] != -1 && (parent[n] <= static_cast<int64_t>(n) || static_cast<size_t>(parent[n]) >= total))
-      throw FileError("corrupt file: hierarchy node " + std::to_string(n) + " has a bad parent");
-  std::vector<std::vector<uint32_t>> stored(total);
-  if (version == 1) {  // LEB128 varints of the differences
-    Reader lr(lists);
-    for (auto& ids : stored) {
-      const uint32_t n = lr.get_varint();
-      if (n > f.object_count) throw FileError("corrupt file: a list holds more entries than there are objects");
-      ids.resize(n);
-      uint64_t previous = 0;
-      for (uint32_t i = 0; i < n; ++i) {
-        const uint64_t id = (i ? previous + 1 : 0) + lr.get_varint();
-        if (id >= f.object_count) throw FileError("corrupt file: object id out of range");
-        ids[i] = static_cast<uint32_t>(id);
-        previous = id;
-      }
-    }
-    if (!lr.at_end()) throw FileError("corrupt file: trailing bytes after the PVS lists");
-  } else {  // binary interpolative coding (id_lists.h)
-    if (f.compact && 8 * static_cast<uint64_t>(lists.size()) > std::numeric_limits<uint32_t>::max())
-      throw FileError("the coded lists exceed 2^32 bits, more than a compact handle indexes");
-    viewcells::id_lists::BitReader lr(lists.data(), lists.size());
-    for (size_t n = 0; n < total; ++n) {
-      if (f.compact) f.node_bit.push_back(static_cast<uint32_t>(lr.position()));
-      if (!viewcells::id_lists::get_list(lr, f.object_count, stored[n]))
-        throw FileError("corrupt file: malformed PVS list of hierarchy node " + std::to_string(n));
-    }
-    if (!lr.at_end()) throw FileError("corrupt file: trailing bytes after the PVS lists");
-    if (f.compact) f.coded = lists;
-  }
+/// Every cell's visible set expanded, or for a compact handle the lists kept coded (format 2:
+/// version 1's lists coded again) with where each node's starts.
+void read_lists(format::PvsPayload& p, vc_pvs& f, std::vector<uint64_t>& node_bits, std::string& coded) {
+  f.cell_count = p.cell_count;
   if (f.compact) {
-    // Format 1's lists coded as format 2's; each cell's path checked for repeats one cell at a
-    // time; only the coding is kept.
-    if (version == 1) {
+    if (coded.empty() && node_bits.empty()) {  // version 1: code the lists as format 2's
       viewcells::id_lists::BitWriter w;
-      f.node_bit.reserve(total);
-      for (const auto& ids : stored) {
-        if (w.bits() > std::numeric_limits<uint32_t>::max())
-          throw FileError("the coded lists exceed 2^32 bits, more than a compact handle indexes");
-        f.node_bit.push_back(static_cast<uint32_t>(w.bits()));
+      for (const auto& ids : p.stored) {
+        node_bits.push_back(w.bits());
         viewcells::id_lists::put_list(w, ids.data(), ids.size(), f.object_count);
       }
-      f.coded = w.finish();
+      coded = w.finish();
     }
-    f.node_parent = parent;
-    std::vector<uint32_t> cell;
-    for (uint32_t c = 0; c < f.cell_count; ++c) {
-      cell.clear();
-      for (int32_t n = static_cast<int32_t>(c); n >= 0; n = parent[n]) {
-        if (cell.size() + stored[n].size() > f.object_count)
-          throw FileError("corrupt file: cell " + std::to_string(c) + " repeats an object");
-        cell.insert(cell.end(), stored[n].begin(), stored[n].end());
-      }
-      std::sort(cell.begin(), cell.end());
-      if (std::adjacent_find(cell.begin(), cell.end()) != cell.end())
-        throw FileError("corrupt file: cell " + std::to_string(c) + " repeats an object");
-    }
+    if (8 * static_cast<uint64_t>(coded.size()) > std::numeric_limits<uint32_t>::max())
+      throw FileError("the coded lists exceed 2^32 bits, more than a compact handle indexes");
+    f.node_bit.assign(node_bits.begin(), node_bits.end());
+    f.coded = std::move(coded);
+    f.node_parent = std::move(p.parent);
     return;
   }
-  // Size first: a path may not repeat an object, so a cell holds at most object_count.
   uint64_t expanded = 0;
-  for (uint32_t c = 0; c < f.cell_count; ++c) {
-    uint64_t here = 0;
-    for (int32_t n = static_cast<int32_t>(c); n >= 0; n = parent[n]) here += stored[n].size();
-    if (here > f.object_count) throw FileError("corrupt file: cell " + std::to_string(c) + " repeats an object");
-    expanded += here;
-  }
+  for (uint32_t c = 0; c < f.cell_count; ++c)
+    for (int32_t n = static_cast<int32_t>(c); n >= 0; n = p.parent[n]) expanded += p.stored[n].size();
   if (expanded > (uint64_t{1} << 31))
     throw FileError("the expanded visible sets hold " + std::to_string(expanded) + " entries, more than 2^31");
   f.offsets.reserve(f.cell_count + 1);
@@ -189,11 +88,9 @@ void read_lists(Reader& r, vc_pvs& f, uint64_t max_items, uint32_t version) {
   f.offsets.push_back(0);
   for (uint32_t c = 0; c < f.cell_count; ++c) {
     const size_t first = f.ids.size();
-    for (int32_t n = static_cast<int32_t>(c); n >= 0; n = parent[n])
-      f.ids.insert(f.ids.end(), stored[n].begin(), stored[n].end());
+    for (int32_t n = static_cast<int32_t>(c); n >= 0; n = p.parent[n])
+      f.ids.insert(f.ids.end(), p.stored[n].begin(), p.stored[n].end());
     std::sort(f.ids.begin() + first, f.ids.end());
-    if (std::adjacent_find(f.ids.begin() + first, f.ids.end()) != f.ids.end())
-      throw FileError("corrupt file: cell " + std::to_string(c) + " repeats an object");
     f.offsets.push_back(f.ids.size());
   }
 }
@@ -287,30 +184,26 @@ void read_bytes(const std::string& bytes, vc_pvs& f) {
 }
 
 void read_payload(const std::string& payload, uint32_t version, vc_pvs& f) {
-  Reader r(payload);
-  const uint64_t max_items = payload.size();
-  f.fingerprint = r.get<uint64_t>();
-  f.object_count = r.get<uint32_t>();
-  const uint64_t names = r.get<uint64_t>();
-  if (names != 0 && names != f.object_count) throw FileError("corrupt file: object names do not match the object count");
-  for (uint64_t i = 0; i < names; ++i) f.names.push_back(r.get_string());
-  f.rule = r.get_string();
-  for (double& x : f.lo) x = r.get<double>();
-  for (double& x : f.hi) x = r.get<double>();
-  // As the toolkit checks it (Box3::volume): finite corners and a positive volume in double.
-  bool box_ok = true;
-  double volume = 1;
-  for (int k = 0; k < 3; ++k) {
-    box_ok &= std::isfinite(f.lo[k]) && std::isfinite(f.hi[k]) && f.lo[k] <= f.hi[k];
-    volume *= f.hi[k] - f.lo[k];
+  std::vector<uint64_t> node_bits;
+  std::string coded;
+  format::PvsPayload p;
+  try {
+    p = format::decode_pvs_payload(payload, version, f.compact ? &node_bits : nullptr, f.compact ? &coded : nullptr);
+  } catch (const format::FormatError& e) {
+    throw FileError(e.what());
   }
-  if (!box_ok || !(volume > 0)) throw FileError("corrupt file: invalid view box");
-  read_bsp(r, f, max_items);
-  read_lists(r, f, max_items, version);
+  f.fingerprint = p.fingerprint;
+  f.object_count = p.object_count;
+  f.names = std::move(p.names);
+  f.rule = std::move(p.rule);
+  for (int k = 0; k < 3; ++k) {
+    f.lo[k] = p.lo[k];
+    f.hi[k] = p.hi[k];
+  }
+  read_bsp(p, f);
+  read_lists(p, f, node_bits, coded);
   for (Node& n : f.nodes) {
-    if (n.right != 0) continue;
-    if (n.meta >= f.cell_count) throw FileError("corrupt file: a BSP leaf has no view cell");
-    if (f.compact) continue;  // no expanded lists to point at
+    if (n.right != 0 || f.compact) continue;  // a compact handle has no expanded lists to point at
     n.list[0] = static_cast<uint32_t>(f.offsets[n.meta]);
     n.list[1] = static_cast<uint32_t>(f.offsets[n.meta + 1] - f.offsets[n.meta]);
   }

@@ -11,6 +11,7 @@
 #include "viewcells/core/error.h"
 #include "viewcells/core/binary_file.h"
 #include "viewcells/format/id_lists.h"
+#include "viewcells/format/pvs_payload.h"
 
 namespace viewcells {
 
@@ -109,32 +110,8 @@ std::string varint_lists(const std::vector<std::vector<uint32_t>>& lists) {
   return out;
 }
 
-uint32_t get_varint(ByteReader& r) {
-  uint32_t v = 0;
-  for (int shift = 0; shift < 35; shift += 7) {
-    const uint8_t b = r.get<uint8_t>();
-    v |= static_cast<uint32_t>(b & 0x7f) << shift;
-    if (!(b & 0x80)) return v;
-  }
-  r.fail("malformed varint");
-}
-
-std::vector<uint32_t> decode_varint_list(ByteReader& r, uint32_t object_count) {
-  const uint32_t n = get_varint(r);
-  if (n > object_count) r.fail("a list holds more entries than there are objects");
-  std::vector<uint32_t> ids(n);
-  uint64_t previous = 0;
-  for (uint32_t i = 0; i < n; ++i) {
-    const uint64_t id = (i ? previous + 1 : 0) + get_varint(r);
-    if (id >= object_count) r.fail("object id " + std::to_string(id) + " out of range");
-    ids[i] = static_cast<uint32_t>(id);
-    previous = id;
-  }
-  return ids;
-}
-
 constexpr char kMagic[5] = "VPVS";
-constexpr uint32_t kVersion = 2;  // 2: lists by binary interpolative coding (id_lists.h)
+constexpr uint32_t kVersion = format::kPvsVersion;  // 2: lists by binary interpolative coding (id_lists.h)
 constexpr char kFlatMagic[5] = "VFLT";
 
 }  // namespace
@@ -292,39 +269,41 @@ PvsFile make_pvs_file(const Subdivision& s, const std::vector<std::vector<uint32
 
 namespace {
 
-std::string pvs_payload(const PvsFile& f, uint32_t format) {
-  ByteWriter w;
-  w.put<uint64_t>(f.scene_fingerprint);
-  w.put<uint32_t>(f.object_count);
-  w.put<uint64_t>(f.object_names.size());
-  for (const std::string& n : f.object_names) w.put_string(n);
-  w.put_string(f.rule);
-  // Point location.
+format::PvsPayload payload_of(const PvsFile& f) {
+  format::PvsPayload p;
+  p.fingerprint = f.scene_fingerprint;
+  p.object_count = f.object_count;
+  p.names = f.object_names;
+  p.rule = f.rule;
   const Subdivision& s = f.bsp;
-  w.put(s.view_box.lo);
-  w.put(s.view_box.hi);
-  put_planes(w, s.planes);
-  w.put<uint64_t>(s.nodes.size());
-  for (size_t n = 0; n < s.nodes.size(); ++n) {
-    w.put<int32_t>(s.nodes[n].plane);
-    w.put<int32_t>(s.nodes[n].child[0]);
-    w.put<int32_t>(s.nodes[n].child[1]);
-    w.put<int32_t>(f.leaf_cell[n]);
+  for (int k = 0; k < 3; ++k) {
+    p.lo[k] = s.view_box.lo[k];
+    p.hi[k] = s.view_box.hi[k];
   }
-  // The hierarchy: cells first, parents, then the kept lists.
-  w.put<uint32_t>(f.pvs.cell_count);
-  w.put_array(f.pvs.parent);
-  w.put_array(f.cell_mht_node);
-  // The coding holds only sorted ids below the object count: refuse to write anything else.
-  for (size_t n = 0; n < f.pvs.stored.size(); ++n) {
-    const std::vector<uint32_t>& l = f.pvs.stored[n];
-    for (size_t i = 0; i < l.size(); ++i)
-      if (l[i] >= f.object_count || (i && l[i - 1] >= l[i]))
-        throw Error("the PVS list of hierarchy node " + std::to_string(n) + " is not sorted ids below the " +
-                    std::to_string(f.object_count) + " objects");
+  for (const Plane& q : s.planes) {
+    format::PvsPlane& out = p.planes.emplace_back();
+    out.axis = q.axis;
+    out.offset = q.offset;
+    for (int k = 0; k < 3; ++k) {
+      out.normal[k] = q.normal[k];
+      for (int i = 0; i < 3; ++i) out.points[i][k] = q.points[i][k];
+    }
   }
-  w.put_string(format == 1 ? varint_lists(f.pvs.stored) : id_lists::encode(f.pvs.stored, f.object_count));
-  return w.data();
+  for (size_t n = 0; n < s.nodes.size(); ++n)
+    p.nodes.push_back({s.nodes[n].plane, {s.nodes[n].child[0], s.nodes[n].child[1]}, f.leaf_cell[n]});
+  p.cell_count = f.pvs.cell_count;
+  p.parent = f.pvs.parent;
+  p.mht = f.cell_mht_node;
+  p.stored = f.pvs.stored;
+  return p;
+}
+
+std::string pvs_payload(const PvsFile& f, uint32_t version) {
+  try {
+    return format::encode_pvs_payload(payload_of(f), version);
+  } catch (const format::FormatError& e) {
+    throw Error(e.what());
+  }
 }
 
 }  // namespace
@@ -343,79 +322,39 @@ PvsFile read_pvs(const std::string& path, uint32_t* format) {
   uint32_t version = 0;
   const std::string payload = read_container(path, kMagic, kVersion, version);
   if (format) *format = version;
-  ByteReader r(payload, path);
+  format::PvsPayload p;
+  try {
+    p = format::decode_pvs_payload(payload, version);
+  } catch (const format::FormatError& e) {
+    throw Error(path, 0, e.what());
+  }
   PvsFile f;
-  const uint64_t max_items = payload.size();
-  f.scene_fingerprint = r.get<uint64_t>();
-  f.object_count = r.get<uint32_t>();
-  const uint64_t names = r.get<uint64_t>();
-  if (names != 0 && names != f.object_count) r.fail("object names do not match the object count");
-  for (uint64_t i = 0; i < names; ++i) f.object_names.push_back(r.get_string());
-  f.rule = r.get_string();
+  f.scene_fingerprint = p.fingerprint;
+  f.object_count = p.object_count;
+  f.object_names = std::move(p.names);
+  f.rule = std::move(p.rule);
   Subdivision& s = f.bsp;
-  s.view_box = get_view_box(r);
-  s.planes = get_planes(r, max_items);
-  const uint64_t planes = s.planes.size();
-  const uint64_t nodes = r.get<uint64_t>();
-  if (nodes == 0 || nodes > max_items || nodes % 2 == 0) r.fail("invalid node count");
-  s.nodes.resize(nodes);
-  f.leaf_cell.resize(nodes);
-  for (size_t n = 0; n < nodes; ++n) {
-    BspNode& b = s.nodes[n];
-    b.plane = r.get<int32_t>();
-    b.child[0] = r.get<int32_t>();
-    b.child[1] = r.get<int32_t>();
-    f.leaf_cell[n] = r.get<int32_t>();
+  s.view_box.lo = {p.lo[0], p.lo[1], p.lo[2]};
+  s.view_box.hi = {p.hi[0], p.hi[1], p.hi[2]};
+  for (const format::PvsPlane& q : p.planes) {
+    Plane& out = s.planes.emplace_back();
+    out.axis = q.axis;
+    out.normal = {q.normal[0], q.normal[1], q.normal[2]};
+    out.offset = q.offset;
+    for (int i = 0; i < 3; ++i) out.points[i] = {q.points[i][0], q.points[i][1], q.points[i][2]};
   }
-  f.pvs.cell_count = r.get<uint32_t>();
-  r.get_array(f.pvs.parent, max_items);
-  r.get_array(f.cell_mht_node, max_items);
-  const std::string lists = r.get_string();
-  if (!r.at_end()) r.fail("trailing bytes");
-  // The BSP: every inner node has a plane and two later children, each child one parent.
-  const size_t total = f.pvs.parent.size();
-  if (f.pvs.cell_count == 0 || f.pvs.cell_count > total || f.cell_mht_node.size() != f.pvs.cell_count)
-    r.fail("invalid view cell count");
-  std::vector<int> parents(nodes, 0);
-  for (size_t n = 0; n < nodes; ++n) {
-    const BspNode& b = s.nodes[n];
-    if (b.plane < 0) {
-      if (b.child[0] != -1 || b.child[1] != -1) r.fail("BSP leaf " + std::to_string(n) + " has children");
-      if (f.leaf_cell[n] < 0 || f.leaf_cell[n] >= static_cast<int32_t>(f.pvs.cell_count))
-        r.fail("BSP leaf " + std::to_string(n) + " has no view cell");
-      continue;
-    }
-    if (b.plane >= static_cast<int32_t>(planes) || f.leaf_cell[n] != -1) r.fail("BSP node " + std::to_string(n) + " is invalid");
-    for (int32_t c : b.child) {
-      if (c <= static_cast<int32_t>(n) || c >= static_cast<int32_t>(nodes)) r.fail("BSP node " + std::to_string(n) + " has a bad child");
-      ++parents[c];
-    }
+  s.nodes.resize(p.nodes.size());
+  f.leaf_cell.reserve(p.nodes.size());
+  for (size_t n = 0; n < p.nodes.size(); ++n) {
+    s.nodes[n].plane = p.nodes[n].plane;
+    s.nodes[n].child[0] = p.nodes[n].child[0];
+    s.nodes[n].child[1] = p.nodes[n].child[1];
+    f.leaf_cell.push_back(p.nodes[n].cell);
   }
-  for (size_t n = 1; n < nodes; ++n)
-    if (parents[n] != 1) r.fail("BSP node " + std::to_string(n) + " is not in the tree once");
-  // The hierarchy: parents come later; lists decode to sorted ids within the object count.
-  for (size_t n = 0; n < total; ++n) {
-    const int32_t p = f.pvs.parent[n];
-    if (p != -1 && (p <= static_cast<int32_t>(n) || p >= static_cast<int32_t>(total)))
-      r.fail("hierarchy node " + std::to_string(n) + " has a bad parent");
-  }
-  f.pvs.stored.resize(total);
-  if (version == 1) {
-    ByteReader lr(lists, path);
-    for (auto& l : f.pvs.stored) l = decode_varint_list(lr, f.object_count);
-    if (!lr.at_end()) r.fail("trailing bytes after the PVS lists");
-  } else {
-    id_lists::BitReader lr(lists.data(), lists.size());
-    for (size_t n = 0; n < total; ++n)
-      if (!id_lists::get_list(lr, f.object_count, f.pvs.stored[n]))
-        r.fail("malformed PVS list of hierarchy node " + std::to_string(n));
-    if (!lr.at_end()) r.fail("trailing bytes after the PVS lists");
-  }
-  for (uint32_t c = 0; c < f.pvs.cell_count; ++c) {
-    // Kept lists along a path are disjoint by construction; a repeat means corruption.
-    const std::vector<uint32_t> pvs = f.pvs.cell_pvs(c);
-    if (std::adjacent_find(pvs.begin(), pvs.end()) != pvs.end()) r.fail("cell " + std::to_string(c) + " repeats an object");
-  }
+  f.pvs.cell_count = p.cell_count;
+  f.pvs.parent = std::move(p.parent);
+  f.cell_mht_node = std::move(p.mht);
+  f.pvs.stored = std::move(p.stored);
   return f;
 }
 
