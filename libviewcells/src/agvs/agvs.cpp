@@ -7,37 +7,28 @@
 #include <optional>
 
 #include "viewcells/core/interrupt.h"
+#include "viewcells/core/names.h"
 #include "viewcells/core/progress.h"
 
 namespace viewcells {
 
-AgvsMethod parse_agvs_method(const std::string& name) {
-  if (name == "agvs") return AgvsMethod::kAgvs;
-  if (name == "sgvs") return AgvsMethod::kSgvs;
-  if (name == "ref") return AgvsMethod::kRef;
-  throw Error("unknown PVS method '" + name + "' (expected agvs, sgvs or ref)");
-}
+namespace {
+constexpr EnumNames<AgvsMethod, 3> kMethodNames{
+    {{{AgvsMethod::kAgvs, "agvs"}, {AgvsMethod::kSgvs, "sgvs"}, {AgvsMethod::kRef, "ref"}}}, "PVS method"};
+constexpr EnumNames<AgvsDistribution, 5> kDistributionNames{
+    {{{AgvsDistribution::kViewSpaceDirection, "view space-direction"},
+      {AgvsDistribution::kObjectDirection, "object-direction"},
+      {AgvsDistribution::kTwoPoint, "two-point"},
+      {AgvsDistribution::kTwoPointMutation, "two-point mutation"},
+      {AgvsDistribution::kSilhouetteMutation, "silhouette mutation"}}},
+    "AGVS distribution"};
+}  // namespace
 
-const char* to_string(AgvsMethod m) {
-  switch (m) {
-    case AgvsMethod::kAgvs: return "agvs";
-    case AgvsMethod::kSgvs: return "sgvs";
-    case AgvsMethod::kRef: return "ref";
-  }
-  return "?";
-}
+AgvsMethod parse_agvs_method(const std::string& name) { return kMethodNames.parse(name); }
 
-const char* to_string(AgvsDistribution d) {
-  switch (d) {
-    case AgvsDistribution::kViewSpaceDirection: return "view space-direction";
-    case AgvsDistribution::kObjectDirection: return "object-direction";
-    case AgvsDistribution::kTwoPoint: return "two-point";
-    case AgvsDistribution::kTwoPointMutation: return "two-point mutation";
-    case AgvsDistribution::kSilhouetteMutation: return "silhouette mutation";
-    case AgvsDistribution::kCount: break;
-  }
-  return "?";
-}
+const char* to_string(AgvsMethod m) { return kMethodNames.name(m); }
+
+const char* to_string(AgvsDistribution d) { return kDistributionNames.name(d); }
 
 AgvsSolver::AgvsSolver(const Scene& scene, const RayCaster& caster, const CellLocator& cells, const AgvsConfig& config) {
   if (config.batch_size == 0) throw Error("the batch size must be positive");

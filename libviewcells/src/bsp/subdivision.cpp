@@ -30,6 +30,7 @@
 #include "bsp/subdivision_builder.h"
 #include "viewcells/core/default_init.h"
 #include "viewcells/core/error.h"
+#include "viewcells/core/names.h"
 #include "viewcells/core/interrupt.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/core/rng.h"
@@ -90,27 +91,19 @@ int32_t Subdivision::locate(const Vec3& p) const {
   return n;
 }
 
-SplitStrategy parse_split_strategy(const std::string& name) {
-  if (name == "av-s") return SplitStrategy::kCost;
-  if (name == "kd-casm") return SplitStrategy::kKdCycling;
-  if (name == "kd-lasm") return SplitStrategy::kKdLongest;
-  if (name == "kd-vt") return SplitStrategy::kKdVisibility;
-  if (name == "kd-vt-star") return SplitStrategy::kKdVisibilityDepthFirst;
-  if (name == "bsp") return SplitStrategy::kPolygonBsp;
-  throw Error("unknown subdivision method '" + name + "' (expected av-s, kd-casm, kd-lasm, kd-vt, kd-vt-star or bsp)");
-}
+namespace {
+constexpr EnumNames<SplitStrategy, 6> kStrategyNames{{{{SplitStrategy::kCost, "av-s"},
+                                                       {SplitStrategy::kKdCycling, "kd-casm"},
+                                                       {SplitStrategy::kKdLongest, "kd-lasm"},
+                                                       {SplitStrategy::kKdVisibility, "kd-vt"},
+                                                       {SplitStrategy::kKdVisibilityDepthFirst, "kd-vt-star"},
+                                                       {SplitStrategy::kPolygonBsp, "bsp"}}},
+                                                     "subdivision method"};
+}  // namespace
 
-const char* to_string(SplitStrategy s) {
-  switch (s) {
-    case SplitStrategy::kCost: return "av-s";
-    case SplitStrategy::kKdCycling: return "kd-casm";
-    case SplitStrategy::kKdLongest: return "kd-lasm";
-    case SplitStrategy::kKdVisibility: return "kd-vt";
-    case SplitStrategy::kKdVisibilityDepthFirst: return "kd-vt-star";
-    case SplitStrategy::kPolygonBsp: return "bsp";
-  }
-  return "?";
-}
+SplitStrategy parse_split_strategy(const std::string& name) { return kStrategyNames.parse(name); }
+
+const char* to_string(SplitStrategy s) { return kStrategyNames.name(s); }
 
 bool use_geometry_aligned(const Scene& scene, const SubdivisionConfig& config, std::string& reason) {
   const double share = scene.non_axis_aligned_share();

@@ -7,29 +7,23 @@
 #include <vector>
 
 #include "viewcells/core/error.h"
+#include "viewcells/core/names.h"
 #include "viewcells/core/rng.h"
 
 namespace viewcells {
 
-GeneratorKind parse_generator_kind(const std::string& name) {
-  if (name == "office") return GeneratorKind::kOffice;
-  if (name == "city") return GeneratorKind::kCity;
-  if (name == "rotated-office") return GeneratorKind::kRotatedOffice;
-  if (name == "town") return GeneratorKind::kTown;
-  if (name == "glass-city") return GeneratorKind::kGlassCity;
-  throw Error("unknown scene kind '" + name + "' (expected office, city, rotated-office or town)");
-}
+namespace {
+constexpr EnumNames<GeneratorKind, 5> kKindNames{{{{GeneratorKind::kOffice, "office"},
+                                                   {GeneratorKind::kCity, "city"},
+                                                   {GeneratorKind::kRotatedOffice, "rotated-office"},
+                                                   {GeneratorKind::kTown, "town"},
+                                                   {GeneratorKind::kGlassCity, "glass-city"}}},
+                                                 "scene kind"};
+}  // namespace
 
-const char* to_string(GeneratorKind kind) {
-  switch (kind) {
-    case GeneratorKind::kOffice: return "office";
-    case GeneratorKind::kCity: return "city";
-    case GeneratorKind::kRotatedOffice: return "rotated-office";
-    case GeneratorKind::kTown: return "town";
-    case GeneratorKind::kGlassCity: return "glass-city";
-  }
-  return "?";
-}
+GeneratorKind parse_generator_kind(const std::string& name) { return kKindNames.parse(name); }
+
+const char* to_string(GeneratorKind kind) { return kKindNames.name(kind); }
 
 namespace {
 

@@ -8,32 +8,25 @@
 #include <unordered_map>
 
 #include "viewcells/core/error.h"
+#include "viewcells/core/names.h"
 #include "viewcells/core/union_find.h"
 #include "viewcells/core/rng.h"
 
 namespace viewcells {
 
-ObjectGrouping parse_grouping(const std::string& name) {
-  if (name == "auto") return ObjectGrouping::kAuto;
-  if (name == "groups") return ObjectGrouping::kGroups;
-  if (name == "components") return ObjectGrouping::kComponents;
-  if (name == "triangles") return ObjectGrouping::kTriangles;
-  if (name == "nodes") return ObjectGrouping::kNodes;
-  if (name == "meshes") return ObjectGrouping::kMeshes;
-  throw Error("unknown object grouping '" + name + "' (expected auto, groups, components, triangles, nodes or meshes)");
-}
+namespace {
+constexpr EnumNames<ObjectGrouping, 6> kGroupingNames{{{{ObjectGrouping::kAuto, "auto"},
+                                                        {ObjectGrouping::kGroups, "groups"},
+                                                        {ObjectGrouping::kComponents, "components"},
+                                                        {ObjectGrouping::kTriangles, "triangles"},
+                                                        {ObjectGrouping::kNodes, "nodes"},
+                                                        {ObjectGrouping::kMeshes, "meshes"}}},
+                                                      "object grouping"};
+}  // namespace
 
-const char* to_string(ObjectGrouping g) {
-  switch (g) {
-    case ObjectGrouping::kAuto: return "auto";
-    case ObjectGrouping::kGroups: return "groups";
-    case ObjectGrouping::kComponents: return "components";
-    case ObjectGrouping::kTriangles: return "triangles";
-    case ObjectGrouping::kNodes: return "nodes";
-    case ObjectGrouping::kMeshes: return "meshes";
-  }
-  return "?";
-}
+ObjectGrouping parse_grouping(const std::string& name) { return kGroupingNames.parse(name); }
+
+const char* to_string(ObjectGrouping g) { return kGroupingNames.name(g); }
 
 namespace {
 
