@@ -63,7 +63,7 @@ def start():
 def watch():
     state["ticks"] += 1  # Blender's event loop ran while the bake was baking
     s = bpy.context.scene.viewcells
-    if addon._job is not None:
+    if addon.state.job is not None:
         state["progress"].append(s.progress)
         if time.time() - state["started"] > 240:
             finish("FAIL: the bake did not end in 240 s", 1)
@@ -77,11 +77,11 @@ def watch():
     # the bar as the timers saw it never fell. That it rises through the stages is checked on
     # the stages the add-on set, not on what the timers sampled: how many distinct values a
     # timer sees depends on the machine's speed (two of five runs on a quiet machine saw one).
-    print(f"stages set: {addon.last_stages}")
+    print(f"stages set: {addon.state.last_stages}")
     if not state["progress"] or state["progress"] != sorted(state["progress"]):
         finish(f"FAIL: the progress bar should show and never fall while the bake runs: {state['progress']}", 1)
-    if len(addon.last_stages) < 5 or addon.last_stages != sorted(addon.last_stages):
-        finish(f"FAIL: the bake should go through its stages in order: {addon.last_stages}", 1)
+    if len(addon.state.last_stages) < 5 or addon.state.last_stages != sorted(addon.state.last_stages):
+        finish(f"FAIL: the bake should go through its stages in order: {addon.state.last_stages}", 1)
     if not os.path.exists(s.output) or not os.path.exists(s.gltf):
         finish("FAIL: the .pvs or the .glb is missing", 1)
     # A click on a cell (here: making it the active object) selects its PVS, through the

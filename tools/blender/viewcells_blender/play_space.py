@@ -5,7 +5,9 @@ space), drawn as green floors, and start points to mark where players begin."""
 import bpy
 import numpy as np
 
-from . import PLAY_COLLECTION, import_viewcells, scene_arrays, start_positions
+from .level import scene_arrays, start_positions
+from .module import import_viewcells
+from .state import PLAY_COLLECTION
 
 PLAY_OBJECT = "viewcells play space"
 PLAY_MATERIAL = "viewcells play space"
