@@ -10,8 +10,11 @@ this directory into Blender's add-on directory, or Preferences > Add-ons > Insta
 of it; docs/blender.md says how objects and materials map to what a PVS lists.
 
 Everything Blender-independent (mesh arrays to a scene, option words, colours, the PVS of a
-point) is in plain functions below, so the headless test (tests/blender/addon_test.py) calls
-the same code a click does.
+point) is in plain functions, so the headless test (tests/blender/addon_test.py) calls the same
+code a click does. The modules: module.py finds `viewcells`; level.py turns the visible meshes
+into arrays and finds the start points; options.py the bake's keywords and progress stages;
+results.py puts the cells into the scene; operators.py, play_space.py and panel.py are what
+the sidebar shows; state.py what they share.
 """
 
 bl_info = {
