@@ -76,30 +76,10 @@ std::shared_ptr<const viewcells::Scene> scene_from(const vc_bake_object* objects
       viewcells::make_scene(std::move(mesh), viewcells::ObjectGrouping::kGroups, kName));
 }
 
-}  // namespace
-
-extern "C" {
-
-int vc_bake(const vc_bake_object* objects, size_t object_count, const char* const* options, const char* output,
-            vc_bake_log log, void* user, vc_bake_result** out, char* error, size_t error_size) {
-  if (out) *out = nullptr;
-  if (!out || (!objects && object_count)) {
-    put_error(error, error_size, "vc_bake: out must not be NULL, nor objects when object_count is not 0");
-    return 1;
-  }
-  std::vector<std::string> args = {kName, "-o", output ? output : "(not written).pvs"};
-  for (const char* const* w = options; w && *w; ++w) {
-    const std::string word = *w;
-    if (word == "-o" || word == "--output" || word.rfind("--output=", 0) == 0 || word == "--report" ||
-        word.rfind("--report=", 0) == 0) {
-      put_error(error, error_size, "vc_bake: " + word + " is not an option here (the output is vc_bake's argument, "
-                                   "the report vc_bake_result_report)");
-      return 1;
-    }
-    args.push_back(word);
-  }
+/// Bakes `config` (its scene set here) into a result; the error codes of bake.h.
+int run_bake(viewcells::pipeline::BakeConfig config, const vc_bake_object* objects, size_t object_count,
+             const char* output, vc_bake_log log, void* user, vc_bake_result** out, char* error, size_t error_size) {
   try {
-    viewcells::pipeline::BakeConfig config = viewcells::cli::bake_config_from_args(args, log == nullptr);
     config.scene.scene = scene_from(objects, object_count);
     if (!output) config.output.clear();
     viewcells::pipeline::Log lines = [](const std::string&) {};
@@ -122,6 +102,95 @@ int vc_bake(const vc_bake_object* objects, size_t object_count, const char* cons
     put_error(error, error_size, e.what());
     return 2;
   }
+}
+
+}  // namespace
+
+extern "C" {
+
+vc_bake_config vc_bake_config_default(void) {
+  const viewcells::pipeline::BakeConfig d;
+  vc_bake_config c{};
+  c.cells = d.cells;
+  c.memory_bytes = d.memory;
+  c.memory_of_lists = d.memory_of_lists;
+  c.samples = d.sampling.samples;
+  c.seed = d.sampling.seed;
+  c.pixel_error = d.agvs.pixel_error;
+  c.agvs_samples = d.agvs.max_samples;
+  c.holes = d.holes;
+  c.time_seconds = d.max_seconds;
+  c.near_samples = d.near.rays_per_object;
+  c.play_space = d.play_space_where_known;
+  c.prove_hidden = d.prove_hidden;
+  c.conservative = d.conservative;
+  c.metres_per_unit = d.scene.floors.metres_per_unit;
+  c.start_points = nullptr;
+  c.start_point_count = 0;
+  return c;
+}
+
+int vc_bake_with_config(const vc_bake_object* objects, size_t object_count, const vc_bake_config* config,
+                        const char* output, vc_bake_log log, void* user, vc_bake_result** out, char* error,
+                        size_t error_size) {
+  if (out) *out = nullptr;
+  if (!out || !config || (!objects && object_count) || (config->start_point_count && !config->start_points)) {
+    put_error(error, error_size,
+              "vc_bake_with_config: out and config must not be NULL, nor objects when object_count is not 0, nor "
+              "start_points when start_point_count is not 0");
+    return 1;
+  }
+  viewcells::pipeline::BakeConfig c;
+  c.scene.path = kName;
+  c.output = output ? output : "";
+  c.cells = config->cells;
+  c.memory = config->memory_bytes;
+  c.memory_of_lists = config->memory_of_lists != 0;
+  c.sampling.samples = config->samples;
+  c.sampling.seed = c.subdivision.seed = c.agvs.seed = config->seed;
+  c.agvs.pixel_error = config->pixel_error;
+  c.agvs.max_samples = config->agvs_samples;
+  c.holes = config->holes;
+  c.max_seconds = config->time_seconds;
+  c.near.rays_per_object = config->near_samples;
+  c.play_space_where_known = config->play_space != 0;
+  c.prove_hidden = config->prove_hidden != 0;
+  c.conservative = config->conservative != 0;
+  c.scene.floors.metres_per_unit = config->metres_per_unit;
+  for (size_t i = 0; i < config->start_point_count; ++i)
+    c.scene.floors.start_points.push_back(
+        {config->start_points[3 * i], config->start_points[3 * i + 1], config->start_points[3 * i + 2]});
+  const bool quiet = log == nullptr;
+  c.sampling.show_progress = c.subdivision.show_progress = c.agvs.show_progress = !quiet;
+  return run_bake(std::move(c), objects, object_count, output, log, user, out, error, error_size);
+}
+
+int vc_bake(const vc_bake_object* objects, size_t object_count, const char* const* options, const char* output,
+            vc_bake_log log, void* user, vc_bake_result** out, char* error, size_t error_size) {
+  if (out) *out = nullptr;
+  if (!out || (!objects && object_count)) {
+    put_error(error, error_size, "vc_bake: out must not be NULL, nor objects when object_count is not 0");
+    return 1;
+  }
+  std::vector<std::string> args = {kName, "-o", output ? output : "(not written).pvs"};
+  for (const char* const* w = options; w && *w; ++w) {
+    const std::string word = *w;
+    if (word == "-o" || word == "--output" || word.rfind("--output=", 0) == 0 || word == "--report" ||
+        word.rfind("--report=", 0) == 0) {
+      put_error(error, error_size, "vc_bake: " + word + " is not an option here (the output is vc_bake's argument, "
+                                   "the report vc_bake_result_report)");
+      return 1;
+    }
+    args.push_back(word);
+  }
+  viewcells::pipeline::BakeConfig config;
+  try {
+    config = viewcells::cli::bake_config_from_args(args, log == nullptr);
+  } catch (const std::exception& e) {
+    put_error(error, error_size, e.what());
+    return 2;
+  }
+  return run_bake(std::move(config), objects, object_count, output, log, user, out, error, error_size);
 }
 
 const void* vc_bake_result_bytes(const vc_bake_result* result, size_t* size) {

@@ -137,6 +137,58 @@ TEST(BakeApi, GivesTheBytesOfABakeOfTheSameSceneFromAFile) {
   vc_bake_result_free(r);
 }
 
+// The config struct binds fields, parsing nothing: its defaults are the library's, and a bake
+// with fields set gives the bytes of the bake with the same settings as option words.
+TEST(BakeApi, TheConfigStructIsTheLibrarysDefaultAndBakesAsTheWords) {
+  const vc_bake_config d = vc_bake_config_default();
+  const pipeline::BakeConfig library;
+  EXPECT_EQ(d.samples, library.sampling.samples);
+  EXPECT_EQ(d.near_samples, library.near.rays_per_object);
+  EXPECT_EQ(d.play_space != 0, library.play_space_where_known);
+  EXPECT_EQ(d.cells, 0u);
+  EXPECT_EQ(d.memory_bytes, 0u);
+  const Meshes m = office();
+  vc_bake_result* words = nullptr;
+  std::string error;
+  ASSERT_EQ(bake(m, kOptions, nullptr, &words, &error), 0) << error;
+  vc_bake_config c = vc_bake_config_default();
+  c.cells = 12;
+  c.samples = 20000;
+  c.agvs_samples = 40000;
+  c.seed = 3;
+  c.near_samples = 64;
+  const std::vector<vc_bake_object> objects = m.objects();
+  vc_bake_result* fields = nullptr;
+  char message[512] = "";
+  ASSERT_EQ(vc_bake_with_config(objects.data(), objects.size(), &c, nullptr, nullptr, nullptr, &fields, message,
+                                sizeof message),
+            0)
+      << message;
+  size_t a = 0, b = 0;
+  const char* wa = static_cast<const char*>(vc_bake_result_bytes(words, &a));
+  const char* fb = static_cast<const char*>(vc_bake_result_bytes(fields, &b));
+  EXPECT_EQ(std::string(wa, a), std::string(fb, b)) << "the config struct bakes otherwise than the words";
+  vc_bake_result_free(fields);
+  // The check can fail: another seed gives other bytes.
+  c.seed = 4;
+  ASSERT_EQ(vc_bake_with_config(objects.data(), objects.size(), &c, nullptr, nullptr, nullptr, &fields, message,
+                                sizeof message),
+            0)
+      << message;
+  EXPECT_NE(std::string(wa, a), std::string(static_cast<const char*>(vc_bake_result_bytes(fields, &b)), b));
+  vc_bake_result_free(fields);
+  vc_bake_result_free(words);
+  // No budget, or two: an error naming it, code 2.
+  c.cells = 0;
+  EXPECT_EQ(vc_bake_with_config(objects.data(), objects.size(), &c, nullptr, nullptr, nullptr, &fields, message,
+                                sizeof message),
+            2);
+  EXPECT_NE(std::string(message).find("budget"), std::string::npos) << message;
+  EXPECT_EQ(vc_bake_with_config(objects.data(), objects.size(), nullptr, nullptr, nullptr, nullptr, &fields, message,
+                                sizeof message),
+            1);
+}
+
 /// Two boxes with a pane between them, the view space on the left: the right box is seen only
 /// when the pane is see-through, and the pane is seen either way, although it stands outside
 /// the view box (a see-through object is looked for along the whole line of sight). So is a

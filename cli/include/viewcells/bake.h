@@ -52,6 +52,40 @@ typedef struct vc_bake_result vc_bake_result;
 int vc_bake(const vc_bake_object* objects, size_t object_count, const char* const* options, const char* output,
             vc_bake_log log, void* user, vc_bake_result** out, char* error, size_t error_size);
 
+/* The bake's settings as fields, for callers that would rather not write option words:
+ * vc_bake_config_default() gives the library's defaults (pipeline::BakeConfig{}, which are
+ * `viewcells bake`'s), and vc_bake_with_config bakes with them, parsing nothing. Fields not
+ * here keep their defaults; the library decides the rest from the scene and budget (the
+ * report's settings.decided says what). */
+typedef struct vc_bake_config {
+  uint32_t cells;             /* budget: this many view cells ... */
+  uint64_t memory_bytes;      /* ... or a .pvs of at most this many bytes (exactly one of the two) */
+  int memory_of_lists;        /* non-zero: memory_bytes counts the coded lists alone */
+  uint64_t samples;           /* construction samples (default 1,000,000) */
+  uint64_t seed;              /* the same seed, the same file, for any number of threads */
+  double pixel_error;         /* stop AGVS at this estimated pixel error of 1024x1024 (0: none given) */
+  uint64_t agvs_samples;      /* stop AGVS after this many samples (0: none given) */
+  double holes;               /* stop once at most this share (0-1) of measuring frames shows a
+                                 wrong pixel (0: none) */
+  double time_seconds;        /* the whole bake's time limit (0: none) */
+  uint32_t near_samples;      /* rays per near-object candidate (0: none; default 2048) */
+  int play_space;             /* non-zero (default): cells where players stand, when the scene
+                                 has walkable floors */
+  int prove_hidden;           /* sort (cell, object) pairs into proven visible, hidden, undecided */
+  int conservative;           /* ship the undecided pairs too: no holes by construction */
+  double metres_per_unit;     /* 0 (default): the scene's unit taken as metres */
+  const double* start_points; /* x, y, z per start point, scene units (NULL: none) */
+  size_t start_point_count;
+} vc_bake_config;
+
+/* The library's defaults, with no budget: set cells or memory_bytes. */
+vc_bake_config vc_bake_config_default(void);
+
+/* As vc_bake, with `config` (non-NULL) instead of option words. */
+int vc_bake_with_config(const vc_bake_object* objects, size_t object_count, const vc_bake_config* config,
+                        const char* output, vc_bake_log log, void* user, vc_bake_result** out, char* error,
+                        size_t error_size);
+
 /* The baked .pvs file's bytes (as written to `output`), owned by the result. */
 const void* vc_bake_result_bytes(const vc_bake_result* result, size_t* size);
 /* The bake's report as JSON (what `viewcells bake --report` writes), owned by the result. */
