@@ -21,8 +21,10 @@
 #include "viewcells/io/scene_io.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
+#include "viewcells/q3/bsp_file.h"
 
 int main(int argc, char** argv) {
+  viewcells::register_q3_map_format();
   using Clock = std::chrono::steady_clock;
   if (argc < 3) {
     std::fprintf(stderr, "usage: %s SCENE FILE.vcells [SAMPLES] [REPEATS] [THREADS]\n", argv[0]);

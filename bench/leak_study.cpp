@@ -13,6 +13,7 @@
 #include "viewcells/core/rng.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/raycast/ray_caster.h"
+#include "viewcells/q3/bsp_file.h"
 
 using namespace viewcells;
 
@@ -81,6 +82,7 @@ std::vector<Ray> make_rays(const Scene& scene, const std::string& kind, size_t n
 }  // namespace
 
 int main(int argc, char** argv) {
+  viewcells::register_q3_map_format();
   if (argc != 6) {
     std::cerr << "usage: viewcells_leaks LEAK_SCENE SPEED_SCENE RAYS SPEED_RAYS OUT.json\n";
     return 2;

@@ -19,8 +19,10 @@
 #include "viewcells/core/error.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/merge/merge.h"
+#include "viewcells/q3/bsp_file.h"
 
 int main(int argc, char** argv) {
+  viewcells::register_q3_map_format();
   using Clock = std::chrono::steady_clock;
   if (argc < 3) {
     std::fprintf(stderr, "usage: %s SCENE FILE.vcells [REPEATS] [THREADS]\n", argv[0]);

@@ -34,6 +34,7 @@
 #include "viewcells/merge/merge.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
+#include "viewcells/q3/bsp_file.h"
 
 using namespace viewcells;
 
@@ -95,6 +96,7 @@ size_t block_count(const std::vector<int32_t>& block) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  viewcells::register_q3_map_format();
   if (argc < 6) {
     std::fprintf(stderr, "usage: %s SCENE SAMPLES CELLS EVAL_SAMPLES COUNT[,COUNT...] [VIEW_BOX|-] [SET2_SAMPLES]\n",
                  argv[0]);

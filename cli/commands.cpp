@@ -3,6 +3,8 @@
 // pvs_commands.cpp and compare_command.cpp.
 #include "commands.h"
 
+#include "viewcells/q3/bsp_file.h"
+
 #include <cstdlib>
 #include <iostream>
 
@@ -16,6 +18,7 @@
 namespace viewcells::cli {
 
 int run(int argc, char** argv) {
+  register_q3_map_format();  // the front end brings the formats the library leaves to adapters
   CLI::App app{
       "viewcells: builds view cells for visibility preprocessing from the visibility of the scene itself.\n"
       "Pipeline: generate or load a scene -> sample visibility segments -> subdivide the view space\n"

@@ -39,6 +39,7 @@
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pipeline/bake.h"
 #include "viewcells/pipeline/play.h"
+#include "viewcells/q3/bsp_file.h"
 #include "viewcells/pipeline/report.h"
 #include "viewcells/pvs/pvs.h"
 #include "viewcells/vis/level_view.h"
@@ -548,6 +549,7 @@ std::shared_ptr<Baked> read_baked(const py::object& pvs_path, const py::object& 
 }  // namespace
 
 PYBIND11_MODULE(viewcells, m) {
+  register_q3_map_format();  // the front end brings the Quake 3 maps (q3/bsp_file.h)
   m.doc() = "viewcells: view cells and potentially visible sets (PVS) for a scene, baked from Python";
   static py::exception<Error> error(m, "Error");
   py::register_exception_translator([](std::exception_ptr p) {

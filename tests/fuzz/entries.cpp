@@ -17,7 +17,7 @@
 #include "viewcells/cells/hierarchy_file.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/binary_file.h"
-#include "viewcells/io/q3bsp.h"
+#include "viewcells/q3/bsp_file.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pvs/pvs.h"
 #include "viewcells/bake.h"

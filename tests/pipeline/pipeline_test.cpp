@@ -4,16 +4,18 @@
 
 #include <cmath>
 #include <filesystem>
+#include <sstream>
 #include <nlohmann/json.hpp>
 
 #include "support/test_scenes.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/binary_file.h"
-#include "viewcells/io/q3bsp.h"
+#include "viewcells/q3/bsp_file.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pipeline/bake.h"
 #include "viewcells/pipeline/cut.h"
 #include "viewcells/pipeline/measure.h"
+#include "viewcells/pipeline/play.h"
 #include "viewcells/pipeline/pvs.h"
 #include "viewcells/pipeline/report.h"
 #include "viewcells/pipeline/sampling.h"
@@ -617,6 +619,74 @@ TEST(Pipeline, PvsStopsAtAMeasuredError) {
   c.measure_cameras = 16;
   c.measure_at = {5000};
   EXPECT_THROW(pipeline::compute_pvs(c, quiet), Error);
+}
+
+}  // namespace
+}  // namespace viewcells
+
+namespace viewcells {
+namespace {
+
+/// A level format the library does not know, brought by its front end (this test) as a Quake 3
+/// map's reader is brought by the command line: lines "box NAME X0 Y0 Z0 X1 Y1 Z1" and
+/// "start X Y Z", in metres.
+RawMesh read_boxes_level(const std::string& path) {
+  std::istringstream in(read_file_bytes(path));
+  RawMesh mesh;
+  std::string word;
+  int line = 0;
+  for (std::string text; std::getline(in, text);) {
+    ++line;
+    std::istringstream l(text);
+    if (!(l >> word)) continue;
+    if (word == "box") {
+      std::string name;
+      Vec3 lo, hi;
+      if (!(l >> name >> lo.x >> lo.y >> lo.z >> hi.x >> hi.y >> hi.z)) throw Error(path, line, "box NAME X0 Y0 Z0 X1 Y1 Z1");
+      test::add_cube(mesh, lo, hi, name);
+    } else if (word == "start") {
+      Vec3 p;
+      if (!(l >> p.x >> p.y >> p.z)) throw Error(path, line, "start X Y Z");
+      mesh.start_points.push_back(p);
+    } else {
+      throw Error(path, line, "unknown line '" + word + "'");
+    }
+  }
+  mesh.metres_per_unit = 1;
+  return mesh;
+}
+
+// A second level format without touching the pipeline: registered by its front end, a file of
+// it loads, and bake finds its play space from its start point as it would a glTF's spawn node.
+TEST(Pipeline, ALevelFormatRegisteredByItsFrontEndBakesThroughThePipeline) {
+  const std::string level = test::temp_path("room.vcboxes");
+  test::write_file(level,
+                   "box floor 0 0 -0.2 12 12 0\nbox pillar 5 5 0 6 6 3\nbox crate 2 8 0 2.8 8.8 0.8\n"
+                   "box wall 8 0 0 8.3 12 3\nstart 2 2 0.5\n");
+  EXPECT_THROW(load_scene(level), Error) << "an unregistered extension is an error";
+  register_scene_format({".vcboxes", "boxes level", read_boxes_level});
+  const Scene scene = load_scene(level);
+  EXPECT_EQ(scene.object_count(), 4u);
+  ASSERT_EQ(scene.start_points.size(), 1u);
+  pipeline::BakeConfig c;
+  c.scene.path = level;
+  c.cells = 4;
+  c.sampling.samples = 5000;
+  c.agvs.max_samples = 5000;
+  c.near.rays_per_object = 0;
+  c.sampling.show_progress = c.subdivision.show_progress = c.agvs.show_progress = false;
+  const pipeline::BakeResult r = pipeline::bake(c, [](const std::string&) {});
+  EXPECT_EQ(r.cells, 4u);
+  EXPECT_NE(r.view_space_choice.find("reachable from 1 of 1 start points"), std::string::npos) << r.view_space_choice;
+  // The wall at x = 8 to 8.3 cuts the room: walking from the start reaches the side x < 8 only,
+  // and the side beyond joins as a region within the 10 m margin; with only_from_starts it does not.
+  pipeline::SceneSource source = c.scene;
+  const pipeline::FoundPlaySpace joined = pipeline::find_play_space(source, [](const std::string&) {});
+  source.floors.only_from_starts = true;
+  const pipeline::FoundPlaySpace strict = pipeline::find_play_space(source, [](const std::string&) {});
+  ASSERT_TRUE(joined.space && strict.space);
+  EXPECT_NEAR(strict.space->floor_area(), 8 * 12 - 1 - 0.64, 3.0) << strict.why;
+  EXPECT_NEAR(joined.space->floor_area(), 8 * 12 - 1 - 0.64 + 3.7 * 12, 4.0) << joined.why;
 }
 
 }  // namespace

@@ -1,3 +1,4 @@
+#include "viewcells/q3/bsp_file.h"
 // The test binary's main: GoogleTest's own, plus --all-skipped-exit=N, which the ctest entries
 // pass (support/gtest_suites.cmake): when no test that ran passed and some were skipped (the
 // OpenArena maps not fetched), exit with N, which ctest reports as skipped. A failing test
@@ -8,6 +9,7 @@
 #include <cstring>
 
 int main(int argc, char** argv) {
+  viewcells::register_q3_map_format();  // the front end brings the Quake 3 maps
   testing::InitGoogleTest(&argc, argv);
   int all_skipped_exit = -1;
   constexpr const char* kFlag = "--all-skipped-exit=";

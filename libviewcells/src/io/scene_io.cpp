@@ -1,6 +1,7 @@
-// load_scene (io/scene_io.h): the reader a file's extension names (OBJ, PLY, OFF, STL, a Quake 3
-// map, or through Assimp glTF, FBX and the others), the coordinates checked, and the scene
-// made. The readers themselves live in obj_io.cpp, mesh_io.cpp, q3bsp.cpp and assimp_io.cpp.
+// load_scene (io/scene_io.h): the reader a file's extension names (OBJ, PLY, OFF, STL, through
+// Assimp glTF, FBX and the others, or a format a front end registered, such as a Quake 3 map),
+// the coordinates checked, and the scene made. The readers themselves live in obj_io.cpp,
+// mesh_io.cpp and assimp_io.cpp (and q3/bsp_file.cpp, registered).
 #include "viewcells/io/scene_io.h"
 
 #include <algorithm>
@@ -10,9 +11,32 @@
 
 #include "viewcells/core/binary_file.h"
 #include "viewcells/core/error.h"
-#include "viewcells/io/q3bsp.h"
+#include <map>
+#include <mutex>
 
 namespace viewcells {
+
+namespace {
+std::mutex formats_mutex;
+std::map<std::string, SceneFormat>& formats() {
+  static std::map<std::string, SceneFormat> f;
+  return f;
+}
+}  // namespace
+
+void register_scene_format(SceneFormat format) {
+  if (format.extension.empty() || format.extension[0] != '.' || !format.read)
+    throw Error("register_scene_format: an extension with its dot and a reader are needed");
+  const std::lock_guard<std::mutex> lock(formats_mutex);
+  std::string ext = format.extension;
+  formats()[ext] = std::move(format);
+}
+
+const SceneFormat* registered_scene_format(const std::string& path) {
+  const std::lock_guard<std::mutex> lock(formats_mutex);
+  const auto it = formats().find(lower_extension(path));
+  return it == formats().end() ? nullptr : &it->second;
+}
 
 Scene load_scene(const std::string& path, ObjectGrouping grouping) {
   std::error_code ec;
@@ -44,11 +68,11 @@ Scene load_scene(const std::string& path, ObjectGrouping grouping) {
     mesh = read_off(read_file_bytes(path), path);
   } else if (ext == ".stl") {
     mesh = read_stl(read_file_bytes(path), path);
+  } else if (const SceneFormat* registered = registered_scene_format(path)) {
+    mesh = registered->read(path);
   } else if (ext == ".bsp") {
-    // Quake 3 maps: the world's opaque surfaces, the sky and the solid brushes that close it
-    // (neither rendered), patches at level 4.
-    mesh = q3_world_mesh(read_q3bsp(path));
-    mesh.metres_per_unit = 1.0 / 32;  // its 56-unit player 1.75 m tall
+    throw Error(path, 0, "a Quake 3 map, but no reader for .bsp was registered (a front end calls "
+                         "register_q3_map_format(), q3/bsp_file.h)");
   } else {
     throw Error(path, 0, "unknown scene format '" + ext +
                              "' (expected .obj, .ply, .off, .stl, .bsp, or through Assimp .gltf, .glb, .fbx, .dae, "

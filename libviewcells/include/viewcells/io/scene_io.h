@@ -23,6 +23,20 @@ namespace viewcells {
 /// kNodes and kMeshes apply to the Assimp formats only (for them kAuto and kGroups mean kNodes).
 Scene load_scene(const std::string& path, ObjectGrouping grouping = ObjectGrouping::kAuto);
 
+/// A scene format the readers below do not know, brought by a front end (the command line, the
+/// Python module, a test): a Quake 3 map's reader lives with the rest of the map's code
+/// (q3/bsp_file.h: register_q3_map_format()). load_scene reads a file whose extension
+/// (lowercase, with the dot) is registered with `read`.
+struct SceneFormat {
+  std::string extension;  ///< ".bsp"
+  std::string name;       ///< for messages: "Quake 3 map"
+  std::function<RawMesh(const std::string& path)> read;
+};
+/// Registers `format` (again: replaces the one of the same extension). Thread-safe.
+void register_scene_format(SceneFormat format);
+/// The registered format of `path`'s extension, or null.
+const SceneFormat* registered_scene_format(const std::string& path);
+
 /// The extension of `path` in lower case, with its dot ("" when it has none).
 inline std::string lower_extension(const std::string& path) {
   std::string ext = std::filesystem::path(path).extension().string();

@@ -4,7 +4,7 @@
 #include <optional>
 #include <string>
 
-#include "viewcells/io/q3bsp.h"
+#include "viewcells/q3/bsp_file.h"
 #include "viewcells/pipeline/sampling.h"
 
 namespace viewcells::pipeline {

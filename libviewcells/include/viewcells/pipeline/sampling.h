@@ -13,7 +13,7 @@
 #include "viewcells/hidden/hidden_space.h"
 #include "viewcells/viewspace/floor_space.h"
 #include "viewcells/viewspace/view_space.h"
-#include "viewcells/io/q3bsp.h"
+#include "viewcells/q3/bsp_file.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
 #include "viewcells/scene/scene.h"

@@ -5,7 +5,7 @@
 #include <memory>
 
 #include "viewcells/hidden/hidden_space.h"
-#include "viewcells/io/q3bsp.h"
+#include "viewcells/q3/bsp_file.h"
 
 namespace viewcells {
 

@@ -6,7 +6,7 @@
 #include <memory>
 
 #include "viewcells/viewspace/view_space.h"
-#include "viewcells/io/q3bsp.h"
+#include "viewcells/q3/bsp_file.h"
 
 namespace viewcells {
 

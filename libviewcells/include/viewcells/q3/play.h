@@ -9,7 +9,7 @@
 
 #include "viewcells/eval/frames.h"
 #include "viewcells/viewspace/view_space.h"
-#include "viewcells/io/q3bsp.h"
+#include "viewcells/q3/bsp_file.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/scene/scene.h"
 #include "viewcells/viewspace/floor_space.h"

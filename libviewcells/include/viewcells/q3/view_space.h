@@ -10,7 +10,7 @@
 
 #include "viewcells/scene/cost_model.h"
 #include "viewcells/bsp/subdivision.h"
-#include "viewcells/io/q3bsp.h"
+#include "viewcells/q3/bsp_file.h"
 #include "viewcells/scene/scene.h"
 
 namespace viewcells {

@@ -6,7 +6,7 @@
 #include <fstream>
 
 #include "viewcells/core/error.h"
-#include "viewcells/io/q3bsp.h"
+#include "viewcells/q3/bsp_file.h"
 #include "viewcells/io/scene_io.h"
 
 namespace viewcells {
