@@ -3,6 +3,7 @@
 
 #include "options.h"
 #include "viewcells/core/parallel.h"
+#include "viewcells/q3/level.h"
 #include "viewcells/studies/compare.h"
 
 namespace viewcells::cli {
@@ -27,7 +28,7 @@ int run_compare(const CompareArgs& a, const Common& c) {
   ThreadLimit threads(c.threads);
   studies::CompareRunConfig config = a.bound;
   config.scene = a.sampling.source();
-  if (a.methods_given || !pipeline::is_q3_map(a.sampling.scene)) config.methods = split_list(a.methods);
+  if (a.methods_given || !is_q3_map(a.sampling.scene)) config.methods = split_list(a.methods);
   config.max_cells = a.max_cells_given ? a.max_cells : 0;
   config.construction = a.sampling.sampler(c);
   config.merge_agvs = a.merge.agvs(c, config.construction.seed, config.construction.samples);

@@ -2,6 +2,7 @@
 #include <iostream>
 
 #include "options.h"
+#include "viewcells/q3/level.h"
 #include "viewcells/core/isa.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
@@ -49,7 +50,7 @@ int run_convert(const ConvertArgs& a, const Common& c) {
   if (lower_extension(a.output) != ".glb") throw Error(a.output, 0, "convert writes binary glTF: give a .glb output");
   Stopwatch sw;
   const Scene scene = load_scene(a.scene, parse_grouping(a.objects));
-  const bool map = pipeline::is_q3_map(a.scene);
+  const bool map = is_q3_map(a.scene);
   SceneGltfOptions options;
   options.metres_per_unit = a.metres_per_unit > 0 ? a.metres_per_unit
                             : scene.metres_per_unit > 0 ? scene.metres_per_unit : 1.0;
@@ -100,22 +101,13 @@ struct InfoArgs {
   std::string json_path;
 };
 
-void print_map(const pipeline::MapInfo& m) {
-  const Q3Map& map = m.map;
-  const Q3MeshStats& st = m.mesh;
-  std::cout << "quake 3 map:        IBSP version " << map.version << ", " << map.shaders.size() << " shaders, "
-            << map.nodes.size() << " nodes, " << map.leaves.size() << " leaves (" << m.solid_leaves << " solid)\n"
-            << "world surfaces:     " << st.surfaces[0] << " opaque, " << st.surfaces[1]
-            << " sky (they close the map for rays but are not rendered: no render cost), " << st.surfaces[2]
-            << " water/fog/translucent (rendered, seen through: they stop no ray), " << st.surfaces[3]
-            << " nodraw/hint/skip/flare (left out); " << st.patches << " patches tessellated at level 4\n"
-            << "solid brushes:      " << st.brush_hulls << " of " << map.world_brush_count
-            << " as hulls 0.5 units inside their sides (occlude, not rendered)\n"
-            << "visibility:         "
-            << (map.has_visibility() ? std::to_string(map.cluster_count) + " clusters, rows of " +
-                                           std::to_string(map.cluster_bytes) + " bytes (q3map2's PVS)"
-                                     : std::string("none (the map was not vis-compiled)"))
-            << "\nspawn points:       " << st.spawn_points << '\n';
+/// What a level file brings besides its triangles, as "label: text" lines.
+void print_level(const LevelData& level) {
+  for (const auto& [label, text] : level.info_lines()) {
+    std::string head = label + ":";
+    head.resize(std::max<size_t>(head.size() + 1, 20), ' ');
+    std::cout << head << text << '\n';
+  }
 }
 
 int run_info(const InfoArgs& a, const Common& c) {
@@ -132,7 +124,7 @@ int run_info(const InfoArgs& a, const Common& c) {
             << "empty space detect: " << info.empty_space.reason << '\n'
             << "non-axis-aligned:   " << fmt(100.0 * scene.non_axis_aligned_share(), 2) << "% of "
             << fmt(scene.surface_area, 1) << " surface area\n";
-  if (info.map) print_map(*info.map);
+  if (info.level) print_level(*info.level);
   if (a.list) {
     std::cout << "\n#id\ttriangles\tclosed\toriented\tsolid\trendered\toccluder\tname\n";
     for (size_t i = 0; i < scene.objects.size(); ++i) {

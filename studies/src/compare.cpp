@@ -12,6 +12,7 @@
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/binary_file.h"
 #include "viewcells/pipeline/report.h"
+#include "viewcells/q3/level.h"
 
 namespace viewcells::studies {
 
@@ -201,9 +202,9 @@ CompareRunResult compare(const CompareRunConfig& c, const Log& log) {
   for (const std::string& m : config.methods) method_list += (method_list.empty() ? "" : ",") + m;
   if (with_q3) {
     method_list += ",q3-clusters";
-    if (!out.loaded.map->has_visibility())
+    if (!q3_map_of(out.loaded.level.get())->has_visibility())
       throw Error(c.scene.path, 0, "the map has no visibility data: there are no q3map2 clusters to compare with");
-    if (config.max_cells == 0) config.max_cells = 3 * static_cast<uint32_t>(out.loaded.map->cluster_count);
+    if (config.max_cells == 0) config.max_cells = 3 * static_cast<uint32_t>(q3_map_of(out.loaded.level.get())->cluster_count);
   }
   // The scene's view space (on a map its non-solid space), for both samplers and the cells' weights.
   out.loaded.view_space->restrict(config.construction);
@@ -217,7 +218,7 @@ CompareRunResult compare(const CompareRunConfig& c, const Log& log) {
       std::to_string(config.construction.seed) + "), " + std::to_string(config.evaluation.samples) +
       " evaluation samples (seed " + std::to_string(config.evaluation.seed) + "); view space " +
       out.loaded.view_space->describe());
-  if (with_q3) out.q3 = compare_with_q3map2(*out.loaded.scene, *out.loaded.map, *out.loaded.caster, config);
+  if (with_q3) out.q3 = compare_with_q3map2(*out.loaded.scene, *q3_map_of(out.loaded.level.get()), *out.loaded.caster, config);
   else out.plain = compare_methods(*out.loaded.scene, *out.loaded.caster, config);
   write_curves(out, c.output_dir + "/curves.csv");
   write_histograms(out.comparison(), c.output_dir + "/histogram.csv");

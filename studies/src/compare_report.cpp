@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "pipeline/report_parts.h"
+#include "viewcells/q3/level.h"
 #include "viewcells/studies/compare.h"
 
 namespace viewcells::studies {
@@ -108,7 +109,7 @@ std::string report_json(const CompareRunResult& r) {
         {"construction_sampling_seconds", cmp.construction.seconds},
         {"evaluation_sampling_seconds", cmp.evaluation.seconds},
         {"evaluation_seconds", cmp.evaluation_seconds}}}};
-  if (r.q3) summary["q3map2"] = q3_summary(*r.q3, *r.loaded.map);
+  if (r.q3) summary["q3map2"] = q3_summary(*r.q3, *q3_map_of(r.loaded.level.get()));
   return text(summary);
 }
 

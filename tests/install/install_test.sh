@@ -16,7 +16,7 @@ test -f "$work/prefix/lib/cmake/viewcells/viewcellsConfig.cmake"
 test -f "$work/prefix/include/viewcells/runtime.h"
 # The stable headers are installed, the internals no stable header needs are not.
 test -f "$work/prefix/include/viewcells/pipeline/bake.h"
-for internal in core/parallel.h core/progress.h core/ranks.h vis/level_view.h; do
+for internal in core/parallel.h core/progress.h core/ranks.h vis/level_view.h q3/play.h q3/level.h; do
   if [ -e "$work/prefix/include/viewcells/$internal" ]; then echo "FAIL: installed an internal header, $internal"; exit 1; fi
 done
 cmake -S "$src/examples/consumer" -B "$work/consumer" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" \
@@ -41,6 +41,9 @@ if "$work/consumer/pvs_lookup" "$work/office.obj" 0 0 0 2>"$work/err"; then echo
 grep -q "office.obj" "$work/err"
 # The toolkit component links and runs too.
 "$work/consumer/scene_stats" "$work/office.obj" | grep -q "triangles"
+# ... and reads a Quake 3 map, whose reader it registers as a front end does.
+map="$src/data/maps/bsp/oa_dm2.bsp"
+if [ -f "$map" ]; then "$work/consumer/scene_stats" "$map" | grep -q "triangles"; fi
 # A procedural level baked in memory, from C++ (bake_in_memory) and from C (bake_c: vc_bake, then
 # vc_pvs_open_memory): 9 cells for 3 x 3 rooms, a cell for every room's middle (the corner rooms
 # see fewer than all the objects), and nothing written where it ran.

@@ -19,6 +19,7 @@
 #include "viewcells/pipeline/pvs.h"
 #include "viewcells/pipeline/report.h"
 #include "viewcells/pipeline/sampling.h"
+#include "viewcells/q3/level.h"
 #include "viewcells/q3/play.h"
 #include "viewcells/q3/view_space.h"
 #include "viewcells/core/rng.h"
@@ -170,7 +171,7 @@ TEST(Pipeline, PlaySpaceWeighsCellsWherePlayersAreAndAgvsDrawsThere) {
   EXPECT_TRUE(j["effects"]["viewpoint_density"]["enabled"]) << j["effects"].dump();
   // Each cell weighs its volume in the play space's leaves: in all, the play space's volume.
   pipeline::LoadedScene& loaded = r.sampling.loaded;
-  const PlaySpace play = q3_play_space(*loaded.map, *loaded.scene, *loaded.caster, PlaySpaceConfig{});
+  const PlaySpace play = q3_play_space(*q3_map_of(loaded.level.get()), *loaded.scene, *loaded.caster, PlaySpaceConfig{});
   // The build kept the play space it found, for AGVS to share (a bake finds it once).
   const std::shared_ptr<const ViewSpace> found = pipeline::play_view_space(loaded);
   EXPECT_EQ(found->viewpoint_rule(), play.rule);
@@ -185,7 +186,7 @@ TEST(Pipeline, PlaySpaceWeighsCellsWherePlayersAreAndAgvsDrawsThere) {
   pipeline::play_view_space(loaded)->restrict(a);
   ASSERT_TRUE(a.view_point_map && a.view_space);
   EXPECT_EQ(pipeline::play_view_space(loaded), found) << "the play space was found again";
-  const Q3Map& map = *loaded.map;
+  const Q3Map& map = *q3_map_of(loaded.level.get());
   const Subdivision q3 = q3_subdivision(map, q3_view_box(map));
   const size_t inner = map.nodes.size();
   double west_volume = 0;

@@ -61,6 +61,18 @@ class CheckLayers(unittest.TestCase):
         self.assertEqual(r.returncode, 1)
         self.assertIn("directory stray belongs to no layer", r.stdout)
 
+    def test_the_pipeline_may_not_include_quake3(self):
+        """Quake 3 is an adapter beside the pipeline: the library's own layers refuse an include
+        of q3/ from pipeline/ (a copy of the library with one such include added fails)."""
+        import shutil
+        root = tempfile.mkdtemp()
+        shutil.copytree(LIBRARY, os.path.join(root, "lib"), ignore=shutil.ignore_patterns("*.o"))
+        with open(os.path.join(root, "lib", "src", "pipeline", "bake.cpp"), "a") as f:
+            f.write('#include "viewcells/q3/level.h"\n')
+        r = check(os.path.join(root, "lib"))
+        self.assertEqual(r.returncode, 1, r.stdout)
+        self.assertIn("layer pipeline includes viewcells/q3/level.h of layer q3", r.stdout)
+
     def test_the_library_passes(self):
         r = check(LIBRARY)
         self.assertEqual(r.returncode, 0, r.stdout)

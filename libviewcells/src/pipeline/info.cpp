@@ -1,4 +1,4 @@
-/// `viewcells info`: what a scene file holds, and on a Quake 3 map what the map brings besides.
+/// `viewcells info`: what a scene file holds, and on a level file what it brings besides.
 #include "viewcells/pipeline/info.h"
 
 #include "viewcells/io/scene_io.h"
@@ -13,14 +13,7 @@ SceneInfo scene_info(const std::string& path, ObjectGrouping grouping) {
     info.closed_objects += o.closed;
     info.solid_objects += o.solid();
   }
-  if (is_q3_map(path)) {
-    // What the Quake 3 map itself holds besides the geometry.
-    MapInfo m;
-    m.map = read_q3bsp(path);
-    q3_world_mesh(m.map, {}, &m.mesh);
-    for (const Q3Leaf& l : m.map.leaves) m.solid_leaves += l.cluster < 0;
-    info.map = std::move(m);
-  }
+  info.level = read_level_data(path);  // what the file brings besides the geometry
   return info;
 }
 

@@ -16,7 +16,6 @@
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/pvs/pvs.h"
-#include "viewcells/q3/view_space.h"
 
 namespace viewcells::pipeline {
 
@@ -158,14 +157,15 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
   MeasureResult out;
   out.config = c;
   out.threads = worker_threads();
-  const bool map_scene = is_q3_map(c.scene.path);
-  if (c.pvs_path.empty() && !map_scene)
-    throw Error("measure needs a .pvs file to measure (only a Quake 3 map brings its own PVS)");
+  if (c.pvs_path.empty() && (c.scene.scene || !is_level_file(c.scene.path)))
+    throw Error("measure needs a .pvs file to measure (only a level that brings its own PVS, such as a Quake 3 map, "
+                "is measured without one)");
 
   LoadedScene loaded = load_scene_for_rays(c.scene, log);
   loaded.view_space->check_cameras(c.cameras);  // before the PVS is read
   const Scene& scene = *loaded.scene;
   Measured m;
+  std::shared_ptr<const OwnPvs> own;  // the level's own PVS, when measured without a .pvs
   if (!c.pvs_path.empty()) {
     PvsFile f = read_pvs(c.pvs_path);
     if (f.object_count != scene.object_count() || (f.scene_fingerprint && f.scene_fingerprint != scene.fingerprint()))
@@ -180,16 +180,14 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
     const CellLocator* loc = m.locator.get();
     m.cell_at = [loc](const Vec3& p) { return loc->cell_at(p); };
   } else {
-    const Q3Map& map = *loaded.map;
-    if (!map.has_visibility())
-      throw Error(c.scene.path, 0, "the map has no visibility data: give a .pvs file to measure");
-    m.pvs = GlobalPvs::from_lists(static_cast<uint32_t>(scene.object_count()), q3_admitted_objects(scene, map));
-    out.storage_bytes = out.pvs_bytes = uint64_t(map.cluster_count) * uint64_t(map.cluster_bytes);
-    out.leaf_surface_bytes = map.leaf_surfaces.size() * sizeof(int32_t);
-    out.measured = "the map's own PVS (q3map2's vis rows: " + std::to_string(map.cluster_count) +
-                   " clusters -> their leaves -> their surfaces)";
-    const Q3Map* mp = &map;
-    m.cell_at = [mp](const Vec3& p) { return mp->leaves[mp->leaf_at(p)].cluster; };
+    if (!loaded.level || !loaded.level->brings_pvs())
+      throw Error(c.scene.path, 0, "brings no PVS of its own: give a .pvs file to measure");
+    own = loaded.level->own_pvs(scene);
+    m.pvs = GlobalPvs::from_lists(static_cast<uint32_t>(scene.object_count()), own->cells);
+    out.storage_bytes = out.pvs_bytes = own->bytes;
+    out.leaf_surface_bytes = own->extra_bytes;
+    out.measured = own->what;
+    m.cell_at = own->cell_at;
   }
   out.cells = m.pvs.cell_count();
   out.objects = m.pvs.object_count();
@@ -240,21 +238,9 @@ MeasureResult measure(const MeasureConfig& c, const Log& log) {
     pixels[w.object] += w.pixels;
     ++seen_by[w.object];
   }
-  if (c.pvs_path.empty()) {
-    const Q3Map& map = *loaded.map;
-    const std::vector<int32_t> surface = q3_object_surfaces(scene, map);
-    std::vector<bool> listed(map.surfaces.size(), false);
-    for (const Q3Leaf& l : map.leaves)
-      if (l.cluster >= 0)
-        for (int32_t k = 0; k < l.surface_count; ++k) listed[map.leaf_surfaces[l.first_surface + k]] = true;
-    const double far = q3_far_plane(map);
+  if (own && own->cause) {
     for (const WrongView& w : out.error.wrong) {
-      const Box3& b = scene.objects[w.object].bounds;
-      const Vec3& e = cameras[w.camera].eye;
-      const Vec3 nearest{std::clamp(e.x, b.lo.x, b.hi.x), std::clamp(e.y, b.lo.y, b.hi.y), std::clamp(e.z, b.lo.z, b.hi.z)};
-      const std::string why = !listed[surface[w.object]]              ? "unlisted"
-                              : far > 0 && length(nearest - e) > far ? "far"
-                                                                      : "rejected";
+      const std::string why = own->cause(w.object, cameras[w.camera].eye);
       out.wrong_by_cause[why] += w.pixels;
       cause[w.object] = why;
     }

@@ -9,7 +9,6 @@
 #include "viewcells/core/isa.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/io/scene_io.h"
-#include "viewcells/q3/play.h"
 #include "viewcells/vis/cell_views.h"
 #include "viewcells/vis/level_view.h"
 
@@ -46,23 +45,23 @@ PlaySpaceRun play_space(const PlaySpaceRunConfig& config, const Log& log) {
   SceneSource map_source;
   map_source.path = config.map;
   const LoadedScene map_scene = load_scene_for_rays(map_source, log);
-  if (!map_scene.map) throw Error(config.map, 0, "--map takes a Quake 3 map (.bsp)");
-  const Q3Map& map = *map_scene.map;
-  const PlaySpace play = q3_play_space(map, *map_scene.scene, *map_scene.caster, viewcells::PlaySpaceConfig{});
+  if (!map_scene.level || !map_scene.level->view_space())
+    throw Error(config.map, 0, "--map takes a level that knows its own play space (a Quake 3 map, .bsp)");
   // The found space's units per map unit: the converted level's vertices are the map's times this.
   const double map_mpu = map_scene.scene->metres_per_unit;
   const double scale = map_mpu / k;
-  const PlaySpaceOverlap o = q3_play_space_overlap(map, *map_scene.scene, *map_scene.caster, play, found, scale,
-                                                   config.points, config.seed, config.image.empty() ? 0 : config.image_width);
+  const PlaySpaceComparison o =
+      map_scene.level->compare_play_space(*map_scene.scene, *map_scene.caster, found, scale, config.points, config.seed,
+                                          config.image.empty() ? 0 : config.image_width);
   PlaySpaceRun::Overlap r;
   const double m3 = map_mpu * map_mpu * map_mpu;
-  r.map_m3 = o.map_volume * m3;
+  r.map_m3 = o.reference_volume * m3;
   r.found_m3 = o.found_volume * m3;
   r.both_m3 = o.both_volume * m3;
   r.coverage = o.coverage();
   r.excess = o.excess();
   r.points = o.points;
-  r.map_rule = play.rule;
+  r.map_rule = o.reference_rule;
   r.seconds = sw.seconds();
   out.overlap = r;
   log("viewcells: against " + config.map + "'s play space (" + fmt(r.map_m3, 1) + " m^3 of eye band): covers " +
@@ -77,15 +76,19 @@ PlaySpaceRun play_space(const PlaySpaceRunConfig& config, const Log& log) {
 }
 
 namespace {
-constexpr const char* kMapPlaySpace =
-    "not drawn: a Quake 3 map's play space is the BSP leaves a player's eye reaches, not found from floors";
+/// Why a level that knows its own view space gets no play space from floors.
+std::string level_play_space(const LevelData& level) {
+  return "not drawn: a " + level.kind() + "'s play space is its own (" +
+         (level.view_space() ? level.view_space()->describe() : std::string("its view space")) +
+         "), not found from floors";
+}
 }  // namespace
 
 FoundPlaySpace find_play_space(const SceneSource& source, const Log& log) {
   FoundPlaySpace out;
   out.loaded = load_scene_for_rays(source, log);
-  if (out.loaded.map) {
-    out.why = kMapPlaySpace;
+  if (out.loaded.level && out.loaded.level->view_space()) {
+    out.why = level_play_space(*out.loaded.level);
     return out;
   }
   auto space = std::make_shared<FloorSpace>(find_floor_space(*out.loaded.scene, *out.loaded.caster, source.floors));
@@ -110,9 +113,12 @@ GroupedMesh floor_mesh(const FloorSpace& space, double lift_m) {
 }
 
 void add_play_space(LevelView& view, const SceneSource& source, const Log& log) {
-  if (!source.scene && is_q3_map(source.path)) {
-    view.play_space_rule = kMapPlaySpace;
-    return;
+  if (!source.scene && is_level_file(source.path)) {
+    const std::shared_ptr<const LevelData> level = read_level_data(source.path);
+    if (level && level->view_space()) {
+      view.play_space_rule = level_play_space(*level);
+      return;
+    }
   }
   const FoundPlaySpace found = find_play_space(source, log);
   view.play_space_rule = found.why;

@@ -310,7 +310,7 @@ PvsResult compute_pvs(const PvsConfig& c, const Log& log) {
       to_string(c.agvs.method) + " until " + describe_stop(c) + ", on " + workers_text());
   // AGVS's points are drawn in the scene's view space (on a Quake 3 map its non-solid space),
   // and cameras stand where it places them (on a map, where players do).
-  const std::shared_ptr<const ViewSpace> space = view_space_of(map_of(c.scene_path));
+  const std::shared_ptr<const ViewSpace> space = view_space_of(read_level_data(c.scene_path));
   space->restrict(out.agvs);
   // The file's cells cover every point where a viewer can be (ViewSpace::covered_box): the
   // cameras are located in them as an engine would.

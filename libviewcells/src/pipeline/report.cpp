@@ -29,7 +29,7 @@ std::string report_json(const SceneInfo& info) {
                        {"oriented", o.oriented},
                        {"solid", o.solid()}});
   j["object_list"] = std::move(objects);
-  if (info.map) j["quake3"] = map_summary(*info.map);
+  if (info.level) j[info.level->info_key()] = json::parse(info.level->info_json());
   return text(j);
 }
 

@@ -54,19 +54,6 @@ json scene_summary(const Scene& s) {
           {"non_axis_aligned_area_share", s.non_axis_aligned_share()}};
 }
 
-json map_summary(const MapInfo& m) {
-  const Q3MeshStats& st = m.mesh;
-  return {{"version", m.map.version},
-          {"leaves", m.map.leaves.size()},
-          {"solid_leaves", m.solid_leaves},
-          {"surfaces", {{"opaque", st.surfaces[0]}, {"sky", st.surfaces[1]}, {"non_occluding", st.surfaces[2]},
-                        {"skipped", st.surfaces[3]}, {"patches", st.patches}}},
-          {"brush_hulls", st.brush_hulls},
-          {"clusters", m.map.cluster_count},
-          {"cluster_row_bytes", m.map.cluster_bytes},
-          {"spawn_points", st.spawn_points}};
-}
-
 json sampling_effects(const SamplingRun& s) {
   const SamplingStats& st = s.result.stats;
   const bool robust = s.loaded.source.robust;

@@ -28,8 +28,6 @@ std::string text(json j);
 
 json scene_summary(const Scene& s);
 
-json map_summary(const MapInfo& m);
-
 json sampling_effects(const SamplingRun& s);
 
 json sampling_counts(const SamplingRun& s);

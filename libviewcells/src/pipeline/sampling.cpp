@@ -2,39 +2,26 @@
 /// sample visibility segments (paper 4.1).
 #include "viewcells/pipeline/sampling.h"
 
-#include <cctype>
-#include <filesystem>
 
 #include "viewcells/core/format.h"
 #include "viewcells/core/error.h"
 #include "viewcells/core/parallel.h"
 #include "viewcells/core/progress.h"
 #include "viewcells/io/scene_io.h"
-#include "viewcells/q3/hidden.h"
-#include "viewcells/q3/map_view_space.h"
 #include "viewcells/sampling/segments.h"
 #include "viewcells/viewspace/floor_space.h"
 
 namespace viewcells::pipeline {
 
-bool is_q3_map(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  return ext == ".bsp";
-}
-
-std::shared_ptr<const Q3Map> map_of(const std::string& path) {
-  return is_q3_map(path) ? std::make_shared<const Q3Map>(read_q3bsp(path)) : nullptr;
-}
-
-std::shared_ptr<const ViewSpace> view_space_of(const std::shared_ptr<const Q3Map>& map,
+std::shared_ptr<const ViewSpace> view_space_of(const std::shared_ptr<const LevelData>& level,
                                               const FloorSpaceConfig& floors) {
-  return map ? q3_map_view_space(map) : mesh_view_space(floors);
+  std::shared_ptr<const ViewSpace> own = level ? level->view_space() : nullptr;
+  return own ? own : mesh_view_space(floors);
 }
 
 std::shared_ptr<const HiddenSpace> hidden_space_of(const LoadedScene& loaded, std::string& why) {
   why.clear();
-  if (loaded.map) return q3_hidden_space(*loaded.map, *loaded.scene);
+  if (loaded.level) return loaded.level->hidden_space(*loaded.scene, why);
   return solid_objects_hidden_space(*loaded.scene, why);
 }
 
@@ -47,9 +34,9 @@ LoadedScene load_scene_for_rays(const SceneSource& source, const Log& log) {
     out.scene = std::make_unique<const Scene>(*source.scene);
   } else {
     out.scene = std::make_unique<const Scene>(load_scene(source.path, source.grouping));
-    out.map = map_of(source.path);
+    out.level = read_level_data(source.path);
   }
-  out.view_space = view_space_of(out.map, source.floors);
+  out.view_space = view_space_of(out.level, source.floors);
   out.load_seconds = sw.seconds();
   log("viewcells: " + source.path + ": " + std::to_string(out.scene->object_count()) + " objects, " +
       std::to_string(out.scene->triangle_count()) + " triangles, loaded in " + fmt(out.load_seconds, 2) + " s");

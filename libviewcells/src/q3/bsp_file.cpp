@@ -3,8 +3,6 @@
 // leafs 4, leafsurfaces 5, models 7, drawverts 10, drawindexes 11, surfaces 13, visibility 16.
 #include "viewcells/q3/bsp_file.h"
 
-#include "viewcells/io/scene_io.h"
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -508,12 +506,5 @@ std::vector<Vec3> q3_spawn_points(const Q3Map& map) {
   return out;
 }
 
-void register_q3_map_format() {
-  register_scene_format({".bsp", "Quake 3 map", [](const std::string& path) {
-                           RawMesh mesh = q3_world_mesh(read_q3bsp(path));
-                           mesh.metres_per_unit = 1.0 / 32;  // its 56-unit player 1.75 m tall
-                           return mesh;
-                         }});
-}
 
 }  // namespace viewcells

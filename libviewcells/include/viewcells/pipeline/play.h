@@ -1,7 +1,7 @@
 #pragma once
 /// `viewcells play-space`: the play space found from a scene's floors (viewspace/floor_space.h),
 /// to look at (a top-down picture) and, for a level converted from a Quake 3 map, to check
-/// against the map's own play space (q3/play.h).
+/// against the map's own play space (level/level.h: LevelData::compare_play_space).
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -54,7 +54,7 @@ PlaySpaceRun play_space(const PlaySpaceRunConfig& config, const Log& log);
 
 /// A play space found from a scene's floors (as bake finds it), with the scene and ray caster
 /// it refers to kept alive. A Quake 3 map gets none here: its play space is its BSP's leaves
-/// (q3/play.h); `space` is then null and `why` says so, as it does when no floor is found.
+/// (its level's view space); `space` is then null and `why` says so, as when no floor is found.
 struct FoundPlaySpace {
   LoadedScene loaded;
   std::shared_ptr<const FloorSpace> space;  ///< null when none was found

@@ -13,7 +13,7 @@
 #include "viewcells/hidden/hidden_space.h"
 #include "viewcells/viewspace/floor_space.h"
 #include "viewcells/viewspace/view_space.h"
-#include "viewcells/q3/bsp_file.h"
+#include "viewcells/level/level.h"
 #include "viewcells/raycast/ray_caster.h"
 #include "viewcells/sampling/sampler.h"
 #include "viewcells/scene/scene.h"
@@ -35,15 +35,10 @@ struct SceneSource {
   FloorSpaceConfig floors;
 };
 
-/// True for a Quake 3 map (.bsp).
-bool is_q3_map(const std::string& path);
-
-/// What a scene file brings besides its geometry: its Quake 3 map (.bsp; null for other files).
-std::shared_ptr<const Q3Map> map_of(const std::string& path);
-/// The view space a scene brings (viewspace/view_space.h): a Quake 3 map's (`map` not null), else
-/// the whole view box with a play space found from the scene's floors when asked
-/// (viewspace/floor_space.h). The one place that picks a view space by the kind of scene.
-std::shared_ptr<const ViewSpace> view_space_of(const std::shared_ptr<const Q3Map>& map,
+/// The view space a scene brings (viewspace/view_space.h): its level's (`level` not null and
+/// knowing one, as a Quake 3 map does), else the whole view box with a play space found from the
+/// scene's floors when asked (viewspace/floor_space.h). The one place that picks a view space.
+std::shared_ptr<const ViewSpace> view_space_of(const std::shared_ptr<const LevelData>& level,
                                               const FloorSpaceConfig& floors = {});
 
 /// A scene ready for rays. The scene is held by pointer: the caster refers to it, so it must
@@ -52,14 +47,16 @@ struct LoadedScene {
   SceneSource source;
   std::unique_ptr<const Scene> scene;
   std::unique_ptr<RayCaster> caster;
-  std::shared_ptr<const Q3Map> map;  ///< the Quake 3 map, when the scene is one
+  /// What the scene file brings besides its triangles (level/level.h: a Quake 3 map's BSP and
+  /// PVS), when its format is a registered level format; null otherwise.
+  std::shared_ptr<const LevelData> level;
   /// Where viewpoints can be (view_space_of): the pipeline asks it, never the kind of scene. It
   /// keeps its play space once found, so that the division, merging and AGVS of one bake share it.
   std::shared_ptr<const ViewSpace> view_space = box_view_space();
   double load_seconds = 0, bvh_seconds = 0;
 };
 
-/// What the scene can prove hidden (hidden/hidden_space.h): a Quake 3 map's BSP, else the
+/// What the scene can prove hidden (hidden/hidden_space.h): its level's (a Quake 3 map's BSP), else the
 /// scene's closed convex solids; null, with the reason in `why`, when it can prove nothing.
 std::shared_ptr<const HiddenSpace> hidden_space_of(const LoadedScene& loaded, std::string& why);
 

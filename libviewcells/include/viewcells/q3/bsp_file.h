@@ -131,10 +131,10 @@ struct Q3MeshOptions {
 /// "solid brushes" of the brush hulls.
 RawMesh q3_world_mesh(const Q3Map& map, const Q3MeshOptions& options = {}, Q3MeshStats* stats = nullptr);
 
-/// Registers the .bsp reader with load_scene (io/scene_io.h: register_scene_format): the world's
-/// opaque surfaces, the sky and the solid brushes that close it (neither rendered), patches at
-/// level 4, one unit 1/32 m (a 56-unit player 1.75 m tall). Front ends call it once; again
-/// changes nothing.
+/// Registers Quake 3 maps: the .bsp reader with load_scene (io/scene_io.h: the world's opaque
+/// surfaces, the sky and the solid brushes that close it, neither rendered; patches at level 4;
+/// one unit 1/32 m, a 56-unit player 1.75 m tall), and the map as a level (level/level.h,
+/// q3/level.h). Front ends call it once; again changes nothing. Defined in q3/level.cpp.
 void register_q3_map_format();
 
 /// The worldspawn's "_farplanedist" (q3map2 leaves clusters beyond it out of the PVS; the
