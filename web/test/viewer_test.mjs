@@ -48,13 +48,14 @@ async function screenshotStats(page, png) {
     g.drawImage(img, 0, 0);
     const d = g.getImageData(0, 0, cv.width, cv.height).data;
     const colours = new Set(), shown = new Set(), near = new Map();
-    let background = 0;
+    let background = 0, green = 0;
     const hud = document.getElementById('hud').getBoundingClientRect();
     const ratio = cv.width / window.innerWidth;
     for (let i = 0; i < d.length; i += 4) {
       const key = (d[i] << 16) | (d[i + 1] << 8) | d[i + 2];
       colours.add(key);
       if (Math.abs(d[i] - 0x15) + Math.abs(d[i + 1] - 0x17) + Math.abs(d[i + 2] - 0x1c) < 6) ++background;
+      if (d[i + 1] > d[i] + 40 && d[i + 1] > d[i + 2] + 40) ++green;
       const x = (i / 4) % cv.width / ratio, y = Math.floor(i / 4 / cv.width) / ratio;
       if (x >= hud.left && x <= hud.right && y >= hud.top && y <= hud.bottom) continue;
       let hit = near.get(key);
@@ -65,7 +66,7 @@ async function screenshotStats(page, png) {
       }
       if (hit !== undefined) shown.add(hit);
     }
-    return { colours: colours.size, background: background / (d.length / 4), shown: shown.size,
+    return { colours: colours.size, background: background / (d.length / 4), green: green / (d.length / 4), shown: shown.size,
              distinct: new Set(keys).size, crossed: v.sectionCells.length };
   }, png.toString('base64'));
 }
@@ -103,19 +104,7 @@ try {
     await page.waitForTimeout(300);
     const play = await page.evaluate(() => window.viewcells.playSpace);
     const png = await page.screenshot({ path: join(work, `viewer-${h.replace(/[=&]/g, '-')}.png`) });
-    greens.push(await page.evaluate(async (data) => {
-      const img = new Image();
-      img.src = 'data:image/png;base64,' + data;
-      await img.decode();
-      const cv = document.createElement('canvas');
-      cv.width = img.width; cv.height = img.height;
-      const g = cv.getContext('2d');
-      g.drawImage(img, 0, 0);
-      const d = g.getImageData(0, 0, cv.width, cv.height).data;
-      let n = 0;
-      for (let i = 0; i < d.length; i += 4) if (d[i + 1] > d[i] + 40 && d[i + 1] > d[i + 2] + 40) ++n;
-      return n / (d.length / 4);
-    }, png.toString('base64')));
+    greens.push((await screenshotStats(page, png)).green);
     if (!(play.triangles > 0)) fail(`no play space drawn: ${play.rule}`);
     if (play.visible !== !h.includes('play=0')) fail(`play space visible ${play.visible} with '${h}'`);
     if (errors.length) fail('the page logged errors: ' + errors.join('; '));
