@@ -49,8 +49,8 @@ struct BakeConfig {
   /// no measured_error, holes or max_seconds) resolve() stops at an estimated pixel error of 10.
   AgvsConfig agvs;
   /// The whole bake's time limit in seconds (0: none): each of the merge's two AGVS runs
-  /// stops at a quarter of it; the proof at half of what the hierarchy left (cells not begun
-  /// prove nothing); the PVSs' AGVS, with its measurements, at what is then left, less a quarter
+  /// stops at a quarter of it; the proof at half of what the hierarchy left, nine tenths with
+  /// `conservative`, whose sets are the proof's (cells not begun prove nothing); the PVSs' AGVS, with its measurements, at what is then left, less a quarter
   /// for each later stage of frame samples, near-object samples or measuring (down to a half,
   /// and at agvs.max_seconds); those stages, aimed rays included, at the limit itself, leaving
   /// out the frames and rays not begun by then (the report says how many frames were measured).
