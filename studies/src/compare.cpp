@@ -202,6 +202,8 @@ CompareRunResult compare(const CompareRunConfig& c, const Log& log) {
   for (const std::string& m : config.methods) method_list += (method_list.empty() ? "" : ",") + m;
   if (with_q3) {
     method_list += ",q3-clusters";
+    if (!q3_map_of(out.loaded.level.get()))
+      throw Error(c.scene.path, 0, "q3-clusters needs the map read as a Quake 3 level (register_q3_map_format())");
     if (!q3_map_of(out.loaded.level.get())->has_visibility())
       throw Error(c.scene.path, 0, "the map has no visibility data: there are no q3map2 clusters to compare with");
     if (config.max_cells == 0) config.max_cells = 3 * static_cast<uint32_t>(q3_map_of(out.loaded.level.get())->cluster_count);
