@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <type_traits>
 
@@ -171,12 +172,24 @@ void read_lists(const std::string& lists, uint32_t version, PvsPayload& p, std::
 
 /// No cell's path through the hierarchy repeats an object (what the nodes of a path keep is
 /// disjoint by construction); sized first, so that a path can never hold more than the objects.
-void check_paths(const PvsPayload& p) {
-  std::vector<uint32_t> cell;
+/// Each object is stamped with the last cell that met it, in one pass over the entries; when the
+/// objects far outnumber the payload's bytes (a hostile count), each path is sorted instead, so
+/// that memory stays bounded by the payload.
+void check_paths(const PvsPayload& p, size_t payload_bytes) {
+  const bool stamps = p.object_count <= 64 * uint64_t{payload_bytes} + 4096;
+  std::vector<uint32_t> stamp(stamps ? p.object_count : 0, UINT32_MAX), cell;
   for (uint32_t c = 0; c < p.cell_count; ++c) {
     uint64_t size = 0;
     for (int32_t n = static_cast<int32_t>(c); n >= 0; n = p.parent[n]) size += p.stored[n].size();
     if (size > p.object_count) corrupt("cell " + std::to_string(c) + " repeats an object");
+    if (stamps) {
+      for (int32_t n = static_cast<int32_t>(c); n >= 0; n = p.parent[n])
+        for (uint32_t id : p.stored[n]) {
+          if (stamp[id] == c) corrupt("cell " + std::to_string(c) + " repeats an object");
+          stamp[id] = c;
+        }
+      continue;
+    }
     cell.clear();
     for (int32_t n = static_cast<int32_t>(c); n >= 0; n = p.parent[n])
       cell.insert(cell.end(), p.stored[n].begin(), p.stored[n].end());
@@ -286,7 +299,7 @@ PvsPayload decode_pvs_payload(const std::string& payload, uint32_t version, std:
       corrupt("hierarchy node " + std::to_string(n) + " has a bad parent");
   }
   read_lists(lists, version, p, version == 1 ? nullptr : node_bits);
-  check_paths(p);
+  check_paths(p, payload.size());
   if (coded && version != 1) *coded = std::move(lists);
   return p;
 }

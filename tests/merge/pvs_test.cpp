@@ -1,6 +1,8 @@
 // PVS compression through the merge history, the .pvs file, and Quake-style flat rows.
 #include <gtest/gtest.h>
 
+#include "viewcells/runtime.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -147,6 +149,31 @@ TEST(Pvs, FileRoundTripAndPointLocation) {
   *std::find_if(bad.leaf_cell.begin(), bad.leaf_cell.end(), [](int32_t c) { return c >= 0; }) = 99;
   write_pvs(cut, bad);
   EXPECT_THROW(read_pvs(cut), Error);
+  // A cell whose path keeps an object twice (in the cell and in its parent): the one codec
+  // refuses it for the toolkit and for the runtime, both with object counts near the payload's
+  // size (each object stamped) and far above it (each path sorted: memory bounded by the file).
+  for (const uint32_t objects : {f.object_count, 50'000'000u}) {
+    bad = f;
+    bad.object_count = objects;
+    bad.object_names.clear();
+    int32_t cell = 0;
+    while (bad.pvs.parent[cell] < 0 || bad.pvs.stored[cell].empty()) ++cell;
+    const uint32_t id = bad.pvs.stored[cell][0];
+    auto& up = bad.pvs.stored[bad.pvs.parent[cell]];
+    up.insert(std::lower_bound(up.begin(), up.end(), id), id);
+    write_pvs(cut, bad);
+    try {
+      read_pvs(cut);
+      ADD_FAILURE() << "a path keeping an object twice was accepted (" << objects << " objects)";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("repeats an object"), std::string::npos) << e.what();
+    }
+    vc_pvs* opened = nullptr;
+    char message[256] = "";
+    EXPECT_NE(vc_pvs_open(cut.c_str(), &opened, message, sizeof message), 0) << objects;
+    EXPECT_NE(std::string(message).find("repeats an object"), std::string::npos) << message;
+    EXPECT_NE(vc_pvs_open_compact(cut.c_str(), &opened, message, sizeof message), 0) << objects;
+  }
 }
 
 TEST(Pvs, QuakeStyleRowsRoundTrip) {
