@@ -247,22 +247,16 @@ void check_bake_paths(const BakeConfig& c) {
                                  ", whose files later runs with it read: write the .pvs elsewhere");
 }
 
-/// The settings a bake refuses, before any work.
+/// The settings a bake refuses, before any work (after resolve(): a stop rule and the measuring
+/// cameras a measured stop needs are there by then).
 void check_bake(const BakeConfig& c) {
   if ((c.cells > 0) == (c.memory > 0)) throw Error("bake needs one budget: --cells N or --memory BYTES");
   if (!(c.measured_error >= 0) || !std::isfinite(c.measured_error))
     throw Error("the measured pixel error must be a finite number >= 0");
-  if (c.measured_error > 0 && !c.measure_cameras)
-    throw Error("a measured pixel error needs measuring cameras");
   if (!(c.holes >= 0 && c.holes <= 1)) throw Error("the share of frames with holes must be from 0 to 1");
-  if (c.holes > 0 && !c.measure_cameras) throw Error("a share of frames with holes needs measuring cameras");
   if (c.measure_cameras) check_frame_budget(c.measure_cameras, c.frame.width, c.frame.height);
   if (c.frame_samples) check_frame_budget(c.frame_samples, c.sample_frame.width, c.sample_frame.height);
   if (!(c.max_seconds >= 0) || !std::isfinite(c.max_seconds)) throw Error("the bake's time limit must be finite and >= 0");
-  if (!c.agvs.max_samples && !(c.agvs.max_seconds > 0) && !(c.agvs.pixel_error > 0) && !(c.measured_error > 0) &&
-      !(c.holes > 0) && !(c.max_seconds > 0))
-    throw Error("give when the PVSs are good enough: a pixel error (estimated or measured), a time or a number of "
-                "AGVS samples");
   check_bake_paths(c);
   if (c.cells && c.subdivision.max_cells && c.cells > c.subdivision.max_cells)
     throw Error("--cells " + std::to_string(c.cells) + " asks for more view cells than the " +

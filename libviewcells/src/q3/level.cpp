@@ -2,8 +2,7 @@
 #include "viewcells/q3/level.h"
 
 #include <algorithm>
-#include <cctype>
-#include <filesystem>
+#include <mutex>
 #include <nlohmann/json.hpp>
 
 #include "viewcells/core/error.h"
@@ -81,8 +80,7 @@ class Q3Level final : public LevelData {
 
   std::vector<std::pair<std::string, std::string>> info_lines() const override {
     const Q3Map& map = *map_;
-    Q3MeshStats st;
-    q3_world_mesh(map, {}, &st);
+    const Q3MeshStats& st = mesh_stats();
     std::vector<std::pair<std::string, std::string>> out;
     out.emplace_back("quake 3 map", "IBSP version " + std::to_string(map.version) + ", " +
                                         std::to_string(map.shaders.size()) + " shaders, " +
@@ -106,8 +104,7 @@ class Q3Level final : public LevelData {
   std::string info_key() const override { return "quake3"; }
   std::string info_json() const override {
     const Q3Map& map = *map_;
-    Q3MeshStats st;
-    q3_world_mesh(map, {}, &st);
+    const Q3MeshStats& st = mesh_stats();
     const nlohmann::json j = {
         {"version", map.version},
         {"leaves", map.leaves.size()},
@@ -122,6 +119,11 @@ class Q3Level final : public LevelData {
   }
 
  private:
+  /// What the map's world mesh holds by kind: made once, when `info` first asks.
+  const Q3MeshStats& mesh_stats() const {
+    std::call_once(stats_once_, [this] { q3_world_mesh(*map_, {}, &stats_); });
+    return stats_;
+  }
   size_t solid_leaves() const {
     size_t n = 0;
     for (const Q3Leaf& l : map_->leaves) n += l.cluster < 0;
@@ -129,15 +131,13 @@ class Q3Level final : public LevelData {
   }
   std::shared_ptr<const Q3Map> map_;
   std::shared_ptr<const ViewSpace> view_space_;
+  mutable std::once_flag stats_once_;
+  mutable Q3MeshStats stats_;
 };
 
 }  // namespace
 
-bool is_q3_map(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  for (char& ch : ext) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
-  return ext == ".bsp";
-}
+bool is_q3_map(const std::string& path) { return lower_extension(path) == ".bsp"; }
 
 std::shared_ptr<const Q3Map> q3_map_of(const LevelData* level) {
   const auto* q = dynamic_cast<const Q3Level*>(level);
