@@ -459,6 +459,11 @@ assert e['frames_with_wrong_pixels_share'] == e['cameras_with_wrong_pixels'] / 8
   json_get dm2bake.json "['effects']['restricted_view_space']['reason']" | grep -q "play space" && ok ||
     bad "bake on a map: the report does not say AGVS drew in the play space"
   expect_error "excludes" "$VC" bake "$MAPS/oa_dm2.bsp" --cells 40 --play-space --no-play-space -o dm2bad.pvs
+  # view on a map draws no play space from floors (its own is the BSP's), and says so.
+  "$VC" view dm2.pvs --scene "$MAPS/oa_dm2.bsp" --gltf dm2view.glb 2> view.err && ok || bad "view on a map failed"
+  grep -q "play space not drawn: a Quake 3 map" view.err && ok || bad "view on a map: $(grep 'play space' view.err)"
+  expect_ok "$VC" info dm2view.glb --list
+  ! grep -q 'play space' out.txt && ok || bad "view on a map drew a play space from floors"
   expect_error "not expected" "$VC" build "$MAPS/oa_dm2.bsp" --no-play-space -o dm2bad.vcells
   # bake --measured-error: stops when the play cameras measure it, and measure agrees with its report.
   expect_ok "$VC" bake "$MAPS/oa_dm2.bsp" --cells 40 --samples 50000 --max-cells 100 --merge-pvs samples \

@@ -44,6 +44,12 @@ bool is_level_file(const std::string& path) {
   return levels().count(lower_extension(path)) > 0;
 }
 
+std::string level_format_name(const std::string& path) {
+  const std::lock_guard<std::mutex> lock(levels_mutex);
+  const auto it = levels().find(lower_extension(path));
+  return it == levels().end() ? std::string() : it->second.name;
+}
+
 std::shared_ptr<const LevelData> read_level_data(const std::string& path) {
   std::function<std::shared_ptr<const LevelData>(const std::string&)> read;
   {

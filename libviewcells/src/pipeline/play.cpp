@@ -77,10 +77,8 @@ PlaySpaceRun play_space(const PlaySpaceRunConfig& config, const Log& log) {
 
 namespace {
 /// Why a level that knows its own view space gets no play space from floors.
-std::string level_play_space(const LevelData& level) {
-  return "not drawn: a " + level.kind() + "'s play space is its own (" +
-         (level.view_space() ? level.view_space()->describe() : std::string("its view space")) +
-         "), not found from floors";
+std::string level_play_space(const std::string& kind) {
+  return "not drawn: a " + kind + "'s play space is its own view space, not found from floors";
 }
 }  // namespace
 
@@ -88,7 +86,7 @@ FoundPlaySpace find_play_space(const SceneSource& source, const Log& log) {
   FoundPlaySpace out;
   out.loaded = load_scene_for_rays(source, log);
   if (out.loaded.level && out.loaded.level->view_space()) {
-    out.why = level_play_space(*out.loaded.level);
+    out.why = level_play_space(out.loaded.level->kind());
     return out;
   }
   auto space = std::make_shared<FloorSpace>(find_floor_space(*out.loaded.scene, *out.loaded.caster, source.floors));
@@ -113,12 +111,11 @@ GroupedMesh floor_mesh(const FloorSpace& space, double lift_m) {
 }
 
 void add_play_space(LevelView& view, const SceneSource& source, const Log& log) {
-  if (!source.scene && is_level_file(source.path)) {
-    const std::shared_ptr<const LevelData> level = read_level_data(source.path);
-    if (level && level->view_space()) {
-      view.play_space_rule = level_play_space(*level);
-      return;
-    }
+  // A level file (a Quake 3 map) brings its own view space: said without reading it again (the
+  // scene in memory, as `view` hands it, is that file's triangles).
+  if (const std::string kind = level_format_name(source.path); !kind.empty()) {
+    view.play_space_rule = level_play_space(kind);
+    return;
   }
   const FoundPlaySpace found = find_play_space(source, log);
   view.play_space_rule = found.why;

@@ -78,6 +78,8 @@ struct LevelFormat {
 void register_level_format(LevelFormat format);
 /// Whether `path`'s extension is a registered level format.
 bool is_level_file(const std::string& path);
+/// The registered level format's name for `path` ("Quake 3 map"), without reading it; "" when none.
+std::string level_format_name(const std::string& path);
 /// What the level file at `path` brings (read now), or null when its format is not a level's.
 std::shared_ptr<const LevelData> read_level_data(const std::string& path);
 

@@ -68,7 +68,8 @@ GroupedMesh floor_mesh(const FloorSpace& space, double lift_m = 0.03);
 
 /// The play space of `scene_path`'s floors (floor_mesh) added to a view of its cells, for the
 /// web page and glTF (`viewcells view`); nothing, with the reason in view.play_space_rule, on a
-/// map or a scene without floors.
+/// level file (a registered level format: a Quake 3 map brings its own view space) or a scene
+/// without floors.
 void add_play_space(LevelView& view, const SceneSource& source, const Log& log);
 /// The run's JSON report (indented, with a final newline).
 std::string report_json(const PlaySpaceRun& run);
