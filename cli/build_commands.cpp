@@ -26,11 +26,11 @@ int run_build(const BuildArgs& a, const Common& c) {
   ThreadLimit threads(c.threads);
   pipeline::BuildConfig config;
   config.model = a.cells.model();  // before the sampling, not after
-  config.subdivision = a.cells.subdivision(c, a.sampling);
+  config.subdivision = a.cells.subdivision(c.quiet, a.sampling);
   config.scene = a.sampling.source();
-  config.sampling = a.sampling.sampler(c);
+  config.sampling = a.sampling.sampler(c.quiet);
   config.merge = !a.no_merge;
-  if (!a.no_merge) config.merge_agvs = a.merge.agvs(c, a.sampling.seed, config.sampling.samples);
+  if (!a.no_merge) config.merge_agvs = a.merge.agvs(c.quiet, a.sampling.seed, config.sampling.samples);
   config.hierarchy_path = a.output;
   config.views = a.views;
   const pipeline::BuildResult result = pipeline::build(config, c.logger());

@@ -30,8 +30,8 @@ int run_compare(const CompareArgs& a, const Common& c) {
   config.scene = a.sampling.source();
   if (a.methods_given || !is_q3_map(a.sampling.scene)) config.methods = split_list(a.methods);
   config.max_cells = a.max_cells_given ? a.max_cells : 0;
-  config.construction = a.sampling.sampler(c);
-  config.merge_agvs = a.merge.agvs(c, config.construction.seed, config.construction.samples);
+  config.construction = a.sampling.sampler(c.quiet);
+  config.merge_agvs = a.merge.agvs(c.quiet, config.construction.seed, config.construction.samples);
   studies::compare(config, c.logger());
   return 0;
 }
@@ -69,7 +69,7 @@ void add_compare_command(CLI::App& app, const Common& common, Commands& commands
   cm->add_option("--axis-candidates", a->bound.subdivision.max_axis_candidates, "AV-S/AV-M: axis-aligned positions per axis and cell")
       ->capture_default_str()
       ->check(positive());
-  cm->add_flag("--exact-candidates", a->bound.subdivision.exact_candidates, std::string("AV-S/AV-M: ") + kExactCandidatesHelp);
+  cm->add_flag("--exact-candidates", a->bound.subdivision.exact_candidates, "AV-S/AV-M: " + pipeline::find_bake_option("--exact-candidates")->help);
   cm->add_option("--min-reduction", a->bound.subdivision.min_reduction,
                  "AV-S/AV-M: stop when splits reduce the cost by less than this share of the initial cost for 50 "
                  "splits running (0: always reach --max-cells)")

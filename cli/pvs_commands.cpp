@@ -31,31 +31,22 @@ struct AgvsOptions {
   }
 };
 
-void add_agvs_options(CLI::App* cmd, AgvsOptions& a, bool with_method, const std::string& samples_name,
-                      const std::string& time_name = "--time") {
-  cmd->add_option("--pixel-error", a.bound.pixel_error,
-                  "Stop when the estimated pixel error (pixels of a 1024x1024 image that differ) is at most this")
-      ->check(positive());
-  cmd->add_option(time_name, a.bound.max_seconds, "Stop AGVS after this many seconds of sampling")->check(positive());
-  cmd->add_option(samples_name, a.bound.max_samples,
-                  "Stop after this many AGVS samples (checked between batches: a run may pass it by less than a batch)")
-      ->check(whole(1, kMaxSamples));
-  if (with_method)
-    cmd->add_option("--method", a.method, "agvs (adaptive mixture), sgvs (view space-direction only) or ref (per cell)")
-        ->capture_default_str();
-  cmd->add_option("--batch", a.bound.batch_size, "Samples per batch")->capture_default_str()->check(whole(1, 100'000'000));
-  cmd->add_option("--mutation-lanes", a.bound.mutation_lanes,
-                  "AGVS: independent lanes of mutation candidates, each with its own random stream and its share of "
-                  "the buffer. Lanes are drawn and fed in parallel, on a cluster each by its own rank: give at least "
-                  "as many as the cores of all nodes for a bake that scales. The result depends on it, not on the "
-                  "threads or ranks")
-      ->capture_default_str()
-      ->check(whole(1, 65536));
-  cmd->add_option("--min-share", a.bound.min_share,
-                  "AGVS: share of every batch kept for view space-direction samples whatever their weight; they are "
-                  "the pixel error estimator's camera rays (more: a finer estimate, fewer samples for the mutations)")
-      ->capture_default_str()
-      ->check(in_range(0.0, 1.0));
+/// pvs's AGVS options: bake's (its table's help and checks), --agvs-time and --agvs-samples
+/// named --time and --samples, and --method.
+void add_agvs_options(CLI::App* cmd, AgvsOptions& a) {
+  auto shared = [cmd](const std::string& flag, const std::string& table_flag, auto& field) {
+    const pipeline::BakeOption& o = *pipeline::find_bake_option(table_flag);
+    CLI::Option* opt = cmd->add_option(flag, field, o.help)->check(table_check(o));
+    if (o.show_default) opt->capture_default_str();
+  };
+  shared("--pixel-error", "--pixel-error", a.bound.pixel_error);
+  shared("--time", "--agvs-time", a.bound.max_seconds);
+  shared("--samples", "--agvs-samples", a.bound.max_samples);
+  cmd->add_option("--method", a.method, "agvs (adaptive mixture), sgvs (view space-direction only) or ref (per cell)")
+      ->capture_default_str();
+  shared("--batch", "--batch", a.bound.batch_size);
+  shared("--mutation-lanes", "--mutation-lanes", a.bound.mutation_lanes);
+  shared("--min-share", "--min-share", a.bound.min_share);
 }
 
 /// `pvs`'s options: bound to the fields of `config` (what the library runs), but for the few
@@ -98,7 +89,7 @@ void add_pvs_command(CLI::App& app, const Common& common, Commands& commands) {
   pv->add_option("--objects", a->objects, "Object grouping used when building")->capture_default_str();
   pv->add_option("--cells", a->config.cells, "View cells cut from the merge history (default: every elementary cell)")
       ->check(whole(1, kMaxCells));
-  add_agvs_options(pv, a->agvs, true, "--samples");
+  add_agvs_options(pv, a->agvs);
   pv->add_option("--seed", a->agvs.bound.seed, "Random seed")
       ->capture_default_str()
       ->check(whole(0, UINT64_MAX));
@@ -154,188 +145,36 @@ void add_pvs_command(CLI::App& app, const Common& common, Commands& commands) {
   commands.push_back({pv, [a, &common] { return run_pvs(*a, common); }});
 }
 
-/// `bake`'s options: those that are a field of the bake's config bind to `bound` (whose defaults
-/// are the command line's); the rest are parsed, shared with other commands, or decide a default
-/// from what else was given, when the command runs (bake_config).
+/// `bake`'s options: the table's (pipeline/options.h), the scene, -o and --report.
 struct BakeArgs {
-  pipeline::BakeConfig bound;
-  SamplingOptions sampling;
-  CellOptions cells;
-  std::string memory, memory_of = "file";
-  AgvsOptions agvs;
-  MergeOptions merge;
+  pipeline::BakeOptions options;
   std::string report;
-  std::string holes, measure_size, frame_size = "256x192";
 };
 
-/// "1%" or "1" (percent) -> 0.01.
-double parse_percent(const std::string& text, const std::string& option) {
-  std::string number = text;
-  if (!number.empty() && number.back() == '%') number.pop_back();
-  const std::vector<double> v = parse_numbers(number, option);
-  if (v.size() != 1 || !(v[0] > 0 && v[0] <= 100))
-    throw Error(option + " needs a percentage above 0 and at most 100, e.g. 1% (got '" + text + "')");
-  return v[0] / 100;
-}
-
-/// The bake the options ask for, with the command line's defaults (also what bindings that
-/// bake from code run: bake_config_from_args).
-pipeline::BakeConfig bake_config(BakeArgs a, const Common& c) {
-  pipeline::BakeConfig config = a.bound;
-  config.model = a.cells.model();
-  config.subdivision = a.cells.subdivision(c, a.sampling);
-  config.play_space_where_known = a.cells.play_space_by_default && !a.cells.no_play_space;
-  config.scene = a.sampling.source();
-  config.sampling = a.sampling.sampler(c);
-  config.merge_on_agvs = a.merge.pvs == "agvs";
-  config.merge_agvs = a.merge.agvs(c, a.sampling.seed, config.sampling.samples);
-  config.memory = a.memory.empty() ? 0 : parse_bytes(a.memory);
-  if (!a.memory.empty() && config.memory == 0) throw Error("--memory must be above 0 bytes (got '" + a.memory + "')");
-  if (a.memory_of != "file" && a.memory_of != "lists") throw Error("--memory-of is file or lists, not '" + a.memory_of + "'");
-  config.memory_of_lists = a.memory_of == "lists";
-  config.holes = a.holes.empty() ? 0.0 : parse_percent(a.holes, "--holes");
-  // The stop rule, the measuring cameras and their frames when not given: the library decides
-  // (pipeline::resolve).
-  if (!a.measure_size.empty())
-    std::tie(config.frame.width, config.frame.height) = parse_size(a.measure_size, "--measure-size", 2048);
-  std::tie(config.sample_frame.width, config.sample_frame.height) = parse_size(a.frame_size, "--frame-size", 2048);
-  config.agvs = a.agvs.config(c);
-  config.agvs.seed = a.sampling.seed;
-  return config;
-}
-
 int run_bake(const BakeArgs& a, const Common& c) {
-  check_files({a.sampling.scene}, {a.bound.output, a.report}, {a.bound.work_dir});
+  check_files({a.options.sampling.scene}, {a.options.bound.output, a.report}, {a.options.bound.work_dir});
   ThreadLimit threads(c.threads);
-  const pipeline::BakeConfig config = bake_config(a, c);
+  const pipeline::BakeConfig config = a.options.config(c.quiet);
   const pipeline::BakeResult result = pipeline::bake(config, c.logger());
   write_report_to(a.report, result, c);
   return 0;
 }
 
-/// Adds `bake`; returns its parsed options (filled by the parse).
+/// Adds `bake`: its options are the table's, which Python's keywords and vc_bake's words set too.
 std::shared_ptr<BakeArgs> add_bake_command(CLI::App& app, const Common& common, Commands& commands) {
   auto a = std::make_shared<BakeArgs>();
-  a->cells.max_cells = 0;
-  a->cells.play_space_by_default = true;
-  a->sampling.samples = 1'000'000;
   auto* bk = app.add_subcommand(
       "bake",
       "The whole chain in one command: sample, subdivide and merge, cut view cells under the budget, compute "
       "their PVSs by AGVS to the pixel error asked for, compress and write a .pvs file for the engine");
-  add_sampling_options(bk, a->sampling);
-  add_floor_options(bk, a->sampling.floors);
-  auto* cells = bk->add_option("--cells", a->bound.cells, "Budget: this many view cells")->check(whole(1, kMaxCells));
-  bk->add_option("--memory", a->memory,
-                 "Budget: a .pvs file of at most this many bytes (K, M, G allowed); the file written is measured, "
-                 "and the cells are merged further until it fits")
-      ->excludes(cells);
-  bk->add_option("--memory-of", a->memory_of,
-                 "What --memory counts: file (the whole .pvs) or lists (the visible sets alone as an engine's compact "
-                 "handle holds them: the coded lists and 8 bytes a hierarchy node, without point location and object "
-                 "names; what stands against a map compiler's vis rows)")
-      ->capture_default_str();
-  bk->add_option("--max-cells", a->cells.max_cells,
-                 "Elementary cells to build before merging (default: 4 x --cells, or 4096 with --memory)")
-      ->check(whole(1, kMaxCells));
-  add_cell_options(bk, a->cells, "");
-  add_merge_options(bk, a->merge);
-  add_agvs_options(bk, a->agvs, false, "--agvs-samples", "--agvs-time");
-  bk->add_option("--time", a->bound.max_seconds,
-                 "Bound the whole bake to this many seconds: each of the merge's two AGVS runs stops at a quarter of "
-                 "it, the PVSs' AGVS at three quarters of what is left, the near-object samples when it runs out (a "
-                 "hierarchy that uses it all up is an error, and with --work is kept for a rerun). --agvs-time bounds "
-                 "the PVSs' AGVS alone")
-      ->check(positive());
-  bk->add_option("--work", a->bound.work_dir,
-                 "Work directory: keeps the hierarchy and the AGVS state, so that a rerun with the same scene and "
-                 "settings skips the hierarchy and continues sampling (e.g. with a smaller --pixel-error)");
-  bk->add_option("--checkpoint", a->bound.checkpoint_seconds,
-                 "With --work: save the AGVS state this often, in seconds, so that a bake cut off continues from "
-                 "there when run again (0: only at the end)")
-      ->capture_default_str()
-      ->check(non_negative());
-  bk->add_option("--measured-error", a->bound.measured_error,
-                 "Stop AGVS once cameras measure at most this many wrong pixels per 1024x1024 frame (mean over the "
-                 "cameras), instead of trusting the estimate: measured after one batch and at every doubling of the "
-                 "samples (a run may sample up to twice what it needed; --time and the other limits still apply)")
-      ->check(non_negative());
-  bk->add_option("--holes", a->holes,
-                 "Stop AGVS once at most this percentage of the measuring cameras' frames shows any wrong pixel "
-                 "(e.g. 1%): the holes a player sees. Measured after one batch and at every doubling of the samples "
-                 "(by default 1,000 cameras of 1024x768, placed as `viewcells measure` places them), each "
-                 "measurement logged with an estimate of the time left; with --measured-error both must hold; "
-                 "--time still bounds the bake");
-  bk->add_option("--frame-samples", a->bound.frame_samples,
-                 "After AGVS, frames as a sampler: this many cameras per view cell on average, placed as measuring "
-                 "cameras are (on a Quake 3 map player eyes, pitch within 30 degrees) but from a seed of their own, "
-                 "render --frame-size frames, and every object a frame shows joins its cell's PVS (0: none)")
-      ->check(whole(0, 100000));
-  bk->add_option("--frame-size", a->frame_size, "Frames of --frame-samples, WIDTHxHEIGHT")->capture_default_str();
-  bk->add_option("--frame-rounds", a->bound.frame_rounds,
-                 "Rounds of --frame-samples: after the first, only the cells whose frames still added an object get "
-                 "about as many frames again")
-      ->capture_default_str()
-      ->check(whole(1, 64));
-  bk->add_option("--near-samples", a->bound.near.rays_per_object,
-                 "After AGVS, near-object samples: every view cell tests each object whose box lies within "
-                 "--near-distance of an object of its PVS and that it lacks, with this many rays from its viewpoints "
-                 "(placed as measuring cameras are, --near-eyes a cell on average, a seed of their own) to random "
-                 "points on the object; the object joins the PVS when a ray reaches it unblocked. They close most "
-                 "of the holes AGVS leaves (trims and steps beside what a cell sees) for a few percent of render "
-                 "cost; at most 2^31 rays in all (fewer a candidate on scenes with more). 0: none")
-      ->capture_default_str()
-      ->check(whole(0, 4096));
-  bk->add_flag("--conservative", a->bound.conservative,
-               "Ship no holes by construction: prove objects hidden through the scene's solid space (a Quake 3 "
-               "map's BSP portals, or a mesh's closed convex solids), and add every (cell, object) pair that is "
-               "neither seen by a ray nor proven hidden to the PVSs, so that no line from any point of a cell "
-               "reaches an object missing from its PVS. Costs more to render than the sampled PVSs (the report's "
-               "hidden.cost_per_frame gives both bounds); an error on a scene that can prove nothing hidden");
-  bk->add_flag("--prove-hidden,!--no-prove-hidden", a->bound.prove_hidden,
-               "Sort every (cell, object) pair into proven visible, proven hidden and undecided, and report the "
-               "classes and the render cost of both bounds (the report's \"hidden\"); the PVSs written are unchanged "
-               "unless --conservative")
-      ->capture_default_str();
-  bk->add_option("--proof-steps", a->bound.hidden_max_steps,
-                 "Portals one flood of the proof may try; a flood over it keeps all it might still reach (never "
-                 "less: only the bound loosens)")
-      ->capture_default_str()
-      ->check(whole(1, 1000000000));
-  bk->add_option("--aimed-rays", a->bound.aimed_rays,
-                 "With the proof (--prove-hidden, --conservative): rays aimed at each (view cell, object) pair it "
-                 "leaves undecided, from points of the cell's empty space to points of the object, up to this many a "
-                 "pair; one that arrives proves the pair visible (0: none)")
-      ->capture_default_str()
-      ->check(whole(0, 1000000));
-  bk->add_option("--near-rounds", a->bound.near.rounds,
-                 "Rounds of --near-samples: each round tests the neighbours of what the last one added")
-      ->capture_default_str()
-      ->check(whole(1, 64));
-  bk->add_option("--near-eyes", a->bound.near_eyes, "Viewpoints a cell has on average for --near-samples")
-      ->capture_default_str()
-      ->check(whole(1, 100000));
-  bk->add_option("--near-distance", a->bound.near.distance,
-                 "Objects are neighbours for --near-samples when their boxes are at most this far apart (default "
-                 "1/1000 of the scene's bounding box diagonal)")
-      ->check(non_negative());
-  bk->add_option("--measure-size", a->measure_size,
-                 "Frames of the measuring cameras, WIDTHxHEIGHT (default 1024x768 with --holes, else 64x48)");
-  bk->add_option("--measure-cameras", a->bound.measure_cameras,
-                 "Cameras that measure the PVSs, placed and counted as `viewcells measure` does (on a Quake 3 map "
-                 "player eyes above floors reachable from the spawn points, else random points of the view box; "
-                 "64x48 pixels, seed 1): the report gives the written file's measured pixel error (default: 5000 "
-                 "with --measured-error, else none)")
-      ->check(whole(1, 1'000'000));
-  bk->add_option("-o,--output", a->bound.output, "The .pvs file to write")->required();
+  bk->add_option("scene", a->options.sampling.scene, "Scene file (.obj, .ply, .off, .stl, or a Quake 3 .bsp)")
+      ->required();
+  add_bake_options(bk, a->options);
+  bk->add_option("-o,--output", a->options.bound.output, "The .pvs file to write")->required();
   bk->add_option("--report", a->report, "JSON report: budget, cells, file bytes, pixel error, samples, timings");
   bk->footer("Without --pixel-error, --measured-error, --time, --agvs-time or --agvs-samples, AGVS runs to an "
              "estimated pixel error of 10 (of 1024x1024).");
-  commands.push_back({bk, [a, &common] {
-                        if (a->bound.cells == 0 && a->memory.empty())
-                          throw Error("bake needs a budget: --cells N or --memory BYTES");
-                        return run_bake(*a, common);
-                      }});
+  commands.push_back({bk, [a, &common] { return run_bake(*a, common); }});
   return a;
 }
 
@@ -414,24 +253,11 @@ void add_measure_command(CLI::App& app, const Common& common, Commands& commands
   commands.push_back({ms, [a, &common] { return run_measure(*a, common); }});
 }
 
-pipeline::BakeConfig bake_config_from_args(const std::vector<std::string>& args, bool quiet) {
+pipeline::BakeOptions bake_options_from_args(const std::vector<std::string>& args) {
   CLI::App app{"viewcells"};
   Common common;
-  common.quiet = quiet;
   Commands commands;
   const std::shared_ptr<BakeArgs> a = add_bake_command(app, common, commands);
-  CLI::App& bake = *commands.front().app;
-  // Words are checked here, in the caller's order, so that an unknown one is named as given
-  // (CLI11 lists leftovers in the order it took them, last first).
-  for (const std::string& word : args) {
-    if (word.rfind("--", 0) != 0) continue;
-    const std::string name = word.substr(0, word.find('='));
-    if (name == "--help")
-      throw Error("bake: help is not an option of a bake from code; the options are viewcells bake's:\n" +
-                  bake.help("", CLI::AppFormatMode::Sub));
-    if (!bake.get_option_no_throw(name))
-      throw Error("bake: unknown option " + name + " (the options are those of `viewcells bake --help`)");
-  }
   std::vector<std::string> reversed = {"bake"};
   reversed.insert(reversed.end(), args.begin(), args.end());
   std::reverse(reversed.begin(), reversed.end());  // CLI11 takes a vector last argument first
@@ -441,8 +267,7 @@ pipeline::BakeConfig bake_config_from_args(const std::vector<std::string>& args,
     throw Error(std::string("bake: ") + e.what());
   }
   check_no_empty_values(*commands.front().app);
-  if (a->bound.cells == 0 && a->memory.empty()) throw Error("bake needs a budget: cells or memory");
-  return bake_config(*a, common);
+  return a->options;
 }
 
 void add_pvs_commands(CLI::App& app, const Common& common, Commands& commands) {

@@ -151,7 +151,7 @@ int run_sample(const SampleArgs& a, const Common& c) {
   ThreadLimit threads(c.threads);
   pipeline::SampleConfig config;
   config.scene = a.sampling.source();
-  config.sampling = a.sampling.sampler(c);
+  config.sampling = a.sampling.sampler(c.quiet);
   config.segments_path = a.output;
   config.measure_raw = a.measure_raw;
   const pipeline::SampleResult result = pipeline::sample(config, c.logger());

@@ -6,11 +6,11 @@
 //   baked = viewcells.bake(scene, "level.pvs", cells=100, pixel_error=5, progress=print)
 //   baked.query((3, 12, 1.5)), baked.pvs(cell), baked.cell_bounds, baked.report
 //
-// bake() takes the command line's options as keywords (cells=100 is --cells 100, no_ga=True
-// is --no-ga) and parses them with the command line's own code (cli::bake_config_from_args),
-// so its defaults and checks are exactly `viewcells bake`'s; the scene then comes from memory
-// (pipeline::SceneSource::scene) when it is a Scene. Errors are viewcells.Error carrying the
-// library's message.
+// bake() takes the bake's options as keywords (cells=100 is --cells 100, no_ga=True is
+// --no-ga), set through the library's table of options (pipeline/options.h), the one the
+// command line is built from, so its defaults, checks and help are exactly `viewcells bake`'s;
+// the scene then comes from memory (pipeline::SceneSource::scene) when it is a Scene. Errors
+// are viewcells.Error carrying the library's message, with options named as keywords.
 // Type errors name the argument and the type given, not only "Unable to cast".
 #define PYBIND11_DETAILED_ERROR_MESSAGES
 #include <pybind11/functional.h>
@@ -30,7 +30,6 @@
 #include <string>
 #include <vector>
 
-#include "commands.h"
 #include "viewcells/cells/view_cells.h"
 #include "viewcells/core/binary_file.h"
 #include "viewcells/core/error.h"
@@ -38,6 +37,7 @@
 #include "viewcells/core/paths.h"
 #include "viewcells/io/scene_io.h"
 #include "viewcells/pipeline/bake.h"
+#include "viewcells/pipeline/options.h"
 #include "viewcells/pipeline/play.h"
 #include "viewcells/q3/bsp_file.h"
 #include "viewcells/pipeline/report.h"
@@ -130,24 +130,43 @@ std::shared_ptr<const Scene> scene_from_arrays(py::array_t<double, py::array::c_
   return std::make_shared<const Scene>(make_scene(std::move(mesh), ObjectGrouping::kGroups, name));
 }
 
-/// A keyword argument as command-line words: cells=100 -> --cells 100, no_ga=True ->
-/// --no-ga=true (so that True given to an option that wants a number is refused by name), a
-/// list -> the option once with every value.
-void add_option(std::vector<std::string>& args, const std::string& key, const py::handle& value) {
-  std::string option = "--" + key;
-  for (char& c : option)
-    if (c == '_') c = '-';
-  if (value.is_none()) return;
-  if (py::isinstance<py::bool_>(value)) {
-    args.push_back(option + (value.cast<bool>() ? "=true" : "=false"));
-    return;
+/// A keyword argument as the text of its option: True/False for a flag ("true" given to an
+/// option that wants a number is refused by name), a list or tuple joined by commas (a box, an
+/// eye band), and for a repeatable option (start) one text per item.
+std::vector<std::string> option_texts(const pipeline::BakeOption& option, const std::string& key, const py::handle& value) {
+  auto one = [](const py::handle& v) -> std::string {
+    if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
+    if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) {
+      std::string joined;
+      for (const py::handle& item : v) joined += (joined.empty() ? "" : ",") + py::str(item).cast<std::string>();
+      return joined;
+    }
+    return py::str(v);
+  };
+  const bool sequence = py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value);
+  if (option.kind == pipeline::BakeOption::Kind::kTexts && sequence) {
+    bool nested = false;
+    for (const py::handle& item : value)
+      nested |= py::isinstance<py::list>(item) || py::isinstance<py::tuple>(item) || py::isinstance<py::str>(item);
+    if (nested) {
+      std::vector<std::string> texts;
+      for (const py::handle& item : value) texts.push_back(one(item));
+      return texts;
+    }
   }
-  args.push_back(option);
-  if (py::isinstance<py::list>(value) || py::isinstance<py::tuple>(value)) {
-    for (const py::handle& item : value) args.push_back(py::str(item));
-    return;
-  }
-  args.push_back(py::str(value));
+  if (sequence && option.kind != pipeline::BakeOption::Kind::kText && option.kind != pipeline::BakeOption::Kind::kTexts)
+    throw Error("bake: " + key + " (keyword) takes one value, not a list");
+  return {one(value)};
+}
+
+/// The options as keywords, for help: "  max_cells=INT in [1, 10000000]  Elementary cells ...".
+std::string keyword_listing() {
+  std::string out;
+  for (const pipeline::BakeOption& o : pipeline::bake_option_table())
+    out += "  " + o.keyword + "=" + (o.kind == pipeline::BakeOption::Kind::kFlag ? std::string("True|False")
+                                                                  : o.type.empty() ? std::string("TEXT") : o.type) +
+           "\n      " + o.help + "\n";
+  return out;
 }
 
 /// A message of the command-line parser with each option the caller gave as a keyword named as
@@ -487,18 +506,30 @@ std::shared_ptr<Baked> bake(const py::object& scene, const py::object& output_pa
   const std::string output = path_of(output_path, "bake: output");
   if (!progress.is_none() && !PyCallable_Check(progress.ptr()))
     throw py::type_error("bake: progress must be callable (it receives each log line), or None");
-  std::vector<std::string> args = {name, "-o", output};
+  pipeline::BakeOptions bake_options;
+  bake_options.sampling.scene = name;
+  bake_options.bound.output = output;
   std::string report;
-  for (const auto& [key, value] : options) {
-    if (py::str(key).cast<std::string>() == "report") {
-      if (!value.is_none()) report = path_of(value, "bake: report");
-      continue;
-    }
-    add_option(args, py::str(key), value);
-  }
   pipeline::BakeConfig config;
   try {
-    config = cli::bake_config_from_args(args, progress.is_none());
+    for (const auto& [k, value] : options) {
+      const std::string key = py::str(k);
+      if (key == "report") {
+        if (!value.is_none()) report = path_of(value, "bake: report");
+        continue;
+      }
+      if (key == "help")
+        throw Error("bake: help is not an option of a bake from code; the options are viewcells bake's, as "
+                    "keywords:\n" + keyword_listing());
+      const pipeline::BakeOption* option = pipeline::find_bake_option(key);
+      if (!option || key != option->keyword)
+        throw Error("bake: unknown option " + key + " (keyword) (the options are those of `viewcells bake --help`, "
+                    "as keywords: max_cells for --max-cells)");
+      if (value.is_none()) continue;
+      for (const std::string& text : option_texts(*option, key, value))
+        pipeline::set_bake_option(bake_options, *option, text, key + " (keyword)");
+    }
+    config = bake_options.config(progress.is_none());
   } catch (const Error& e) {
     throw Error(as_keywords(e.what(), options));
   }
@@ -704,10 +735,12 @@ PYBIND11_MODULE(viewcells, m) {
         "rest in metres; metres_per_unit 0: the file's own). A Quake 3 map's play space is its BSP's "
         "leaves: found is False there, and rule says so.");
 
+  static const std::string bake_doc =
+      "Bakes `scene` (a Scene, or a scene file's path) into the .pvs file `output`, with `viewcells bake`'s "
+      "options as keywords and its defaults (a budget: cells=100 or memory='256K'; report='r.json' writes the "
+      "report). progress(line) receives the log lines. Ctrl-C stops the bake within a second with "
+      "KeyboardInterrupt, writing nothing (and stops any other bake running in the process: the stop is "
+      "process-wide). Returns the file read back.\n\nKeywords (None: the default):\n" + keyword_listing();
   m.def("bake", &bake, py::arg("scene"), py::arg("output"), py::kw_only(), py::arg("progress") = py::none(),
-        "Bakes `scene` (a Scene, or a scene file's path) into the .pvs file `output`, with `viewcells bake`'s "
-        "options as keywords and its defaults (cells=100 or memory='256K'; pixel_error, holes='1%', time, ...; "
-        "report='r.json' writes the report). progress(line) receives the log lines. Ctrl-C stops the bake "
-        "within a second with KeyboardInterrupt, writing nothing (and stops any other bake running in the "
-        "process: the stop is process-wide). Returns the file read back.");
+        bake_doc.c_str());
 }

@@ -19,6 +19,11 @@ test -f "$work/prefix/include/viewcells/pipeline/bake.h"
 for internal in core/parallel.h core/progress.h core/ranks.h vis/level_view.h q3/play.h q3/level.h; do
   if [ -e "$work/prefix/include/viewcells/$internal" ]; then echo "FAIL: installed an internal header, $internal"; exit 1; fi
 done
+# Bindings bind the library's fields: the command line's parser is no part of the install.
+test -f "$work/prefix/include/viewcells/pipeline/options.h"
+for front in viewcells_cli viewcells_studies; do
+  if ls "$work/prefix/lib"/*"$front"* >/dev/null 2>&1; then echo "FAIL: installed $front (the command line's)"; exit 1; fi
+done
 cmake -S "$src/examples/consumer" -B "$work/consumer" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" \
   -DCMAKE_C_FLAGS="$flags" -DCMAKE_CXX_FLAGS="$flags" -DCMAKE_EXE_LINKER_FLAGS="$flags" >/dev/null
 cmake --build "$work/consumer" >/dev/null

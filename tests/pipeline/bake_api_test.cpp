@@ -1,4 +1,4 @@
-// vc_bake (cli/include/viewcells/bake.h): a scene in memory baked from C gives the file a bake
+// vc_bake (capi/include/viewcells/bake.h): a scene in memory baked from C gives the file a bake
 // of the same scene from an OBJ gives, byte for byte; the runtime opens its bytes from memory;
 // see-through objects hide nothing; bad arguments get a message and a non-zero code, and a
 // failing bake leaves an earlier file as it was.
@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
@@ -14,6 +15,7 @@
 #include "viewcells/bake.h"
 #include "viewcells/core/binary_file.h"
 #include "viewcells/pipeline/bake.h"
+#include "viewcells/pipeline/options.h"
 #include "viewcells/runtime.h"
 #include "viewcells/scene/generators.h"
 
@@ -106,7 +108,7 @@ TEST(BakeApi, GivesTheBytesOfABakeOfTheSameSceneFromAFile) {
   test::write_file(obj, m.obj());
   std::vector<std::string> args = {obj, "-o", from_file};
   args.insert(args.end(), kOptions.begin(), kOptions.end());
-  pipeline::bake(cli::bake_config_from_args(args), [](const std::string&) {});
+  pipeline::bake(cli::bake_options_from_args(args).config(true), [](const std::string&) {});
   const std::string want = file_bytes(from_file);
   ASSERT_GT(want.size(), 32u);
 
@@ -320,7 +322,8 @@ std::string describe(const pipeline::BakeConfig& c) {
   const SamplerConfig& s = c.sampling;
   k << "sampling " << s.samples << ' ' << s.target_segments << ' ' << s.seed << ' ' << static_cast<int>(s.empty_space)
     << ' ' << s.max_recasts << ' ' << s.batch_size << ' ' << s.view_box.empty() << '\n';
-  k << "model " << c.model.a << ' ' << c.model.b << ' ' << c.model.c << '\n';
+  k << "model " << c.model.a << ' ' << c.model.b << ' ' << c.model.c << ' ' << c.model.screen_width << 'x'
+    << c.model.screen_height << ' ' << c.model.fov_degrees << '\n';
   const SubdivisionConfig& d = c.subdivision;
   k << "subdivision " << static_cast<int>(d.strategy) << ' ' << d.max_cells << ' ' << d.max_axis_candidates << ' '
     << d.exact_candidates << ' ' << static_cast<int>(d.geometry_aligned) << ' ' << d.ga_candidates << ' '
@@ -357,12 +360,100 @@ TEST(BakeDefaults, AnEmptyCommandLineIsTheLibrarysDefault) {
   library.scene.path = "level.obj";
   library.output = "level.pvs";
   library.cells = 100;
-  const pipeline::BakeConfig command = cli::bake_config_from_args({"level.obj", "-o", "level.pvs", "--cells", "100"});
+  const pipeline::BakeConfig command =
+      cli::bake_options_from_args({"level.obj", "-o", "level.pvs", "--cells", "100"}).config(true);
   EXPECT_EQ(describe(pipeline::resolve(command)), describe(pipeline::resolve(library)));
   // The check can fail: one option given changes the words.
   const pipeline::BakeConfig other =
-      cli::bake_config_from_args({"level.obj", "-o", "level.pvs", "--cells", "100", "--near-samples", "0"});
+      cli::bake_options_from_args({"level.obj", "-o", "level.pvs", "--cells", "100", "--near-samples", "0"}).config(true);
   EXPECT_NE(describe(pipeline::resolve(other)), describe(pipeline::resolve(library)));
+}
+
+/// A value of `o` other than its default that its check takes (texts: one that parses).
+std::string sample_value(const pipeline::BakeOption& o) {
+  using Kind = pipeline::BakeOption::Kind;
+  const std::string fallback = o.show ? o.show(pipeline::BakeOptions{}) : "";
+  std::vector<std::string> candidates;
+  if (o.kind == Kind::kWhole) candidates = {"3", "2", "5", "1", "0"};
+  if (o.kind == Kind::kNumber) candidates = {"0.25", "0.5", "2", "45"};
+  if (o.kind == Kind::kText || o.kind == Kind::kTexts) {
+    const std::map<std::string, std::string> texts = {
+        {"--objects", "triangles"},       {"--view-box", "0,0,0,1,1,1"}, {"--empty-space", "off"},
+        {"--memory", "1M"},               {"--memory-of", "lists"},      {"--screen", "800x600"},
+        {"--density-band", "0,2"},        {"--merge-pvs", "samples"},    {"--work", "work"},
+        {"--holes", "2%"},                {"--frame-size", "64x48"},     {"--measure-size", "32x24"},
+        {"--start", "1,2,3"},             {"--eye-band", "1,2"}};
+    const auto it = texts.find(o.flag);
+    if (it != texts.end()) candidates = {it->second};
+  }
+  for (const std::string& c : candidates)
+    if (o.check(c).empty() && c != fallback) return c;
+  return "";
+}
+
+// Every option of the library's table, one at a time: the command line (CLI11, whose bake is
+// built from the table) and the library's own word parser (vc_bake's) make the same config, and
+// it differs from the one without the option (an option that changed nothing, or that one
+// parser dropped, fails here). Python's keywords go through the same table (set_bake_option).
+TEST(BakeDefaults, EveryOptionOfTheTableMeansTheSameToBothParsers) {
+  using Kind = pipeline::BakeOption::Kind;
+  const std::vector<std::string> base = {"level.obj", "-o", "level.pvs"};
+  const std::string plain = describe(pipeline::parse_bake_words({"level.obj", "-o", "level.pvs", "--cells", "100"}).config(true));
+  size_t tried = 0;
+  for (const pipeline::BakeOption& o : pipeline::bake_option_table()) {
+    std::vector<std::string> words = base;
+    if (o.flag != "--memory" && o.flag != "--cells") words.insert(words.end(), {"--cells", "100"});
+    if (o.flag == "--merge-samples" || o.flag == "--merge-pixel-error") words.insert(words.end(), {"--merge-pvs", "agvs"});
+    if (o.kind == Kind::kFlag) {
+      words.push_back(o.flag);
+    } else {
+      const std::string value = sample_value(o);
+      ASSERT_FALSE(value.empty()) << o.flag << ": give the test a value for it";
+      words.insert(words.end(), {o.flag, value});
+    }
+    SCOPED_TRACE(o.flag);
+    const std::string command = describe(cli::bake_options_from_args(words).config(true));
+    const std::string library = describe(pipeline::parse_bake_words(words).config(true));
+    EXPECT_EQ(command, library);
+    EXPECT_NE(library, plain) << o.flag << " changed nothing in the config";
+    EXPECT_TRUE(pipeline::find_bake_option(o.keyword) == &o) << o.keyword;
+    ++tried;
+  }
+  EXPECT_GT(tried, 60u);
+  // A negation, and the "=" form, in both.
+  for (const std::vector<std::string>& extra : {std::vector<std::string>{"--prove-hidden", "--no-prove-hidden"},
+                                                 std::vector<std::string>{"--cells=7"}}) {
+    std::vector<std::string> words = {"level.obj", "-o", "level.pvs", "--cells", "100"};
+    if (extra.front() == "--cells=7") words = {"level.obj", "-o", "level.pvs"};
+    words.insert(words.end(), extra.begin(), extra.end());
+    EXPECT_EQ(describe(cli::bake_options_from_args(words).config(true)),
+              describe(pipeline::parse_bake_words(words).config(true)));
+  }
+}
+
+// Both parsers refuse the same words, each naming the option.
+TEST(BakeDefaults, BothParsersRefuseWhatTheTableRefuses) {
+  const std::vector<std::vector<std::string>> bad = {
+      {"--cells", "0"}, {"--cells", "4", "--memory", "1M"}, {"--seed", "-1"}, {"--min-share", "2"},
+      {"--merge-pvs", "both"}, {"--cells", "4", "--no-such-option"}, {"--cells", "4", "--ga", "--no-ga"}};
+  for (const auto& extra : bad) {
+    std::vector<std::string> words = {"level.obj", "-o", "level.pvs"};
+    words.insert(words.end(), extra.begin(), extra.end());
+    std::string joined;
+    for (const std::string& w : extra) joined += w + " ";
+    SCOPED_TRACE(joined);
+    EXPECT_THROW(cli::bake_options_from_args(words).config(true), Error);
+    try {
+      pipeline::parse_bake_words(words).config(true);
+      ADD_FAILURE() << "the library took it";
+    } catch (const Error& e) {
+      const std::string named = extra.size() > 2 && extra[0] == "--cells" ? extra[2] : extra[0];
+      EXPECT_NE(std::string(e.what()).find(named), std::string::npos) << e.what();
+    }
+  }
+  // Without a budget: the library's message, for both.
+  EXPECT_THROW(cli::bake_options_from_args({"level.obj", "-o", "level.pvs"}).config(true), Error);
+  EXPECT_THROW(pipeline::parse_bake_words({"level.obj", "-o", "level.pvs"}).config(true), Error);
 }
 
 }  // namespace

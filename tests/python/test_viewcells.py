@@ -341,7 +341,10 @@ def test_arguments_are_checked_before_any_work(tmp_path):
         viewcells.bake(scene, str(tmp_path / "x.pvs"), cells=True)
     with pytest.raises(viewcells.Error, match="help is not an option of a bake from code") as e:
         viewcells.bake(scene, str(tmp_path / "x.pvs"), cells=2, help=True)
-    assert "--agvs-samples" in str(e.value) and "caught in your main" not in str(e.value)
+    assert "agvs_samples=" in str(e.value) and "caught in your main" not in str(e.value)
+    # The keywords and their help come from the library's table, as the command line's do.
+    assert "max_cells=INT in [1, 10000000]" in viewcells.bake.__doc__
+    assert "near_samples=" in viewcells.bake.__doc__ and "conservative=True|False" in viewcells.bake.__doc__
     with pytest.raises(viewcells.Error, match=r"seed \(keyword\): '-1' is not allowed"):
         viewcells.bake(scene, str(tmp_path / "x.pvs"), cells=2, seed=-1)
     with pytest.raises(viewcells.Error, match=r"seed \(keyword\): '100000000000000000000' is not allowed"):

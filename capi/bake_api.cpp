@@ -1,6 +1,7 @@
-// vc_bake (include/viewcells/bake.h): the scene from the caller's arrays, the options parsed by
-// the command line's own code (cli::bake_config_from_args, as the Python module does), so that
-// defaults and checks are `viewcells bake`'s, and the result returned in memory.
+// vc_bake (include/viewcells/bake.h): the scene from the caller's arrays, the option words
+// parsed by the library's table of bake options (pipeline::parse_bake_words: the table
+// `viewcells bake` and Python's keywords use too), so that defaults and checks are `viewcells
+// bake`'s, and the result returned in memory.
 #include "viewcells/bake.h"
 
 #include <cstring>
@@ -9,10 +10,10 @@
 #include <string>
 #include <vector>
 
-#include "commands.h"
 #include "viewcells/core/binary_file.h"
 #include "viewcells/core/error.h"
 #include "viewcells/pipeline/bake.h"
+#include "viewcells/pipeline/options.h"
 #include "viewcells/pipeline/report.h"
 #include "viewcells/pvs/pvs.h"
 #include "viewcells/scene/scene.h"
@@ -185,7 +186,7 @@ int vc_bake(const vc_bake_object* objects, size_t object_count, const char* cons
   }
   viewcells::pipeline::BakeConfig config;
   try {
-    config = viewcells::cli::bake_config_from_args(args, log == nullptr);
+    config = viewcells::pipeline::parse_bake_words(args).config(log == nullptr);
   } catch (const std::exception& e) {
     put_error(error, error_size, e.what());
     return 2;
