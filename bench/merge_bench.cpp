@@ -1,7 +1,7 @@
 // The merge stage alone, on a built hierarchy: the neighbour graph (partition_from_subdivision)
 // and greedy merging on the file's leaf PVSs (merge_cells), each repeated; prints each run's
 // seconds and the merge history's cost at a few counts, so that two builds can be compared on
-// the same input without the subdivision before it (scripts/bench-merge.sh).
+// the same input without the subdivision before it (scripts/bench.sh merge).
 // Usage: viewcells_merge_bench SCENE FILE.vcells [REPEATS] [THREADS]
 #include <algorithm>
 #include <chrono>

@@ -1,5 +1,5 @@
 // Point location plus PVS lookup through the runtime reader (runtime/), as an engine does per
-// frame: VIEWCELLS_BENCH_PVS names the .pvs file (scripts/bench-runtime.sh makes a 50k-cell
+// frame: VIEWCELLS_BENCH_PVS names the .pvs file (scripts/bench.sh runtime makes a 50k-cell
 // city). Viewpoints are uniform in the view box, drawn once (seed 1); each query locates one
 // and reads its cell's visible set.
 #include <benchmark/benchmark.h>

@@ -5,7 +5,7 @@
 # floors reachable from the spawn points (`measure`'s play cameras), elsewhere random points of
 # the view box looking anywhere. From the curves of measured error against the solver's time,
 # the time each method needs to reach a given error, and AGVS's speed-ups. Scenes: the office
-# of size 4 and the city of size 5 (500 cells, as scripts/bench-agvs.sh), and three OpenArena
+# of size 4 and the city of size 5 (500 cells, as scripts/bench.sh agvs), and three OpenArena
 # maps at their q3map2 cluster counts. Writes docs/agvs/measured-*.png and the section
 # "agvs-measured" of BENCHMARKS.md.
 # Usage: scripts/agvs-measured.sh [SECONDS]   (default 60)

@@ -24,7 +24,7 @@ packages=(
   libopenmpi-dev openmpi-bin   # several ranks (VIEWCELLS_MPI; the tests build with it)
   libgtest-dev libgmock-dev libbenchmark-dev   # tests and micro-benchmarks
   gnuplot-nox                                  # plots of comparisons and studies (scripts/plot-*.sh)
-  valgrind               # instruction counts of an A/B benchmark (scripts/bench-ab-instructions.sh)
+  valgrind               # instruction counts of an A/B benchmark (scripts/bench.sh ab-instructions)
   python3-dev pybind11-dev python3-pybind11 python3-numpy python3-pytest   # the Python module (python/) and its tests
   blender                # the module inside Blender 3.4, headless (tests/blender/)
   xvfb xauth             # Blender with a window, on a virtual X server (tests/blender/addon_gui_test.py),

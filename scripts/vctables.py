@@ -1592,9 +1592,31 @@ def stamp_history(*paths):
         open(path, "w").write("\n".join(out))
 
 
+@command("TSV TITLE")
+def ab_medians(path, title):
+    """An A/B table (scripts/bench.sh's ab_table): rows SIDE, QUANTITY, VALUE; per quantity each
+    run's value on both sides, the medians and new / old."""
+    rows = [line.split("\t") for line in open(path).read().split("\n") if line]
+    quantities = list(dict.fromkeys(r[1] for r in rows))
+    runs = max((sum(1 for r in rows if r[0] == "new" and r[1] == q) for q in quantities), default=0)
+    print(f"{title} Medians of {runs} run{'s' if runs != 1 else ''} a side.\n")
+    print("| quantity | old, each run | new, each run | old | new | new / old |")
+    print("| --- | --- | --- | ---: | ---: | ---: |")
+
+    def show(v):
+        return f"{v:,.0f}" if abs(v) >= 1000 else f"{v:.3g}"
+    for q in quantities:
+        v = {side: [float(r[2]) for r in rows if r[0] == side and r[1] == q] for side in ("old", "new")}
+        med = {side: statistics.median(x) if x else None for side, x in v.items()}
+        each = {side: ", ".join(show(x) for x in v[side]) or "-" for side in v}
+        ratio = f"{med['new'] / med['old']:.3f}" if med["old"] and med["new"] is not None else "-"
+        print(f"| {q} | {each['old']} | {each['new']} | {show(med['old']) if med['old'] is not None else '-'} | "
+              f"{show(med['new']) if med['new'] is not None else '-'} | {ratio} |")
+
+
 @command("SIDE SAMPLE_JSON BUILD_JSON [PVS_JSON]")
 def ab_row(side, sample_json, build_json, pvs_json=None):
-    """One row of bench-ab.sh's TSV: side, Msegments/s, raw Mrays/s, subdivision s, merge s (and AGVS Msamples/s)."""
+    """One row of bench.sh ab's TSV: side, Msegments/s, raw Mrays/s, subdivision s, merge s (and AGVS Msamples/s)."""
     s = json.load(open(sample_json))["timings"]
     b = json.load(open(build_json))["timings"]
     row = [side, s["segments_per_second"] / 1e6, s["raw_rays_per_second"] / 1e6, b["subdivision_seconds"],

@@ -86,6 +86,20 @@ class Tables(unittest.TestCase):
         # One set: the cost column alone.
         self.assertEqual(len(vctables.evaluation_sets([{"method": "a", "cells": "1", "cost": "3"}])), 1)
 
+    def test_ab_medians_gives_each_quantity_its_medians_and_ratio(self):
+        tsv = f"{self.d}/ab.tsv"
+        with open(tsv, "w") as f:
+            for side, what, v in [("old", "build s", 2.0), ("new", "build s", 1.0), ("old", "build s", 4.0),
+                                  ("new", "build s", 1.5), ("old", "build s", 3.0), ("new", "build s", 9.0),
+                                  ("old", "rate", 1000), ("new", "rate", 1500), ("new", "new only", 7)]:
+                f.write(f"{side}\t{what}\t{v}\n")
+        t = run("ab-medians", tsv, "Title.")
+        self.assertIn("Medians of 3 runs a side", t)
+        # build s: old 2, 4, 3 -> 3; new 1, 1.5, 9 -> 1.5 (a mean would say 3.83)
+        self.assertEqual(row(t, "build s")[1:], ["2, 4, 3", "1, 1.5, 9", "3", "1.5", "0.500"])
+        self.assertEqual(row(t, "rate")[3:], ["1,000", "1,500", "1.500"])
+        self.assertEqual(row(t, "new only")[1:], ["-", "7", "-", "7", "-"])
+
     def test_replace_section_keeps_the_rest(self):
         md, table = f"{self.d}/b.md", f"{self.d}/t.md"
         open(md, "w").write("head\n<!-- x:begin -->\nold\n<!-- x:end -->\ntail\n")
@@ -645,6 +659,30 @@ class MpiModelTest(unittest.TestCase):
         self.assertEqual(fields[1], f"{(1e-4 + 4e-5 + 1e-3 + 2e-4) / built(1, False):.1f}x")
         self.assertEqual(fields[2], "- / 38")
 
+
+
+class BenchDriver(unittest.TestCase):
+    """scripts/bench.sh: every command file is listed, help shows a command's usage, and a wrong
+    command or a missing earlier commit is an error before anything is built."""
+    root = os.path.join(os.path.dirname(__file__), "..", "..")
+
+    def bench(self, *args):
+        return subprocess.run(["bash", os.path.join(self.root, "scripts", "bench.sh"), *args], capture_output=True,
+                              text=True, timeout=60)
+
+    def test_lists_every_command_and_refuses_unknown_ones(self):
+        listed = self.bench("help")
+        self.assertEqual(listed.returncode, 0)
+        names = sorted(f[:-3] for f in os.listdir(os.path.join(self.root, "scripts", "bench")) if f.endswith(".sh"))
+        self.assertGreater(len(names), 15)
+        for name in names:
+            self.assertRegex(listed.stdout, rf"\n  {name} +\S")
+        self.assertIn("Usage: scripts/bench.sh ab-io OLD_COMMIT", self.bench("help", "ab-io").stdout)
+        self.assertEqual(self.bench("no-such-benchmark").returncode, 2)
+        missing = self.bench("ab-io")
+        self.assertNotEqual(missing.returncode, 0)
+        self.assertIn("OLD_COMMIT", missing.stderr)
+        self.assertEqual(self.bench("ab-io", "not-a-commit-anywhere").returncode, 2)
 
 if __name__ == "__main__":
     unittest.main()

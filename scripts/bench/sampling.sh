@@ -1,9 +1,7 @@
-#!/usr/bin/env bash
 # Sampling benchmark (issue: foundation): a generated city of >= 1M triangles, 1M segments,
 # segments per second against half the raw Embree rays per second measured in the same run.
 # Five runs per configuration by default; the table shows medians. Rewrites the sampling section of
-# BENCHMARKS.md. Usage: scripts/bench-sampling.sh [CITY_SIZE] [RUNS]
-set -euo pipefail
+# BENCHMARKS.md. Usage: scripts/bench.sh sampling [CITY_SIZE] [RUNS]
 size="${1:-23}"
 runs="${2:-5}"
 bench_cmake_args="-DVIEWCELLS_BUILD_BENCH=ON"
@@ -23,5 +21,5 @@ done
 
 python3 scripts/vctables.py sampling "$dir" "$runs" "$size" > "$dir/sampling-table.md"
 
-python3 scripts/vctables.py replace-section BENCHMARKS.md sampling "scripts/bench-sampling.sh $size $runs" "$dir/sampling-table.md"
+python3 scripts/vctables.py replace-section BENCHMARKS.md sampling "scripts/bench.sh sampling $size $runs" "$dir/sampling-table.md"
 cat "$dir/sampling-table.md"

@@ -1,4 +1,3 @@
-#!/usr/bin/env bash
 # Instructions the subdivision executes, an earlier commit against the current tree, counted by
 # callgrind (valgrind): a count does not drift with the machine's speed as wall-clock time does
 # here (up to 1.6x over an hour), so it tells a change of work from noise. Runs the city,
@@ -6,11 +5,8 @@
 # positions), once per build under callgrind (about 50 times slower than without), and prints the
 # instructions of the whole run, of the subdivision (Builder::run) and of the candidate
 # evaluations, each new / old, and the final construction costs (which must match for the same
-# work). The old commit is built (Release) in a git worktree under out/ab/, as bench-ab.sh does.
-# Usage: scripts/bench-ab-instructions.sh OLD_COMMIT [CITY_SIZE] [SEGMENTS] [CELLS]
-set -euo pipefail
-cd "$(dirname "$0")/.."
-old="${1:?usage: scripts/bench-ab-instructions.sh OLD_COMMIT [CITY_SIZE] [SEGMENTS] [CELLS]}"
+# work). The old commit is built (Release) in a git worktree under out/ab/, as bench.sh ab does.
+# Usage: scripts/bench.sh ab-instructions OLD_COMMIT [CITY_SIZE] [SEGMENTS] [CELLS]
 size="${2:-23}"
 segments="${3:-200000}"
 cells="${4:-5000}"

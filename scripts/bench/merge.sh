@@ -1,4 +1,3 @@
-#!/usr/bin/env bash
 # Merging and PVS compression benchmark (issue: merge history, extraction, compression).
 # The generated city (>= 1M triangles): 1.5M segments, 50k AV-S cells, merged to one; and the
 # compression ratios of the sampled PVSs on the office and the city at several view cell
@@ -7,8 +6,7 @@
 # PVSs and the neighbour graph. The neighbour graph and the greedy merge are also timed alone on
 # the greedy run's file (bench/merge_bench.cpp, fastest of 3), which the machine's drift
 # disturbs less than one run of the whole build. Rewrites the merging section of BENCHMARKS.md.
-# Usage: scripts/bench-merge.sh [CITY_SIZE] [CELLS]
-set -euo pipefail
+# Usage: scripts/bench.sh merge [CITY_SIZE] [CELLS]
 size="${1:-23}"
 cells="${2:-50000}"
 bench_cmake_args="-DVIEWCELLS_BUILD_BENCH=ON"
@@ -31,5 +29,5 @@ for n in 2000 200 20; do
     --report "$dir/compress-office-$n.json" -q
 done
 python3 scripts/vctables.py merging "$dir" "$size" "$cells" > "$dir/merge-table.md"
-python3 scripts/vctables.py replace-section BENCHMARKS.md merging "scripts/bench-merge.sh $size $cells" "$dir/merge-table.md"
+python3 scripts/vctables.py replace-section BENCHMARKS.md merging "scripts/bench.sh merge $size $cells" "$dir/merge-table.md"
 cat "$dir/merge-table.md"

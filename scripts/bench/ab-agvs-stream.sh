@@ -1,4 +1,3 @@
-#!/usr/bin/env bash
 # A/B of AGVS's sample stream against an earlier commit, measured in one run (issue 58: the
 # stationary distributions' chunks became Halton index ranges, drawn by the rank that casts
 # them). Without a view space (the office, the city) the stream must not change: their .pvs
@@ -10,11 +9,8 @@
 # map and sample count, each side's seconds and the spread of the measured error (share of
 # frames with any wrong pixel, mean wrong pixels per 1024x1024 frame, 99th percentile, worst),
 # medians over the seeds, and the seeds' range of the share, which is the noise.
-# Usage: scripts/bench-ab-agvs-stream.sh OLD_COMMIT [SECONDS] [MAP ...]
+# Usage: scripts/bench.sh ab-agvs-stream OLD_COMMIT [SECONDS] [MAP ...]
 #   (default: 20 s; aggressor oa_dm4 kaos, from the held-out half of docs/accuracy-vs-time.md)
-set -euo pipefail
-cd "$(dirname "$0")/.."
-old="${1:?usage: scripts/bench-ab-agvs-stream.sh OLD_COMMIT [SECONDS] [MAP ...]}"
 seconds="${2:-20}"
 shift $(($# >= 2 ? 2 : 1))
 maps=("$@")
@@ -54,7 +50,7 @@ import json, statistics, sys, subprocess
 out, sha, seconds, maps = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:]
 commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
 date = subprocess.run(["date", "+%Y-%m-%d"], capture_output=True, text=True).stdout.strip()
-print(f"Command: `scripts/bench-ab-agvs-stream.sh {sha} {seconds} {' '.join(maps)}`\n")
+print(f"Command: `scripts/bench.sh ab-agvs-stream {sha} {seconds} {' '.join(maps)}`\n")
 print(f"{date}, old {sha} against new {commit} (with its uncommitted changes, if any), 2 threads, one run. "
       + open(f"{out}/identity.txt").read().replace("\n", "; ").rstrip("; ") + ". "
       f"On each map: 300 cells, `pvs --time {seconds}`, seeds 1 and 2, measured by 1,000 play cameras of 64x64 "

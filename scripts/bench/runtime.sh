@@ -1,10 +1,8 @@
-#!/usr/bin/env bash
 # The runtime reader for engines (runtime/): point location plus PVS lookup per query on a
 # .pvs of the city with CELLS view cells, one core, Google Benchmark (bench/runtime_bench.cpp).
 # The hierarchy is the merging benchmark's (1.5M segments, 50k AV-S cells; built here when
 # missing). Rewrites the runtime section of BENCHMARKS.md.
-# Usage: scripts/bench-runtime.sh [CITY_SIZE] [CELLS]
-set -euo pipefail
+# Usage: scripts/bench.sh runtime [CITY_SIZE] [CELLS]
 size="${1:-23}"
 cells="${2:-50000}"
 bench_cmake_args="-DVIEWCELLS_BUILD_BENCH=ON"
@@ -22,6 +20,6 @@ VIEWCELLS_BENCH_PVS="$dir/city-$cells.pvs" VIEWCELLS_BENCH_PVS_FORMAT1="$dir/cit
   --benchmark_format=json --benchmark_out="$dir/runtime.json" >/dev/null
 python3 scripts/vctables.py runtime "$dir/runtime.json" "$cells" "$objects" \
   "$(stat -c %s "$dir/city-$cells.pvs")" "$(stat -c %s "$dir/city-$cells-format1.pvs")" > "$dir/runtime-table.md"
-python3 scripts/vctables.py replace-section BENCHMARKS.md runtime "scripts/bench-runtime.sh $size $cells" \
+python3 scripts/vctables.py replace-section BENCHMARKS.md runtime "scripts/bench.sh runtime $size $cells" \
   "$dir/runtime-table.md"
 cat "$dir/runtime-table.md"

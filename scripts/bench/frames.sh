@@ -1,12 +1,10 @@
-#!/usr/bin/env bash
 # Measuring frames (issue: measure at the resolution players play at): primary rays a second at
 # 1024x768 cast as coherent 4x4-pixel packets (rtcIntersect16) against the same frames' rays
 # cast as incoherent single rays (rtcIntersect1M), both timed by `viewcells measure` in one run
 # (its report's cameras.primary_rays_per_second), and the whole measurement's time, on the
 # office, the city and two maps (oa_dm2, and oa_thor, the most detailed). Each scene gets a
 # small bake to measure. Rewrites the "frames" section of BENCHMARKS.md.
-# Usage: scripts/bench-frames.sh [FRAMES]   (default 200)
-set -euo pipefail
+# Usage: scripts/bench.sh frames [FRAMES]   (default 200)
 frames="${1:-200}"
 source "$(dirname "$0")/bench-setup.sh"
 out="$dir/frames"
@@ -37,5 +35,5 @@ for name, path in zip(rest[::2], rest[1::2]):
     print(f"| {name} | {p['coherent'] / 1e6:.1f} | {p['incoherent'] / 1e6:.1f} | {p['coherent'] / p['incoherent']:.2f}x | "
           f"{r['seconds']:.1f} | {e['frames_with_wrong_pixels_share'] * 100:.1f}% | {e['pixels']:.1f} | {e['p99_pixels']:.0f} | {e['worst_pixels']:.0f} |")
 PY
-python3 scripts/vctables.py replace-section BENCHMARKS.md frames "scripts/bench-frames.sh $frames" "$out/table.md"
+python3 scripts/vctables.py replace-section BENCHMARKS.md frames "scripts/bench.sh frames $frames" "$out/table.md"
 cat "$out/table.md"

@@ -1,4 +1,3 @@
-#!/usr/bin/env bash
 # Subdivision benchmark: the generated city (>= 1M triangles), segments to 50k cells, time per
 # phase, with the default (fast) candidate positions and with --exact-candidates (the paper's
 # choice), each size run with both in turn so that their ratio is measured in one run; how the
@@ -8,8 +7,7 @@
 # map with much water and glass), build both ways, time per candidate against the city's by
 # medians of alternating runs (RATIO_RUNS, default 5), and compare with its defaults (peak memory).
 # The stagnation stop is switched off (--min-reduction 0) so that every run reaches CELLS.
-# Rewrites the subdivision section of BENCHMARKS.md. Usage: scripts/bench-subdivision.sh [SIZE] [CELLS]
-set -euo pipefail
+# Rewrites the subdivision section of BENCHMARKS.md. Usage: scripts/bench.sh subdivision [SIZE] [CELLS]
 size="${1:-23}"
 cells="${2:-50000}"
 source "$(dirname "$0")/bench-setup.sh"
@@ -60,5 +58,5 @@ fi
 "$vc" compare "$scene" --segments 1500000 --max-cells "$cells" --min-reduction 0 --methods av-s,av-s-exact --seed 1 -q \
   -o "$dir/compare-candidates"
 python3 scripts/vctables.py subdivision "$dir" "$size" "$cells" > "$dir/subdivision-table.md"
-python3 scripts/vctables.py replace-section BENCHMARKS.md subdivision "scripts/bench-subdivision.sh $size $cells" "$dir/subdivision-table.md"
+python3 scripts/vctables.py replace-section BENCHMARKS.md subdivision "scripts/bench.sh subdivision $size $cells" "$dir/subdivision-table.md"
 cat "$dir/subdivision-table.md"

@@ -1,9 +1,7 @@
-#!/usr/bin/env bash
 # The visibility filter (issue: AGVS, deliverable 5): after a few sample counts, the mean PVS
 # size and the measured pixel error with and without the filter (object space, k = 1; and
 # with the view space filter over one neighbour). Writes the filter section of BENCHMARKS.md.
-# Usage: scripts/bench-filter.sh [KIND] [SIZE] [CELLS]   (defaults: office 4 500)
-set -euo pipefail
+# Usage: scripts/bench.sh filter [KIND] [SIZE] [CELLS]   (defaults: office 4 500)
 kind="${1:-office}"
 size="${2:-4}"
 cells="${3:-500}"
@@ -20,6 +18,6 @@ for n in 100000 1000000 10000000; do
   done
 done
 python3 scripts/vctables.py filter "$out" "$kind" "$size" "$cells" > "$out/table.md"
-python3 scripts/vctables.py replace-section BENCHMARKS.md "filter-$kind$size" "scripts/bench-filter.sh $kind $size $cells" \
+python3 scripts/vctables.py replace-section BENCHMARKS.md "filter-$kind$size" "scripts/bench.sh filter $kind $size $cells" \
   "$out/table.md"
 cat "$out/table.md"

@@ -1,10 +1,8 @@
-#!/usr/bin/env bash
 # Global visibility sampling benchmark (issue: AGVS): AGVS, SGVS and REF computing the PVSs of
 # the same view cells for the same time, their convergence curves (mean PVS size and
 # estimated pixel error against time), and how much sooner AGVS reaches the mean PVS size
 # the others reach at the end. Writes docs/agvs/*.png and the agvs section of BENCHMARKS.md.
-# Usage: scripts/bench-agvs.sh [KIND] [SIZE] [CELLS] [SECONDS]   (defaults: office 4 500 60)
-set -euo pipefail
+# Usage: scripts/bench.sh agvs [KIND] [SIZE] [CELLS] [SECONDS]   (defaults: office 4 500 60)
 kind="${1:-office}"
 size="${2:-4}"
 cells="${3:-500}"
@@ -34,5 +32,5 @@ set ylabel "pixels"; set logscale y
 plot "$out/agvs.dat" using 1:3 with lines lw 2 lc 1 title "AGVS", "$out/sgvs.dat" using 1:3 with lines lw 2 lc 2 title "SGVS", "$out/ref.dat" using 1:3 with lines lw 2 lc 3 title "REF", \
      "$out/agvs.dat" using 1:4 with lines lw 1 lc 1 dt 2 title "AGVS bound", "$out/sgvs.dat" using 1:4 with lines lw 1 lc 2 dt 2 notitle, "$out/ref.dat" using 1:4 with lines lw 1 lc 3 dt 2 notitle
 GP
-python3 scripts/vctables.py replace-section BENCHMARKS.md "agvs-$kind$size" "scripts/bench-agvs.sh $kind $size $cells $seconds" "$out/table.md"
+python3 scripts/vctables.py replace-section BENCHMARKS.md "agvs-$kind$size" "scripts/bench.sh agvs $kind $size $cells $seconds" "$out/table.md"
 cat "$out/table.md"

@@ -1,4 +1,3 @@
-#!/usr/bin/env bash
 # AGVS on one and two threads (issue 58): the city of size 23 (seed 1) cut into 500, 5,000 and
 # 50,000 view cells (one merge history of 50,000 AV-S cells from 4M construction samples), `pvs`
 # with 1M samples in batches of 20,000, seed 1, the default single mutation lane and LANES
@@ -6,8 +5,7 @@
 # phase (the report's phases) its speed-up and the serial share Amdahl's law gives from it,
 # s = 2 t2 / t1 - 1, as a share of the whole run on one thread. Also checks that one and two
 # threads wrote the same .pvs.
-# Usage: scripts/bench-agvs-threads.sh [RUNS] [LANES]   (default 3 rounds, 64 lanes)
-set -euo pipefail
+# Usage: scripts/bench.sh agvs-threads [RUNS] [LANES]   (default 3 rounds, 64 lanes)
 runs="${1:-3}"
 lanes="${2:-64}"
 source "$(dirname "$0")/bench-setup.sh"
@@ -38,7 +36,7 @@ rows = [json.loads(l) for l in open(path)]
 commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
 date = subprocess.run(["date", "+%Y-%m-%d"], capture_output=True, text=True).stdout.strip()
 cpu = subprocess.run(["sh", "-c", "grep -m1 'model name' /proc/cpuinfo | cut -d: -f2"], capture_output=True, text=True).stdout.strip()
-print(f"Command: `scripts/bench-agvs-threads.sh {runs} {lanes}`\n")
+print(f"Command: `scripts/bench.sh agvs-threads {runs} {lanes}`\n")
 print(f"{date}, commit {commit}, {cpu}, 2 cores. City of size 23, 1M AGVS samples in batches of 20,000, seed 1; "
       f"medians of {runs} alternating runs. Phases: planning the batch (draw), the mutation lanes, drawing and casting "
       "the stationary samples (cast), applying; serial: Amdahl's s = 2 t2 / t1 - 1 of the phase, as a share of the "

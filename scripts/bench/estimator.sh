@@ -1,12 +1,10 @@
-#!/usr/bin/env bash
 # The pixel error estimator against the measured pixel error (issue: AGVS, deliverable 6):
 # one computation per method, stopped at doubling sample counts (saved and resumed, which
 # continues exactly), and at each stop the estimate (equation 5's window) next to the error
 # measured by rendering random cameras. Writes docs/agvs/estimator-*.png and the estimator
 # section of BENCHMARKS.md.
-# Usage: scripts/bench-estimator.sh [KIND] [SIZE] [CELLS] [MAX_SAMPLES] [CAMERAS] [CAMERA_SIZE]
+# Usage: scripts/bench.sh estimator [KIND] [SIZE] [CELLS] [MAX_SAMPLES] [CAMERAS] [CAMERA_SIZE]
 #        (defaults: office 4 500 64000000 20000 32)
-set -euo pipefail
 kind="${1:-office}"
 size="${2:-4}"
 cells="${3:-500}"
@@ -42,5 +40,5 @@ plot "$out/sgvs.dat" using 1:2 with linespoints lw 2 lc 2 title "SGVS estimated"
      "$out/agvs.dat" using 1:4 with points pt 7 ps 1.5 lc 1 title "AGVS measured"
 GP
 python3 scripts/vctables.py replace-section BENCHMARKS.md "estimator-$kind$size" \
-  "scripts/bench-estimator.sh $kind $size $cells $max_samples $cameras $camera_size" "$out/table.md"
+  "scripts/bench.sh estimator $kind $size $cells $max_samples $cameras $camera_size" "$out/table.md"
 cat "$out/table.md"

@@ -1,4 +1,3 @@
-#!/usr/bin/env bash
 # The web viewer's frame time in headless Chromium (Debian's chromium, software WebGL on
 # SwiftShader: these machines have no GPU), on the 1M-triangle city (size 23) and the office
 # (size 4): each is baked (500 view cells; 500,000 construction samples, 2,000 cells merged on
@@ -7,8 +6,7 @@
 # following its own cell, drawing everything and drawing only the cell's PVS; some at half
 # resolution (the panel's choice). Also the time from a click to the lit PVS.
 # Prints one JSON line per run and a Markdown table for BENCHMARKS.md.
-# Usage: scripts/bench-viewer.sh [SECONDS]
-set -euo pipefail
+# Usage: scripts/bench.sh viewer [SECONDS]
 source "$(dirname "$0")/bench-setup.sh"
 seconds="${1:-20}"
 out="$dir/viewer"

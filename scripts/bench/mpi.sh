@@ -1,4 +1,3 @@
-#!/usr/bin/env bash
 # MPI (issue: bakes that outgrow one machine): what the ranks exchange and where the time goes,
 # with 1, 2 and 4 ranks of one thread each on this machine (4 ranks oversubscribe its 2 cores:
 # their compute is not faster, their traffic is what it is), and one rank of two threads, for AGVS
@@ -6,8 +5,7 @@
 # for comparison) on the city of size 23 cut into 500 and 5,000 view cells, and for segment
 # sampling (`sample`, 2M samples), three rounds of each. Then the strong-scaling model of docs/distributed.md from
 # those measurements. Prints JSON lines and Markdown tables.
-# Usage: scripts/bench-mpi.sh
-set -euo pipefail
+# Usage: scripts/bench.sh mpi
 bench_cmake_args="-DVIEWCELLS_MPI=ON"
 source "$(dirname "$0")/bench-setup.sh"
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
@@ -57,4 +55,4 @@ for n in 2 4; do
   done
 done
 python3 scripts/vctables.py mpi-model "$lines" | tee "$out/tables.md"
-python3 scripts/vctables.py replace-section docs/distributed.md mpi "scripts/bench-mpi.sh" "$out/tables.md"
+python3 scripts/vctables.py replace-section docs/distributed.md mpi "scripts/bench.sh mpi" "$out/tables.md"
