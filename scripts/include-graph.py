@@ -2,7 +2,7 @@
 """The include graph of the project's modules as a Mermaid flowchart, at a git revision.
 
 A module is a directory of libviewcells (include/viewcells/M/ and src/M/), or format, runtime,
-studies and cli. An arrow A --> B with a count says that many #include lines of A's files name a header
+studies, cli, capi and python. An arrow A --> B with a count says that many #include lines of A's files name a header
 of B. Arrows that run up the layers (the order of libviewcells/CMakeLists.txt's vc_layer calls
 at the working tree; format at the bottom, then the library, the runtime beside it, the CLI on
 top) or into another module's private sources are drawn red: with one-way layers there are none.
@@ -25,7 +25,7 @@ def git(*args):
 
 
 def files():
-    roots = ["libviewcells", "runtime", "format", "studies", "cli"]
+    roots = ["libviewcells", "runtime", "format", "studies", "cli", "capi", "python"]
     if rev:
         names = git("ls-tree", "-r", "--name-only", rev, "--", *roots).split()
     else:
@@ -46,7 +46,7 @@ def module_of_file(name):
         return parts[3]
     if parts[0] == "libviewcells" and len(parts) > 2 and parts[1] == "src":
         return parts[2]
-    return parts[0] if parts[0] in ("runtime", "format", "studies", "cli") else None
+    return parts[0] if parts[0] in ("runtime", "format", "studies", "cli", "capi", "python") else None
 
 
 def module_of_include(path):
@@ -54,6 +54,8 @@ def module_of_include(path):
     parts = path.split("/")
     if parts[0] == "viewcells" and len(parts) > 2:
         return parts[1], False
+    if path == "viewcells/bake.h":
+        return "capi", False  # vc_bake's public header
     if parts[0] == "viewcells":
         return "runtime", False  # viewcells/runtime.hpp, the runtime's public header
     if "runtime" in parts and "src" in parts:
@@ -74,6 +76,7 @@ rank.setdefault("cluster", rank.get("core", 1))  # core/cluster before it was co
 rank["runtime"] = 1
 rank["studies"] = top + 1  # studies/: above the pipeline, beside the product
 rank["cli"] = top + 2
+rank["capi"] = rank["python"] = top + 2  # the other front ends, beside the command line
 
 edges = collections.Counter()
 red = set()
