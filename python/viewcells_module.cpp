@@ -724,6 +724,28 @@ PYBIND11_MODULE(viewcells, m) {
         return py::make_tuple(v, t);
       }, "The reached floors to draw, 3 cm above them: (vertices (V, 3) float32, triangles (T, 3))");
 
+  m.def(
+      "bake_options",
+      [] {
+        py::list out;
+        const pipeline::BakeOptions defaults;
+        for (const pipeline::BakeOption& o : pipeline::bake_option_table()) {
+          static const char* kinds[] = {"flag", "whole", "number", "text", "texts"};
+          py::dict d;
+          d["keyword"] = o.keyword;
+          d["flag"] = o.flag;
+          d["negation"] = o.negation;
+          d["kind"] = kinds[static_cast<int>(o.kind)];
+          d["type"] = o.type;
+          d["help"] = o.help;
+          d["default"] = o.show_default ? py::object(py::str(o.show(defaults))) : py::object(py::none());
+          out.append(d);
+        }
+        return out;
+      },
+      "The bake's options as the library's table lists them (what `viewcells bake --help` and bake()'s keywords "
+      "are made from): a dict each with keyword, flag, negation (a flag's off switch, or ''), kind (flag, whole, "
+      "number, text, texts: repeatable), type (the values it takes), help and default (as help shows it, or None).");
   m.def("play_space", &play_space, py::arg("scene"), py::kw_only(), py::arg("start") = std::vector<std::array<double, 3>>{},
         py::arg("metres_per_unit") = floors.metres_per_unit, py::arg("only_from_starts") = floors.only_from_starts,
         py::arg("region_margin") = floors.region_margin, py::arg("player_height") = floors.player_height,

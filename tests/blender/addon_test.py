@@ -116,7 +116,7 @@ if not (60 < area < 100 and xs.min() < -4 and xs.max() > 4):
 if "reachable from 1 of 1 start points" not in play_obj["rule"]:
     fail("the play space did not start from the PlayerStart: " + play_obj["rule"])
 
-options = ["--samples", "30000", "--max-cells", "24", "--agvs-samples", "30000"]
+options = ["--samples", "30000", "--max-cells", "24", "--agvs-samples=30000", "--no-prove-hidden"]
 s = bpy.context.scene.viewcells
 s.cells = 6
 s.time = 0

@@ -1,6 +1,7 @@
 """The Python module `viewcells` (python/): a scene from numpy arrays or a file, baked with the
 command line's options and defaults, read back as arrays. Run by ctest (tests/CMakeLists.txt)
 with the system Python 3 and PYTHONPATH at the built module; VIEWCELLS_CLI names the executable."""
+import importlib.util
 import json
 import os
 import subprocess
@@ -472,3 +473,31 @@ def test_play_space_from_python(office, tmp_path):
         viewcells.play_space(str(office / "office.obj"), eye_band=(2, 1))
     with pytest.raises(TypeError, match="play_space: scene must be"):
         viewcells.play_space(3)
+
+
+def test_the_table_of_options_is_the_command_lines(tmp_path):
+    """bake_options() is the library's table that `viewcells bake --help` and bake()'s keywords
+    are made from; the Blender add-on reads its extra option words with it."""
+    table = viewcells.bake_options()
+    by_flag = {o["flag"]: o for o in table}
+    assert by_flag["--max-cells"]["keyword"] == "max_cells" and by_flag["--max-cells"]["kind"] == "whole"
+    assert by_flag["--prove-hidden"]["negation"] == "--no-prove-hidden"
+    assert by_flag["--start"]["kind"] == "texts" and by_flag["--samples"]["default"] == "1000000"
+    cli = os.environ.get("VIEWCELLS_CLI")
+    if cli:
+        helped = subprocess.run([cli, "bake", "--help"], capture_output=True, text=True, check=True).stdout
+        for o in table:
+            assert o["flag"] in helped and o["help"][:40] in helped.replace("\n", " "), o["flag"]
+    spec = importlib.util.spec_from_file_location(
+        "addon_options", os.path.join(os.path.dirname(__file__), "..", "..", "tools", "blender", "viewcells_blender",
+                                      "options.py"))
+    addon = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(addon)
+    words = addon.option_words("--no-ga --start 1,2,0 --start=5,2,0 --no-prove-hidden --holes=1% --samples 30000 "
+                               "--conservative=false", table)
+    assert words == {"no_ga": True, "start": ["1,2,0", "5,2,0"], "prove_hidden": False, "holes": "1%",
+                     "samples": "30000", "conservative": False}, words
+    with pytest.raises(ValueError, match="'--nope' is not an option"):
+        addon.option_words("--nope 3", table)
+    with pytest.raises(ValueError, match="--samples needs a value"):
+        addon.option_words("--samples", table)

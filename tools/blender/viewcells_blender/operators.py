@@ -27,7 +27,7 @@ class VIEWCELLS_OT_bake(bpy.types.Operator):
         scene = vc.Scene(v, t, objects=o, names=names, see_through=see_through,
                          name=bpy.path.basename(bpy.data.filepath) or "blender scene")
         output = bpy.path.abspath(settings.output)
-        options = bake_options(settings)
+        options = bake_options(settings, vc.bake_options())
         starts = start_points(context)
         if starts and "start" not in options:
             options["start"] = starts  # the play space's start points, as a glTF export carries them
