@@ -169,24 +169,29 @@ std::string keyword_listing() {
   return out;
 }
 
-/// A message of the command-line parser with each option the caller gave as a keyword named as
-/// that keyword: "--max-cells" -> "max_cells (keyword)".
-std::string as_keywords(std::string message, const py::kwargs& options) {
-  for (const auto& item : options) {
-    const std::string key = py::str(item.first);
-    std::string option = "--" + key;
-    for (char& c : option)
-      if (c == '_') c = '-';
-    for (size_t at = message.find(option); at != std::string::npos; at = message.find(option, at)) {
-      const size_t end = at + option.size();
-      if (end < message.size() && (std::isalnum(static_cast<unsigned char>(message[end])) || message[end] == '-')) {
+/// A library message with every option of the bake named as Python names it: "--max-cells" ->
+/// "max_cells (keyword)", "--no-prove-hidden" -> "prove_hidden=False (keyword)".
+std::string as_keywords(std::string message) {
+  std::vector<std::pair<std::string, std::string>> names;
+  for (const pipeline::BakeOption& o : pipeline::bake_option_table()) {
+    names.push_back({o.flag, o.keyword + " (keyword)"});
+    if (!o.negation.empty()) names.push_back({o.negation, o.keyword + "=False (keyword)"});
+  }
+  // Longer flags first, so that none is taken for a part of another.
+  std::sort(names.begin(), names.end(), [](const auto& x, const auto& y) { return x.first.size() > y.first.size(); });
+  for (const auto& [flag, keyword] : names)
+    for (size_t at = message.find(flag); at != std::string::npos; at = message.find(flag, at)) {
+      const size_t end = at + flag.size();
+      const bool inside = (end < message.size() && (std::isalnum(static_cast<unsigned char>(message[end])) ||
+                                                     message[end] == '-')) ||
+                          (at > 0 && (std::isalnum(static_cast<unsigned char>(message[at - 1])) || message[at - 1] == '-'));
+      if (inside) {
         at = end;
         continue;
       }
-      message.replace(at, option.size(), key + " (keyword)");
-      at += key.size();
+      message.replace(at, flag.size(), keyword);
+      at += keyword.size();
     }
-  }
   return message;
 }
 
@@ -531,7 +536,7 @@ std::shared_ptr<Baked> bake(const py::object& scene, const py::object& output_pa
     }
     config = bake_options.config(progress.is_none());
   } catch (const Error& e) {
-    throw Error(as_keywords(e.what(), options));
+    throw Error(as_keywords(e.what()));
   }
   if (memory) config.scene.scene = memory;
   if (!report.empty()) {
@@ -546,12 +551,18 @@ std::shared_ptr<Baked> bake(const py::object& scene, const py::object& output_pa
       progress(line);
     };
   pipeline::BakeResult result;
-  run_interruptible([&] {
-    OutputBatch outputs;  // written in place only when the whole bake succeeded, as the CLI does
-    result = pipeline::bake(config, log);
-    if (!report.empty()) pipeline::write_report(report, result);
-    outputs.commit();
-  });
+  try {
+    run_interruptible([&] {
+      OutputBatch outputs;  // written in place only when the whole bake succeeded, as the CLI does
+      result = pipeline::bake(config, log);
+      if (!report.empty()) pipeline::write_report(report, result);
+      outputs.commit();
+    });
+  } catch (const Interrupted&) {
+    throw;
+  } catch (const Error& e) {
+    throw Error(as_keywords(e.what()));  // the library's advice ("raise --max-cells") in Python's words
+  }
   auto out = std::make_shared<Baked>(output, *result.file, memory, config.model);
   if (!memory) out->scene_file = config.scene;
   out->report = py::module_::import("json").attr("loads")(pipeline::report_json(result));

@@ -97,8 +97,10 @@ def test_progress_and_see_through_and_errors(office, tmp_path):
     for c in range(baked.cell_count):
         seen.update(baked.pvs(c).tolist())
     assert seen == {0, 1, 2}, "both boxes seen through the glass"
-    with pytest.raises(viewcells.Error, match="max-cells"):
+    with pytest.raises(viewcells.Error, match=r"raise max_cells \(keyword\) or lower cells \(keyword\)"):
         viewcells.bake(scene, str(tmp_path / "x.pvs"), cells=5, max_cells=2)
+    with pytest.raises(viewcells.Error, match=r"needs a budget: cells \(keyword\) N or memory \(keyword\)"):
+        viewcells.bake(scene, str(tmp_path / "x.pvs"))
     with pytest.raises(viewcells.Error, match="NaN or infinite"):
         viewcells.Scene(np.array([[np.nan, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2]]))
     with pytest.raises(viewcells.Error, match=r"triangle 0 \(counting from 0\) has vertex index 99, not from 0 to 7"):
