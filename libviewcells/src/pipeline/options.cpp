@@ -571,10 +571,12 @@ std::vector<BakeOption> make_table() {
                               "Metres in one unit of the scene (default: the file's own: 1 for glTF, 1/32 for a Quake "
                               "3 map; 1 when the file does not say, e.g. OBJ)"),
                        g));
-  BakeOption start = text("--start", FIELD(sampling.floors.starts[0]),
-                          "Where players start, X,Y,Z in scene units (repeatable; default: the file's spawn nodes, else "
-                          "every floor region of at least --min-region)");
+  BakeOption start;  // repeatable: each value is one more start point
+  start.flag = "--start";
   start.kind = Kind::kTexts;
+  start.help = "Where players start, X,Y,Z in scene units (repeatable; default: the file's spawn nodes, else every "
+               "floor region of at least --min-region)";
+  start.check = [](const std::string&) { return std::string(); };
   start.set = [](BakeOptions& b, const std::string& xyz) { b.sampling.floors.starts.push_back(xyz); };
   start.show = [](const BakeOptions&) { return std::string(); };
   t.push_back(in_group(start, g));
