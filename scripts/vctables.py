@@ -9,6 +9,7 @@ Usage: vctables.py COMMAND ARGS...   (vctables.py --help lists the commands)
 import csv
 import datetime
 import glob
+import inspect
 import json
 import subprocess
 import math
@@ -72,10 +73,9 @@ def command(args):
 
 
 @command("DIR RUNS SIZE")
-def sampling(*args):
+def sampling(folder, runs, size):
     """BENCHMARKS.md, sampling: medians of the sample reports of both view spaces."""
-    argv = ["vctables"] + list(args)
-    d, runs, size = argv[1], int(argv[2]), argv[3]
+    d, runs = folder, int(runs)
     rows = []
     for name in ["scene-bounds", "street-band"]:
         reps = [json.load(open(f"{d}/sample-{name}-{r}.json")) for r in range(1, runs + 1)]
@@ -102,10 +102,9 @@ def sampling(*args):
 
 
 @command("DIR SIZE CELLS")
-def subdivision(*args):
+def subdivision(folder, size, cells):
     """BENCHMARKS.md, subdivision: fast and exact candidates at 0.5M-2M segments, growth per doubling, evaluated costs."""
-    argv = ["vctables"] + list(args)
-    d, size, cells = argv[1], argv[2], argv[3]
+    d = folder
     print(f"City size {size} (seed 1), {int(cells):,} cells, default view box, no stagnation stop, no merge, threads = 2. "
           "Fast: the default candidate positions; exact: `--exact-candidates`, the paper's. Each size ran fast, then "
           "exact, in one run of the script.\n")
@@ -205,10 +204,9 @@ def subdivision(*args):
 
 
 @command("DIR SIZE CELLS")
-def merging(*args):
+def merging(folder, size, cells):
     """BENCHMARKS.md, merging: merge and compression reports of the city and the office."""
-    argv = ["vctables"] + list(args)
-    d, size, cells = argv[1], argv[2], int(argv[3])
+    d, cells = folder, int(cells)
     print(f"Merging: the city of size {size} (seed 1), 1.5M segments, {cells:,} AV-S cells merged down to one; "
           "the office of size 4, 1M samples, 2,000 cells. Threads = 2.\n")
     print("| scene | merge PVSs | cells merged | subdivision s | leaf PVSs s | neighbour graph s | merge s | "
@@ -249,28 +247,25 @@ def merging(*args):
 
 
 @command("RESULTS_TSV SHA RUNS SIZE")
-def ab(*args):
+def ab(results_tsv, sha, runs, size):
     """BENCHMARKS.md, ab: medians of alternating old/new runs (rows from ab-row) and their ratios."""
-    argv = ["vctables"] + list(args)
-    rows = [l.split('\t') for l in open(argv[1]).read().split('\n') if l]
+    rows = [l.split('\t') for l in open(results_tsv).read().split('\n') if l]
     width = min(len(r) for r in rows)
     med = {side: [statistics.median(float(r[k]) for r in rows if r[0] == side) for k in range(1, width)]
            for side in ('old', 'new')}
     names = ['sampling Msegments/s', 'raw Embree Mrays/s', 'subdivision s (20k cells)', 'merge s (20k cells)',
              'AGVS Msamples/s (office 4, 500 cells)'][:width - 1]
-    print(f"City size {argv[4]}, office size 4; medians of {argv[3]} alternating runs of the old ({argv[2]}) and the "
+    print(f"City size {size}, office size 4; medians of {runs} alternating runs of the old ({sha}) and the "
           f"new build; threads = 2.\n")
-    print('| quantity | old (' + argv[2] + ') | new | new / old |')
+    print('| quantity | old (' + sha + ') | new | new / old |')
     print('| --- | ---: | ---: | ---: |')
     for n, o, w in zip(names, med['old'], med['new']):
         print(f'| {n} | {o:.2f} | {w:.2f} | {w / o:.3f} |')
 
 
 @command("OUT KIND SIZE CELLS SECONDS")
-def agvs(*args):
+def agvs(out, kind, size, cells, seconds):
     """BENCHMARKS.md, agvs-KINDSIZE: AGVS, SGVS and REF reports; writes OUT/METHOD.dat for the plots."""
-    argv = ["vctables"] + list(args)
-    out, kind, size, cells, seconds = argv[1:6]
     r = {m: json.load(open(f"{out}/{m}.json")) for m in ("agvs", "sgvs", "ref")}
     for m in r:
         with open(f"{out}/{m}.dat", "w") as f:
@@ -323,10 +318,8 @@ def agvs(*args):
 
 
 @command("OUT KIND SIZE CELLS MAX_SAMPLES CAMERAS CAMERA_SIZE")
-def estimator(*args):
+def estimator(out, kind, size, cells, max_samples, cameras, camera_size):
     """BENCHMARKS.md, estimator-KINDSIZE: estimated against measured pixel error; writes OUT/METHOD.dat."""
-    argv = ["vctables"] + list(args)
-    out, kind, size, cells, max_samples, cameras, camera_size = argv[1:8]
     rows = {}
     for m in ("sgvs", "agvs"):
         runs = sorted((json.load(open(f)) for f in glob.glob(f"{out}/{m}-*.json")), key=lambda r: r["samples"])
@@ -363,10 +356,8 @@ def estimator(*args):
 
 
 @command("OUT KIND SIZE CELLS")
-def filter(*args):
+def filter(out, kind, size, cells):
     """BENCHMARKS.md, filter-KINDSIZE: mean PVS and measured error with and without the filter."""
-    argv = ["vctables"] + list(args)
-    out, kind, size, cells = argv[1:5]
     print(f"AGVS on the {kind} of size {size} (seed 1), {cells} view cells. Measured pixel error: 20,000 random cameras "
           f"of 32x32, in pixels of a 1024x1024 image. Object space filter with k = 1; 'and view space': also merged "
           f"with the most similar neighbouring cell.\n")
@@ -383,10 +374,9 @@ def filter(*args):
 
 
 @command("DIR CELLS SIZE")
-def accuracy(*args):
+def accuracy(folder, cells, size):
     """docs/accuracy-vs-time.md from the comparisons and the leak study."""
-    argv = ["vctables"] + list(args)
-    d, cells, size = argv[1], int(argv[2]), argv[3]
+    d, cells = folder, int(cells)
     def curve(run, method):
         return {int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/{run}/curves.csv")) if r["method"] == method}
     def constructed(run, method):
@@ -465,10 +455,9 @@ def accuracy(*args):
 
 
 @command("DIR SCENE")
-def accuracy_samples_dat(*args):
+def accuracy_samples_dat(folder, scene):
     """Plot data: evaluated cost per cell count for each construction sample count."""
-    argv = ["vctables"] + list(args)
-    d, scene = argv[1], argv[2]
+    d = folder
     runs = [50000, 200000, 1000000, 2000000]
     cols = [{int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/samples-{scene}-{n}/curves.csv"))} for n in runs]
     print("cells " + " ".join(f"{n // 1000}k" for n in runs))
@@ -477,10 +466,9 @@ def accuracy_samples_dat(*args):
 
 
 @command("DIR")
-def ga_ratio_dat(*args):
+def ga_ratio_dat(folder):
     """Plot data: cost ratio axis-aligned only / with geometry-aligned candidates."""
-    argv = ["vctables"] + list(args)
-    d = argv[1]
+    d = folder
     off = {int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/ga-off/curves.csv")) if r["method"] == "av-s"}
     on = {int(r["cells"]): float(r["cost"]) for r in csv.DictReader(open(f"{d}/ga-150/curves.csv")) if r["method"] == "av-s"}
     for c in sorted(set(off) & set(on)):
@@ -488,10 +476,9 @@ def ga_ratio_dat(*args):
 
 
 @command("DIR")
-def compare_histogram(*args):
+def compare_histogram(folder):
     """DIR/histogram.dat: volume-weighted histograms of the cells' render cost, 24 common bins."""
-    argv = ["vctables"] + list(args)
-    d = argv[1]
+    d = folder
     rows = list(csv.DictReader(open(f"{d}/histogram.csv")))
     if not rows:
         open(f"{d}/histogram.dat", "w").write("")
@@ -513,12 +500,11 @@ def compare_histogram(*args):
             f.write(f"{(b + 0.5) * top / bins:.6g} " + " ".join(f"{share[m][b] / total[m]:.6g}" for m in methods) + "\n")
 
 
-@command("DIR CELLS SAMPLES SIZE")
-def results(*args):
+@command("DIR CELLS SAMPLES SIZE [EVAL_SAMPLES]")
+def results(folder, cells, samples, size, eval_samples_given=None):
     """docs/results.md from the comparisons of the office, rotated office, city and town."""
-    argv = ["vctables"] + list(args)
-    d, cells, samples, size = argv[1], int(argv[2]), int(argv[3]), argv[4]
-    eval_samples = int(argv[5]) if len(argv) > 5 else 4 * samples
+    d, cells, samples = folder, int(cells), int(samples)
+    eval_samples = int(eval_samples_given) if eval_samples_given is not None else 4 * samples
     names = {"av-m": "AV-M", "av-m-samples": "AV-M (old)", "av-s": "AV-S", "av-s-exact": "AV-S (exact candidates)", "kd-casm": "KD-CASM", "kd-lasm": "KD-LASM",
              "kd-vt": "KD-VT", "kd-vt-star": "KD-VT*", "bsp": "BSP"}
     print("# Results: view cell construction methods compared\n")
@@ -793,10 +779,9 @@ def candidates_dat(d):
 
 
 @command("OUT SAMPLES CELLS")
-def merge_vs_time(*args):
+def merge_vs_time(out, samples, cells):
     """The merge section of docs/accuracy-vs-time.md from scripts/merge-vs-time.sh's runs."""
-    argv = ["vctables"] + list(args)
-    d, samples, cells = argv[1], int(argv[2]), int(argv[3])
+    d, samples, cells = out, int(samples), int(cells)
     print(f"Each scene: {samples:,} construction samples, AV-S to {cells:,} cells, evaluated on "
           f"{4 * samples:,} independent samples (seed 99); the same leaves merged four ways. \"AGVS per run\" is "
           "the samples of each of the two AGVS runs over the leaves (one to merge on, one held out to choose the "
@@ -833,10 +818,9 @@ def merge_vs_time(*args):
 
 
 @command("OUT SAMPLES EVAL_SAMPLES")
-def maps(*args):
+def maps(out, samples, eval_samples):
     """docs/results/q3-maps.md and .csv from the comparisons with q3map2 on every map."""
-    argv = ["vctables"] + list(args)
-    out, samples, eval_samples = argv[1], int(argv[2]), int(argv[3])
+    samples, eval_samples = int(samples), int(eval_samples)
     rows, skipped, failed = [], [], []
     for info_path in sorted(glob.glob(f"{out}/*.info.json")):
         name = os.path.basename(info_path)[:-len(".info.json")]
@@ -1153,10 +1137,9 @@ def agvs_measured(out, seconds, *scenes):
 
 
 @command("PK3 OUT_DIR")
-def unpack_maps(*args):
+def unpack_maps(pk3, out_dir):
     """Extracts maps/*.bsp from a .pk3 (zip) into a directory, each file atomically."""
-    argv = ["vctables"] + list(args)
-    pk3, out = argv[1], argv[2]
+    out = out_dir
     with zipfile.ZipFile(pk3) as z:
         for info in z.infolist():
             name = info.filename
@@ -1720,6 +1703,11 @@ def main(argv):
         print(f"vctables: no command '{name}' (--help lists them)", file=sys.stderr)
         return 2
     f, args, _ = COMMANDS[name]
+    try:
+        inspect.signature(f).bind(*argv[2:])
+    except TypeError:
+        print(f"usage: vctables {name} {args}", file=sys.stderr)
+        return 2
     f(*argv[2:])
     return 0
 
