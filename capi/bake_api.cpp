@@ -78,8 +78,29 @@ std::shared_ptr<const viewcells::Scene> scene_from(const vc_bake_object* objects
 }
 
 /// Bakes `config` (its scene set here) into a result; the error codes of bake.h.
+/// The options vc_bake_config sets, as its fields: the library's messages name flags.
+const std::vector<std::pair<std::string, std::string>> kConfigFields = {
+    {"--cells", "cells (vc_bake_config)"},
+    {"--memory", "memory_bytes (vc_bake_config)"},
+    {"--memory-of", "memory_of_lists (vc_bake_config)"},
+    {"--samples", "samples (vc_bake_config)"},
+    {"--seed", "seed (vc_bake_config)"},
+    {"--pixel-error", "pixel_error (vc_bake_config)"},
+    {"--agvs-samples", "agvs_samples (vc_bake_config)"},
+    {"--holes", "holes (vc_bake_config)"},
+    {"--time", "time_seconds (vc_bake_config)"},
+    {"--near-samples", "near_samples (vc_bake_config)"},
+    {"--play-space", "play_space (vc_bake_config)"},
+    {"--prove-hidden", "prove_hidden (vc_bake_config)"},
+    {"--conservative", "conservative (vc_bake_config)"},
+    {"--metres-per-unit", "metres_per_unit (vc_bake_config)"},
+    {"--start", "start_points (vc_bake_config)"}};
+
+/// Bakes `config` from the caller's objects; a message names options as `names` says (empty:
+/// as flags, for vc_bake's words).
 int run_bake(viewcells::pipeline::BakeConfig config, const vc_bake_object* objects, size_t object_count,
-             const char* output, vc_bake_log log, void* user, vc_bake_result** out, char* error, size_t error_size) {
+             const char* output, vc_bake_log log, void* user, vc_bake_result** out, char* error, size_t error_size,
+             const std::vector<std::pair<std::string, std::string>>& names = {}) {
   try {
     config.scene.scene = scene_from(objects, object_count);
     if (!output) config.output.clear();
@@ -100,7 +121,7 @@ int run_bake(viewcells::pipeline::BakeConfig config, const vc_bake_object* objec
     put_error(error, error_size, "vc_bake: out of memory");
     return 3;
   } catch (const std::exception& e) {
-    put_error(error, error_size, e.what());
+    put_error(error, error_size, names.empty() ? e.what() : viewcells::pipeline::rename_options(e.what(), names));
     return 2;
   }
 }
@@ -163,7 +184,7 @@ int vc_bake_with_config(const vc_bake_object* objects, size_t object_count, cons
         {config->start_points[3 * i], config->start_points[3 * i + 1], config->start_points[3 * i + 2]});
   const bool quiet = log == nullptr;
   c.sampling.show_progress = c.subdivision.show_progress = c.agvs.show_progress = !quiet;
-  return run_bake(std::move(c), objects, object_count, output, log, user, out, error, error_size);
+  return run_bake(std::move(c), objects, object_count, output, log, user, out, error, error_size, kConfigFields);
 }
 
 int vc_bake(const vc_bake_object* objects, size_t object_count, const char* const* options, const char* output,

@@ -171,28 +171,13 @@ std::string keyword_listing() {
 
 /// A library message with every option of the bake named as Python names it: "--max-cells" ->
 /// "max_cells (keyword)", "--no-prove-hidden" -> "prove_hidden=False (keyword)".
-std::string as_keywords(std::string message) {
+std::string as_keywords(const std::string& message) {
   std::vector<std::pair<std::string, std::string>> names;
   for (const pipeline::BakeOption& o : pipeline::bake_option_table()) {
     names.push_back({o.flag, o.keyword + " (keyword)"});
     if (!o.negation.empty()) names.push_back({o.negation, o.keyword + "=False (keyword)"});
   }
-  // Longer flags first, so that none is taken for a part of another.
-  std::sort(names.begin(), names.end(), [](const auto& x, const auto& y) { return x.first.size() > y.first.size(); });
-  for (const auto& [flag, keyword] : names)
-    for (size_t at = message.find(flag); at != std::string::npos; at = message.find(flag, at)) {
-      const size_t end = at + flag.size();
-      const bool inside = (end < message.size() && (std::isalnum(static_cast<unsigned char>(message[end])) ||
-                                                     message[end] == '-')) ||
-                          (at > 0 && (std::isalnum(static_cast<unsigned char>(message[at - 1])) || message[at - 1] == '-'));
-      if (inside) {
-        at = end;
-        continue;
-      }
-      message.replace(at, flag.size(), keyword);
-      at += keyword.size();
-    }
-  return message;
+  return pipeline::rename_options(message, std::move(names));
 }
 
 /// A path given as str or os.PathLike (pathlib.Path); TypeError otherwise.

@@ -186,6 +186,10 @@ TEST(BakeApi, TheConfigStructIsTheLibrarysDefaultAndBakesAsTheWords) {
                                 sizeof message),
             2);
   EXPECT_NE(std::string(message).find("budget"), std::string::npos) << message;
+  // ... named as the struct's fields, not as the command line's flags.
+  EXPECT_NE(std::string(message).find("cells (vc_bake_config)"), std::string::npos) << message;
+  EXPECT_NE(std::string(message).find("memory_bytes (vc_bake_config)"), std::string::npos) << message;
+  EXPECT_EQ(std::string(message).find("--"), std::string::npos) << message;
   EXPECT_EQ(vc_bake_with_config(objects.data(), objects.size(), nullptr, nullptr, nullptr, nullptr, &fields, message,
                                 sizeof message),
             1);

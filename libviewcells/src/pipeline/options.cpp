@@ -1,6 +1,7 @@
 #include "viewcells/pipeline/options.h"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -650,6 +651,23 @@ std::string bake_options_listing() {
     out += head + "\n      " + o.help + "\n";
   }
   return out;
+}
+
+std::string rename_options(std::string message, std::vector<std::pair<std::string, std::string>> names) {
+  // Longer flags first, so that none is taken for a part of another.
+  std::sort(names.begin(), names.end(), [](const auto& x, const auto& y) { return x.first.size() > y.first.size(); });
+  auto word = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_'; };
+  for (const auto& [flag, name] : names)
+    for (size_t at = message.find(flag); at != std::string::npos; at = message.find(flag, at)) {
+      const size_t end = at + flag.size();
+      if ((end < message.size() && word(message[end])) || (at > 0 && word(message[at - 1]))) {
+        at = end;
+        continue;
+      }
+      message.replace(at, flag.size(), name);
+      at += name.size();
+    }
+  return message;
 }
 
 BakeOptions parse_bake_words(const std::vector<std::string>& words) {

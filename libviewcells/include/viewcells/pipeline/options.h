@@ -152,5 +152,8 @@ void set_bake_option(BakeOptions& options, const BakeOption& option, const std::
 BakeOptions parse_bake_words(const std::vector<std::string>& words);
 /// A listing of the options (flag, value, help), for errors that list them.
 std::string bake_options_listing();
+/// `message` with every whole flag of `names` ({"--max-cells", "max_cells (keyword)"}) replaced
+/// by its name there: a binding's words for the options the library's messages name.
+std::string rename_options(std::string message, std::vector<std::pair<std::string, std::string>> names);
 
 }  // namespace viewcells::pipeline
