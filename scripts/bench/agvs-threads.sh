@@ -8,7 +8,7 @@
 # Usage: scripts/bench.sh agvs-threads [RUNS] [LANES]   (default 3 rounds, 64 lanes)
 runs="${1:-3}"
 lanes="${2:-64}"
-source "$(dirname "$0")/bench-setup.sh"
+source scripts/bench-setup.sh
 scene=$(bench_scene city 23)
 out="$dir/agvs-threads"
 mkdir -p "$out"

@@ -7,7 +7,7 @@ kind="${1:-office}"
 size="${2:-4}"
 cells="${3:-500}"
 seconds="${4:-60}"
-source "$(dirname "$0")/bench-setup.sh"
+source scripts/bench-setup.sh
 scene=$(bench_scene "$kind" "$size")
 out="$dir/agvs-$kind$size"
 mkdir -p docs/agvs

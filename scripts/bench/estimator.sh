@@ -11,7 +11,7 @@ cells="${3:-500}"
 max_samples="${4:-64000000}"
 cameras="${5:-20000}"
 camera_size="${6:-32}"
-source "$(dirname "$0")/bench-setup.sh"
+source scripts/bench-setup.sh
 scene=$(bench_scene "$kind" "$size")
 out="$dir/estimator-$kind$size"
 mkdir -p docs/agvs

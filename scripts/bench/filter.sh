@@ -5,7 +5,7 @@
 kind="${1:-office}"
 size="${2:-4}"
 cells="${3:-500}"
-source "$(dirname "$0")/bench-setup.sh"
+source scripts/bench-setup.sh
 scene=$(bench_scene "$kind" "$size")
 out="$dir/filter-$kind$size"
 bench_level "$scene" "$cells" "$out"

@@ -6,7 +6,7 @@
 # small bake to measure. Rewrites the "frames" section of BENCHMARKS.md.
 # Usage: scripts/bench.sh frames [FRAMES]   (default 200)
 frames="${1:-200}"
-source "$(dirname "$0")/bench-setup.sh"
+source scripts/bench-setup.sh
 out="$dir/frames"
 mkdir -p "$out"
 office=$(bench_scene office 2)

@@ -10,7 +10,7 @@
 size="${1:-23}"
 cells="${2:-50000}"
 bench_cmake_args="-DVIEWCELLS_BUILD_BENCH=ON"
-source "$(dirname "$0")/bench-setup.sh"
+source scripts/bench-setup.sh
 city=$(bench_scene city "$size")
 office=$(bench_scene office 4)
 "$vc" build "$city" --segments 1500000 --max-cells "$cells" --min-reduction 0 --seed 1 -q \

@@ -7,7 +7,7 @@
 # those measurements. Prints JSON lines and Markdown tables.
 # Usage: scripts/bench.sh mpi
 bench_cmake_args="-DVIEWCELLS_MPI=ON"
-source "$(dirname "$0")/bench-setup.sh"
+source scripts/bench-setup.sh
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 scene=$(bench_scene city 23)
 out="$dir/mpi"

@@ -6,7 +6,7 @@
 size="${1:-23}"
 cells="${2:-50000}"
 bench_cmake_args="-DVIEWCELLS_BUILD_BENCH=ON"
-source "$(dirname "$0")/bench-setup.sh"
+source scripts/bench-setup.sh
 city=$(bench_scene city "$size")
 if [ ! -f "$dir/city-merge.vcells" ]; then
   "$vc" build "$city" --segments 1500000 --max-cells "$cells" --min-reduction 0 --seed 1 -q \

@@ -5,7 +5,7 @@
 size="${1:-23}"
 runs="${2:-5}"
 bench_cmake_args="-DVIEWCELLS_BUILD_BENCH=ON"
-source "$(dirname "$0")/bench-setup.sh"
+source scripts/bench-setup.sh
 scene=$(bench_scene city "$size")
 # The street band: the whole footprint, from the ground to 30 m (where people and cars are).
 bounds=$("$vc" info "$scene" --json "$dir/info.json" >/dev/null && python3 scripts/vctables.py street-band "$dir/info.json")

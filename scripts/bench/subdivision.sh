@@ -10,7 +10,7 @@
 # Rewrites the subdivision section of BENCHMARKS.md. Usage: scripts/bench.sh subdivision [SIZE] [CELLS]
 size="${1:-23}"
 cells="${2:-50000}"
-source "$(dirname "$0")/bench-setup.sh"
+source scripts/bench-setup.sh
 scene=$(bench_scene city "$size")
 # peak KB FILE COMMAND...: runs COMMAND, writing its peak resident memory (KB) to FILE when
 # GNU time is there.

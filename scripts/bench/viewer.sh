@@ -7,7 +7,7 @@
 # resolution (the panel's choice). Also the time from a click to the lit PVS.
 # Prints one JSON line per run and a Markdown table for BENCHMARKS.md.
 # Usage: scripts/bench.sh viewer [SECONDS]
-source "$(dirname "$0")/bench-setup.sh"
+source scripts/bench-setup.sh
 seconds="${1:-20}"
 out="$dir/viewer"
 mkdir -p "$out"
