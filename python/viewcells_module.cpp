@@ -161,11 +161,13 @@ std::vector<std::string> option_texts(const pipeline::BakeOption& option, const 
 
 /// The options as keywords, for help: "  max_cells=INT in [1, 10000000]  Elementary cells ...".
 std::string keyword_listing() {
-  std::string out;
-  for (const pipeline::BakeOption& o : pipeline::bake_option_table())
+  std::string out, heading;
+  for (const pipeline::BakeOption& o : pipeline::bake_option_table()) {
+    if (o.group != heading) out += "\n" + (heading = o.group) + ":\n";
     out += "  " + o.keyword + "=" + (o.kind == pipeline::BakeOption::Kind::kFlag ? std::string("True|False")
                                                                   : o.type.empty() ? std::string("TEXT") : o.type) +
            "\n      " + o.help + "\n";
+  }
   return out;
 }
 

@@ -399,13 +399,20 @@ void floor_options(std::vector<BakeOption>& t) {
 
 std::vector<BakeOption> make_table() {
   std::vector<BakeOption> t;
-  sampling_options(t);
-  budget_options(t);
-  subdivision_options(t);
-  merge_options(t);
-  agvs_options(t);
-  bake_own_options(t);
-  floor_options(t);
+  // Each group under its heading in help (the floors' options name theirs).
+  auto group = [&t](void (*add)(std::vector<BakeOption>&), const char* heading) {
+    const size_t from = t.size();
+    add(t);
+    for (size_t i = from; i < t.size(); ++i)
+      if (t[i].group.empty()) t[i].group = heading;
+  };
+  group(sampling_options, "Scene and sampling");
+  group(budget_options, "Budget");
+  group(subdivision_options, "View cells: subdivision and render cost model");
+  group(merge_options, "Merging");
+  group(agvs_options, "PVSs by AGVS: when it stops, how it samples");
+  group(bake_own_options, "The bake: time, work directory, measured stops, frame and near-object samples, the proof");
+  group(floor_options, "");
   for (BakeOption& o : t) {
     o.keyword = o.flag.substr(2);
     std::replace(o.keyword.begin(), o.keyword.end(), '-', '_');

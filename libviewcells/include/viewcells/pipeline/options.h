@@ -129,7 +129,7 @@ struct BakeOption {
   Kind kind = Kind::kText;
   std::string type;         ///< what a value must be, for help: "INT in [1, 10000000]", "NUMBER > 0", "{a,b}"; "" any text
   std::string help;
-  std::string group;        ///< help's heading, or empty
+  std::string group;        ///< help's heading ("Budget")
   bool show_default = false;
   std::vector<std::string> excludes;  ///< flags it may not be given with
   OptionCheck check;
