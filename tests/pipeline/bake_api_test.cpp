@@ -424,8 +424,16 @@ TEST(BakeDefaults, EveryOptionOfTheTableMeansTheSameToBothParsers) {
     ++tried;
   }
   EXPECT_GT(tried, 60u);
+  // A negation given a truth value turns the option off for any way of writing true.
+  for (const char* on : {"true", "1", "on", "yes"})
+    EXPECT_FALSE(pipeline::parse_bake_words(
+                     {"level.obj", "-o", "level.pvs", "--prove-hidden", std::string("--no-prove-hidden=") + on})
+                     .bound.prove_hidden)
+        << on;
+  EXPECT_THROW(pipeline::parse_bake_words({"level.obj", "-o", "level.pvs", "--no-prove-hidden=maybe"}), Error);
   // A negation, and the "=" form, in both.
   for (const std::vector<std::string>& extra : {std::vector<std::string>{"--prove-hidden", "--no-prove-hidden"},
+                                                 std::vector<std::string>{"--prove-hidden", "--no-prove-hidden=1"},
                                                  std::vector<std::string>{"--cells=7"}}) {
     std::vector<std::string> words = {"level.obj", "-o", "level.pvs", "--cells", "100"};
     if (extra.front() == "--cells=7") words = {"level.obj", "-o", "level.pvs"};

@@ -245,8 +245,6 @@ OptionCheck number_check(std::function<bool(double)> ok, const std::string& want
   };
 }
 
-
-
 const BakeOption* find_bake_option(const std::string& name) {
   for (const BakeOption& o : bake_option_table())
     if (o.flag == name || o.keyword == name || (!o.negation.empty() && o.negation == name)) return &o;
@@ -317,9 +315,11 @@ BakeOptions parse_bake_words(const std::vector<std::string>& words) {
     if (!option || name.rfind("--", 0) != 0)
       throw Error("bake: unknown option " + name + " (the options are those of `viewcells bake --help`)");
     if (option->kind == BakeOption::Kind::kFlag) {
-      const bool negated = name == option->negation;
       std::string value = eq == std::string::npos ? "true" : word.substr(eq + 1);
-      if (negated) value = value == "true" ? "false" : (value == "false" ? "true" : value);
+      if (name == option->negation) {  // --no-x=1 is --x=false; what is no truth value stays, refused
+        if (value == "true" || value == "1" || value == "on" || value == "yes") value = "false";
+        else if (value == "false" || value == "0" || value == "off" || value == "no") value = "true";
+      }
       set_bake_option(options, *option, value, name);
       continue;
     }
