@@ -288,6 +288,7 @@ RawMesh decode(const std::string& b, const std::string& name) {
   size_t pos = 0;
   auto get = [&](void* p, size_t n) {
     if (n > b.size() - pos) throw Error(name, 0, "internal: the Assimp reader's answer is truncated");
+    if (n == 0) return;  // an empty vector's data() may be null, which memcpy may not be given
     std::memcpy(p, b.data() + pos, n);
     pos += n;
   };
