@@ -27,37 +27,18 @@ pipeline::Log Common::logger() const {
 
 namespace {
 
-std::string short_number(double v) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", v);
-  return text;
-}
-
-CLI::Validator validator(const pipeline::OptionCheck& check, const std::string& name) {
-  return CLI::Validator([check](std::string& text) { return check(text); }, name);
+CLI::Validator validator(const pipeline::ValueRule& rule) {
+  return CLI::Validator([check = rule.check](std::string& text) { return check(text); }, rule.type);
 }
 
 }  // namespace
 
-CLI::Validator whole(uint64_t lo, uint64_t hi) {
-  return validator(pipeline::whole_check(lo, hi), "INT in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-}
+CLI::Validator whole(uint64_t lo, uint64_t hi) { return validator(pipeline::whole_rule(lo, hi)); }
+CLI::Validator positive() { return validator(pipeline::positive_rule()); }
+CLI::Validator non_negative() { return validator(pipeline::non_negative_rule()); }
+CLI::Validator in_range(double lo, double hi) { return validator(pipeline::range_rule(lo, hi)); }
 
-CLI::Validator positive() {
-  return validator(pipeline::number_check([](double v) { return v > 0; }, "a number above 0"), "NUMBER > 0");
-}
-
-CLI::Validator non_negative() {
-  return validator(pipeline::number_check([](double v) { return v >= 0; }, "a number of at least 0"), "NUMBER >= 0");
-}
-
-CLI::Validator in_range(double lo, double hi) {
-  return validator(pipeline::number_check([lo, hi](double v) { return v >= lo && v <= hi; },
-                                          "a number from " + short_number(lo) + " to " + short_number(hi)),
-                   "NUMBER in [" + short_number(lo) + ", " + short_number(hi) + "]");
-}
-
-CLI::Validator table_check(const pipeline::BakeOption& o) { return validator(o.check, o.type); }
+CLI::Validator table_check(const pipeline::BakeOption& o) { return validator({o.check, o.type}); }
 
 void check_no_empty_values(const CLI::App& command) {
   for (const CLI::Option* o : command.get_options())

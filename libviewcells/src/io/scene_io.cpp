@@ -11,31 +11,21 @@
 
 #include "viewcells/core/binary_file.h"
 #include "viewcells/core/error.h"
-#include <map>
-#include <mutex>
+#include "viewcells/core/registry.h"
 
 namespace viewcells {
 
 namespace {
-std::mutex formats_mutex;
-std::map<std::string, SceneFormat>& formats() {
-  static std::map<std::string, SceneFormat> f;
+ExtensionRegistry<SceneFormat>& formats() {
+  static ExtensionRegistry<SceneFormat> f;
   return f;
 }
 }  // namespace
 
-void register_scene_format(SceneFormat format) {
-  if (format.extension.empty() || format.extension[0] != '.' || !format.read)
-    throw Error("register_scene_format: an extension with its dot and a reader are needed");
-  const std::lock_guard<std::mutex> lock(formats_mutex);
-  std::string ext = format.extension;
-  formats()[ext] = std::move(format);
-}
+void register_scene_format(SceneFormat format) { formats().add(std::move(format), "register_scene_format"); }
 
-const SceneFormat* registered_scene_format(const std::string& path) {
-  const std::lock_guard<std::mutex> lock(formats_mutex);
-  const auto it = formats().find(lower_extension(path));
-  return it == formats().end() ? nullptr : &it->second;
+std::optional<SceneFormat> registered_scene_format(const std::string& path) {
+  return formats().find(lower_extension(path));
 }
 
 Scene load_scene(const std::string& path, ObjectGrouping grouping) {
@@ -68,7 +58,7 @@ Scene load_scene(const std::string& path, ObjectGrouping grouping) {
     mesh = read_off(read_file_bytes(path), path);
   } else if (ext == ".stl") {
     mesh = read_stl(read_file_bytes(path), path);
-  } else if (const SceneFormat* registered = registered_scene_format(path)) {
+  } else if (const std::optional<SceneFormat> registered = registered_scene_format(path)) {
     mesh = registered->read(path);
   } else if (ext == ".bsp") {
     throw Error(path, 0, "a Quake 3 map, but no reader for .bsp was registered (a front end calls "

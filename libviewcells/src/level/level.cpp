@@ -1,18 +1,16 @@
 /// Level formats registered by front ends (level/level.h), and what a level brings by default.
 #include "viewcells/level/level.h"
 
-#include <map>
-#include <mutex>
 
 #include "viewcells/core/error.h"
+#include "viewcells/core/registry.h"
 #include "viewcells/io/scene_io.h"
 
 namespace viewcells {
 
 namespace {
-std::mutex levels_mutex;
-std::map<std::string, LevelFormat>& levels() {
-  static std::map<std::string, LevelFormat> l;
+ExtensionRegistry<LevelFormat>& levels() {
+  static ExtensionRegistry<LevelFormat> l;
   return l;
 }
 }  // namespace
@@ -31,34 +29,18 @@ PlaySpaceComparison LevelData::compare_play_space(const Scene&, const RayCaster&
   throw Error("a " + kind() + " knows no play space of its own to compare with");
 }
 
-void register_level_format(LevelFormat format) {
-  if (format.extension.empty() || format.extension[0] != '.' || !format.read)
-    throw Error("register_level_format: an extension with its dot and a reader are needed");
-  const std::lock_guard<std::mutex> lock(levels_mutex);
-  const std::string ext = format.extension;
-  levels()[ext] = std::move(format);
-}
+void register_level_format(LevelFormat format) { levels().add(std::move(format), "register_level_format"); }
 
-bool is_level_file(const std::string& path) {
-  const std::lock_guard<std::mutex> lock(levels_mutex);
-  return levels().count(lower_extension(path)) > 0;
-}
+bool is_level_file(const std::string& path) { return levels().find(lower_extension(path)).has_value(); }
 
 std::string level_format_name(const std::string& path) {
-  const std::lock_guard<std::mutex> lock(levels_mutex);
-  const auto it = levels().find(lower_extension(path));
-  return it == levels().end() ? std::string() : it->second.name;
+  const std::optional<LevelFormat> format = levels().find(lower_extension(path));
+  return format ? format->name : std::string();
 }
 
 std::shared_ptr<const LevelData> read_level_data(const std::string& path) {
-  std::function<std::shared_ptr<const LevelData>(const std::string&)> read;
-  {
-    const std::lock_guard<std::mutex> lock(levels_mutex);
-    const auto it = levels().find(lower_extension(path));
-    if (it == levels().end()) return nullptr;
-    read = it->second.read;
-  }
-  return read(path);
+  const std::optional<LevelFormat> format = levels().find(lower_extension(path));
+  return format ? format->read(path) : nullptr;
 }
 
 }  // namespace viewcells

@@ -215,24 +215,31 @@ BakeConfig BakeOptions::config(bool quiet) const {
   return config;
 }
 
-namespace {
-
-std::string refused(const std::string& text, const std::string& wanted) {
+std::string refused_value(const std::string& text, const std::string& wanted) {
   return "'" + text + "' is not allowed: give " + wanted;
 }
 
-}  // namespace
-
-OptionCheck whole_check(uint64_t lo, uint64_t hi) {
-  return [lo, hi](const std::string& text) -> std::string {
-    uint64_t v = 0;
-    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (text.empty() || ec != std::errc() || ptr != text.data() + text.size() || v < lo || v > hi)
-      return refused(text, "a whole number from " + std::to_string(lo) + " to " + std::to_string(hi));
-    return "";
-  };
+std::string option_number(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
 }
 
+ValueRule whole_rule(uint64_t lo, uint64_t hi) {
+  const std::string range = std::to_string(lo) + " to " + std::to_string(hi);
+  return {[lo, hi, range](const std::string& text) -> std::string {
+            uint64_t v = 0;
+            const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+            if (text.empty() || ec != std::errc() || ptr != text.data() + text.size() || v < lo || v > hi)
+              return refused_value(text, "a whole number from " + range);
+            return "";
+          },
+          "INT in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]"};
+}
+
+namespace {
+
+/// One finite number that `ok` accepts; `wanted` completes "give ...".
 OptionCheck number_check(std::function<bool(double)> ok, const std::string& wanted) {
   return [ok, wanted](const std::string& text) -> std::string {
     try {
@@ -241,8 +248,21 @@ OptionCheck number_check(std::function<bool(double)> ok, const std::string& want
       if (used == text.size() && std::isfinite(v) && ok(v)) return "";
     } catch (const std::exception&) {
     }
-    return refused(text, wanted);
+    return refused_value(text, wanted);
   };
+}
+
+}  // namespace
+
+ValueRule any_number_rule() { return {number_check([](double) { return true; }, "a finite number"), ""}; }
+ValueRule positive_rule() { return {number_check([](double v) { return v > 0; }, "a number above 0"), "NUMBER > 0"}; }
+ValueRule non_negative_rule() {
+  return {number_check([](double v) { return v >= 0; }, "a number of at least 0"), "NUMBER >= 0"};
+}
+ValueRule range_rule(double lo, double hi) {
+  return {number_check([lo, hi](double v) { return v >= lo && v <= hi; },
+                       "a number from " + option_number(lo) + " to " + option_number(hi)),
+          "NUMBER in [" + option_number(lo) + ", " + option_number(hi) + "]"};
 }
 
 const BakeOption* find_bake_option(const std::string& name) {

@@ -15,32 +15,11 @@ namespace {
 using Kind = BakeOption::Kind;
 using Check = OptionCheck;
 
-std::string refused(const std::string& text, const std::string& wanted) {
-  return "'" + text + "' is not allowed: give " + wanted;
-}
-
-std::string short_number(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
-
-/// The numbers' checks and how help names them.
-struct NumberRule {
-  Check check;
-  std::string type;
-};
-/// Any finite number (the cost model checks its own ranges, naming the field).
-NumberRule any_number() { return {number_check([](double) { return true; }, "a finite number"), ""}; }
-NumberRule positive() { return {number_check([](double v) { return v > 0; }, "a number above 0"), "NUMBER > 0"}; }
-NumberRule non_negative() {
-  return {number_check([](double v) { return v >= 0; }, "a number of at least 0"), "NUMBER >= 0"};
-}
-NumberRule in_range(double lo, double hi) {
-  return {number_check([lo, hi](double v) { return v >= lo && v <= hi; },
-                       "a number from " + short_number(lo) + " to " + short_number(hi)),
-          "NUMBER in [" + short_number(lo) + ", " + short_number(hi) + "]"};
-}
+/// The number rules, by the names the table reads best with.
+ValueRule any_number() { return any_number_rule(); }
+ValueRule positive() { return positive_rule(); }
+ValueRule non_negative() { return non_negative_rule(); }
+ValueRule in_range(double lo, double hi) { return range_rule(lo, hi); }
 
 std::optional<bool> truth(const std::string& text) {
   if (text == "true" || text == "1" || text == "on" || text == "yes") return true;
@@ -56,10 +35,11 @@ BakeOption whole(const std::string& flag, Get get, uint64_t lo, uint64_t hi, std
   BakeOption o;
   o.flag = flag;
   o.kind = Kind::kWhole;
-  o.type = "INT in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]";
+  const ValueRule rule = whole_rule(lo, hi);
+  o.type = rule.type;
   o.help = std::move(help);
   o.show_default = show;
-  o.check = whole_check(lo, hi);
+  o.check = rule.check;
   o.set = [get](BakeOptions& b, const std::string& text) {
     using T = std::remove_reference_t<decltype(get(b))>;
     get(b) = static_cast<T>(std::stoull(text));
@@ -72,7 +52,7 @@ BakeOption whole(const std::string& flag, Get get, uint64_t lo, uint64_t hi, std
 }
 
 template <class Get>
-BakeOption number(const std::string& flag, Get get, const NumberRule& rule, std::string help, bool show = false) {
+BakeOption number(const std::string& flag, Get get, const ValueRule& rule, std::string help, bool show = false) {
   BakeOption o;
   o.flag = flag;
   o.kind = Kind::kNumber;
@@ -83,7 +63,7 @@ BakeOption number(const std::string& flag, Get get, const NumberRule& rule, std:
   o.set = [get](BakeOptions& b, const std::string& text) { get(b) = std::stod(text); };
   o.show = [get](const BakeOptions& b) {
     BakeOptions copy = b;
-    return short_number(get(copy));
+    return option_number(get(copy));
   };
   return o;
 }
@@ -105,7 +85,7 @@ BakeOption text(const std::string& flag, Get get, std::string help, bool show = 
     }
     o.type = "{" + list + "}";
     o.check = [members, said](const std::string& t) {
-      return std::find(members.begin(), members.end(), t) != members.end() ? "" : refused(t, said);
+      return std::find(members.begin(), members.end(), t) != members.end() ? "" : refused_value(t, said);
     };
   } else {
     o.check = [](const std::string&) { return std::string(); };
@@ -126,7 +106,7 @@ BakeOption flag(const std::string& name, Get get, std::string help, const std::s
   o.negation = negation;
   o.kind = Kind::kFlag;
   o.help = std::move(help);
-  o.check = [](const std::string& t) { return truth(t) ? "" : refused(t, "true or false"); };
+  o.check = [](const std::string& t) { return truth(t) ? "" : refused_value(t, "true or false"); };
   o.set = [get](BakeOptions& b, const std::string& t) { get(b) = *truth(t); };
   o.show = [get](const BakeOptions& b) {
     BakeOptions copy = b;

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <istream>
 #include <functional>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -34,8 +35,8 @@ struct SceneFormat {
 };
 /// Registers `format` (again: replaces the one of the same extension). Thread-safe.
 void register_scene_format(SceneFormat format);
-/// The registered format of `path`'s extension, or null.
-const SceneFormat* registered_scene_format(const std::string& path);
+/// The registered format of `path`'s extension (a copy), or none.
+std::optional<SceneFormat> registered_scene_format(const std::string& path);
 
 /// The extension of `path` in lower case, with its dot ("" when it has none).
 inline std::string lower_extension(const std::string& path) {

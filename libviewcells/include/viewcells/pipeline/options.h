@@ -40,10 +40,23 @@ std::vector<std::string> split_list(const std::string& text);
 /// A check of an option's text: "" when it is a value the option takes, else why not
 /// ("'x' is not allowed: give a whole number from 1 to 10").
 using OptionCheck = std::function<std::string(const std::string& text)>;
+/// A check and how help names what it takes ("INT in [1, 10]", "NUMBER > 0"; "" any text): the
+/// table's options and the command line's own options share these.
+struct ValueRule {
+  OptionCheck check;
+  std::string type;
+};
 /// A whole number from lo to hi, written without sign or exponent.
-OptionCheck whole_check(uint64_t lo, uint64_t hi);
-/// One finite number that `ok` accepts; `wanted` completes "give ..." ("a number above 0").
-OptionCheck number_check(std::function<bool(double)> ok, const std::string& wanted);
+ValueRule whole_rule(uint64_t lo, uint64_t hi);
+/// A finite number, any (what takes it checks its own range).
+ValueRule any_number_rule();
+ValueRule positive_rule();
+ValueRule non_negative_rule();
+ValueRule range_rule(double lo, double hi);
+/// "'TEXT' is not allowed: give WANTED".
+std::string refused_value(const std::string& text, const std::string& wanted);
+/// A number as help shows it (1e-06, 0.25, 100).
+std::string option_number(double v);
 
 /// Where players stand on a scene without a view space of its own (viewspace/floor_space.h).
 struct FloorOptions {
